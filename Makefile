@@ -1,0 +1,40 @@
+# rover-cosim: two commands set up everything —
+#   make run    creates .venv if missing and runs the whole pipeline that exists so far
+#   make test   creates .venv if missing and runs the test suite
+# Nothing else needs installing by hand: python3 (>= 3.11), gcc and make are enough.
+
+PYTHON ?= python3
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+RESULTS ?= results
+
+.PHONY: run test fig3 bench venv clean
+
+# The virtualenv is (re)installed when pyproject.toml changes; the stamp records success.
+$(STAMP): pyproject.toml
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "rover-cosim needs Python >= 3.11, found " + sys.version.split()[0])'
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[test]'
+	@touch $@
+
+venv: $(STAMP)
+
+## run: the whole pipeline that exists so far (now: the paper's Fig. 3 from the reference wheel)
+run: fig3
+
+## fig3: Fx against slip for loads 100..800 N -> results/fig3_fx_vs_slip.{csv,png}
+fig3: $(STAMP)
+	$(VENV)/bin/rover-cosim fig3 --out $(RESULTS)
+
+## test: the test suite
+test: $(STAMP)
+	$(PY) -m pytest
+
+## bench: benchmarks (not tests) -> results/bench/*.json
+bench: $(STAMP)
+	$(PY) benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
+
+clean:
+	rm -rf $(VENV) $(RESULTS) .pytest_cache

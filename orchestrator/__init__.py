@@ -1,0 +1,1 @@
+"""Pipeline driver: the ``rover-cosim`` command and the jobs behind the Makefile targets."""

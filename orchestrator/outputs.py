@@ -1,0 +1,68 @@
+"""Writing results: all-or-nothing file groups and the record of what a run did."""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+from datetime import datetime, timezone
+from importlib import metadata
+from pathlib import Path
+from typing import Mapping
+
+PACKAGES = ("rover-cosim", "numpy", "scipy", "pandas", "matplotlib")
+
+
+def write_all(files: Mapping[Path, bytes]) -> None:
+    """Write every file or none of them.
+
+    Each payload goes to a temporary file beside its target first; only when all temporaries
+    are complete are they renamed into place (a rename within a directory is atomic), so a
+    failure leaves no half-written result and no stray temporary.
+    """
+    staged: list[tuple[Path, Path]] = []
+    try:
+        for target, payload in files.items():
+            target.parent.mkdir(parents=True, exist_ok=True)
+            handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+            staged.append((Path(temporary), target))
+            with os.fdopen(handle, "wb") as stream:
+                stream.write(payload)
+        for temporary, target in staged:
+            os.replace(temporary, target)
+    finally:
+        for temporary, _ in staged:
+            temporary.unlink(missing_ok=True)
+
+
+def _version(package: str) -> str | None:
+    try:
+        return metadata.version(package)
+    except metadata.PackageNotFoundError:
+        return None
+
+
+def _git_commit() -> str | None:
+    try:
+        result = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10,
+                                cwd=Path(__file__).resolve().parent)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return result.stdout.strip() or None if result.returncode == 0 else None
+
+
+def run_record(command: str, parameters: Mapping[str, object]) -> bytes:
+    """JSON bytes describing a run: command, parameters, versions, commit, machine, time."""
+    record = {
+        "command": command,
+        "parameters": parameters,
+        "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "git_commit": _git_commit(),
+        "python": sys.version.split()[0],
+        "platform": platform.platform(),
+        "versions": {name: _version(name) for name in PACKAGES},
+    }
+    return (json.dumps(record, indent=2, default=str) + "\n").encode()

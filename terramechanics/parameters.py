@@ -1,0 +1,109 @@
+"""Wheel and soil parameters of the terramechanics wheel model (paper Table 2).
+
+These dataclasses are the single Python place for the wheel and soil numbers; the Modelica
+records in ``modelica/`` mirror the same field names. All values are SI: lengths in m,
+stresses in Pa, angles in rad.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+
+def _check(name: str, value: float, ok: bool, expected: str) -> None:
+    """Raise ValueError naming the field, its value and the accepted range unless ``ok``."""
+    if not ok:
+        raise ValueError(f"{name}={value!r} is not physical: expected {expected}")
+
+
+def _check_finite(obj: object) -> None:
+    for f in fields(obj):  # type: ignore[arg-type]
+        value = getattr(obj, f.name)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise TypeError(f"{f.name}={value!r}: expected a real number")
+        _check(f.name, value, math.isfinite(value), "a finite number")
+
+
+@dataclass(frozen=True)
+class Wheel:
+    """Rigid wheel geometry and inertia.
+
+    Attributes:
+        r: wheel radius [m] (Table 2: 0.355 m).
+        b: wheel width, "tread" in Table 2 [m] (0.175 m).
+        J: wheel polar moment of inertia about its axle [kg·m²]. Not given in the paper;
+            0.5 kg·m² is a uniform 8 kg disc of radius 0.355 m (J = m r² / 2), the order of a
+            wheel rim of an ATHLETE-class rover. It only matters for wheel spin dynamics.
+    """
+
+    r: float = 0.355
+    b: float = 0.175
+    J: float = 0.5
+
+    def __post_init__(self) -> None:
+        _check_finite(self)
+        _check("r", self.r, self.r > 0, "r > 0 m")
+        _check("b", self.b, self.b > 0, "b > 0 m")
+        _check("J", self.J, self.J > 0, "J > 0 kg·m²")
+
+
+@dataclass(frozen=True)
+class Soil:
+    """Soil parameters of the Bekker/Wong-Reece/Ishigami wheel-soil model (Eqs. 3-10).
+
+    Attributes:
+        c: cohesion stress [Pa] (Table 2: 0.80 kPa).
+        phi: internal friction angle [rad] (Table 2: 37.2 deg); use ``Soil.from_degrees``
+            to give it in degrees.
+        kc: cohesive pressure-sinkage modulus [N/m^(n+1)] (1.37e3).
+        kphi: frictional pressure-sinkage modulus [N/m^(n+2)] (8.14e5).
+        n: sinkage exponent [-] (1.0).
+        kx: shear deformation modulus in x [m] (0.036 m).
+        a0: constant of the maximum-stress angle, Eq. (3) [-] (0.4).
+        a1: slip coefficient of the maximum-stress angle, Eq. (3) [-] (0.15).
+        lam: wheel sinkage ratio λ of the exit angle, Eq. (2) [-] (0.90).
+
+    The accepted ranges keep the contact patch well defined for every slip in [-1, 1]:
+    0 < a0 - a1 and a0 + a1 < 1 put the maximum-stress angle strictly between the exit and
+    entry angles.
+    """
+
+    c: float = 800.0
+    phi: float = math.radians(37.2)
+    kc: float = 1.37e3
+    kphi: float = 8.14e5
+    n: float = 1.0
+    kx: float = 0.036
+    a0: float = 0.4
+    a1: float = 0.15
+    lam: float = 0.90
+
+    def __post_init__(self) -> None:
+        _check_finite(self)
+        _check("c", self.c, self.c >= 0, "c >= 0 Pa")
+        _check("phi", self.phi, 0 < self.phi < math.pi / 2, "0 < phi < pi/2 rad")
+        _check("kc", self.kc, self.kc >= 0, "kc >= 0 N/m^(n+1)")
+        _check("kphi", self.kphi, self.kphi > 0, "kphi > 0 N/m^(n+2)")
+        _check("n", self.n, self.n > 0, "n > 0")
+        _check("kx", self.kx, self.kx > 0, "kx > 0 m")
+        _check("a0", self.a0, 0 < self.a0 < 1, "0 < a0 < 1")
+        _check("a1", self.a1, 0 <= self.a1 < self.a0 and self.a0 + self.a1 < 1,
+               f"0 <= a1 < min(a0, 1 - a0) = {min(self.a0, 1 - self.a0)!r}")
+        _check("lam", self.lam, 0 < self.lam <= 1, "0 < lam <= 1")
+
+    @classmethod
+    def from_degrees(cls, phi_deg: float, **others: float) -> "Soil":
+        """Soil with the friction angle given in degrees [deg]; other fields as keywords."""
+        _check("phi_deg", phi_deg, isinstance(phi_deg, (int, float)) and 0 < phi_deg < 90,
+               "0 < phi_deg < 90 deg")
+        return cls(phi=math.radians(phi_deg), **others)
+
+    @property
+    def phi_deg(self) -> float:
+        """Internal friction angle [deg]."""
+        return math.degrees(self.phi)
+
+    def bekker_modulus(self, b: float) -> float:
+        """k = kc / b + kphi [N/m^(n+2)], the Bekker pressure-sinkage modulus for width b [m]."""
+        return self.kc / b + self.kphi

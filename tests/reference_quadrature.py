@@ -1,0 +1,34 @@
+"""Independent reference for Eqs. (11)-(13): composite Simpson on 20 000 points per piece.
+
+It uses the public stress functions of Eqs. (5)-(10) directly (both σ branches, the
+shear displacement as written), not the fused, node-sharing kernel of terramechanics.forces.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import simpson
+
+from terramechanics import Soil, Wheel, entry_angle, exit_angle, max_stress_angle
+from terramechanics import normal_stress, shear_displacement, shear_stress
+
+POINTS = 20_000
+
+
+def reference_forces(sinkage: float, slip: float, wheel: Wheel, soil: Soil,
+                     points: int = POINTS) -> np.ndarray:
+    """(Fx, Fz, Tx) for one sinkage [m] and slip [-], pieces [θr, θm] and [θm, θf]."""
+    theta_f = entry_angle(sinkage, wheel)
+    theta_r = exit_angle(sinkage, wheel, soil)
+    theta_m = max_stress_angle(theta_f, slip, soil)
+    total = np.zeros(3)
+    for start, end in ((theta_r, theta_m), (theta_m, theta_f)):
+        theta = np.linspace(start, end, points)
+        sigma = normal_stress(theta, theta_f, theta_r, theta_m, wheel, soil)
+        tau = shear_stress(sigma, shear_displacement(theta, theta_f, slip, wheel), soil)
+        total += [
+            wheel.r * wheel.b * simpson(tau * np.cos(theta) - sigma * np.sin(theta), x=theta),
+            wheel.r * wheel.b * simpson(tau * np.sin(theta) + sigma * np.cos(theta), x=theta),
+            wheel.r**2 * wheel.b * simpson(tau, x=theta),
+        ]
+    return total

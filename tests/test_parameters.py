@@ -1,0 +1,56 @@
+import math
+
+import pytest
+
+from terramechanics import Soil, Wheel
+
+
+def test_defaults_are_table_2():
+    wheel, soil = Wheel(), Soil()
+    assert (wheel.r, wheel.b) == (0.355, 0.175)
+    assert wheel.J > 0
+    assert soil.c == 800.0
+    assert soil.phi == pytest.approx(math.radians(37.2))
+    assert soil.phi_deg == pytest.approx(37.2)
+    assert (soil.kc, soil.kphi, soil.n, soil.kx) == (1.37e3, 8.14e5, 1.0, 0.036)
+    assert (soil.a0, soil.a1, soil.lam) == (0.4, 0.15, 0.90)
+
+
+def test_friction_angle_in_degrees():
+    soil = Soil.from_degrees(30.0, c=100.0)
+    assert soil.phi == pytest.approx(math.pi / 6)
+    assert soil.c == 100.0
+    with pytest.raises(ValueError, match=r"phi_deg=95.0.*0 < phi_deg < 90"):
+        Soil.from_degrees(95.0)
+
+
+def test_bekker_modulus():
+    assert Soil().bekker_modulus(0.175) == pytest.approx(1.37e3 / 0.175 + 8.14e5)
+
+
+@pytest.mark.parametrize("field, value, expected", [
+    ("r", 0.0, "r > 0"), ("r", -0.1, "r > 0"), ("b", 0.0, "b > 0"), ("J", -1.0, "J > 0"),
+    ("r", float("nan"), "finite"), ("b", float("inf"), "finite"),
+])
+def test_wheel_rejects_non_physical(field, value, expected):
+    with pytest.raises(ValueError, match=rf"{field}={value!r}.*{expected}"):
+        Wheel(**{field: value})
+
+
+@pytest.mark.parametrize("field, value, expected", [
+    ("phi", 0.0, "0 < phi < pi/2"), ("phi", math.pi / 2, "0 < phi < pi/2"), ("phi", 37.2, "0 < phi < pi/2"),
+    ("lam", 0.0, "0 < lam <= 1"), ("lam", 1.2, "0 < lam <= 1"),
+    ("n", 0.0, "n > 0"), ("n", -1.0, "n > 0"),
+    ("kx", 0.0, "kx > 0"), ("kx", -0.01, "kx > 0"),
+    ("c", -1.0, "c >= 0"), ("kc", -5.0, "kc >= 0"), ("kphi", 0.0, "kphi > 0"),
+    ("a0", 1.0, "0 < a0 < 1"), ("a1", 0.5, "a1 <"), ("a1", -0.1, "a1 <"),
+    ("c", float("nan"), "finite"),
+])
+def test_soil_rejects_non_physical(field, value, expected):
+    with pytest.raises(ValueError, match=rf"{field}={value!r}.*{expected}"):
+        Soil(**{field: value})
+
+
+def test_non_numbers_are_rejected():
+    with pytest.raises(TypeError, match="r='0.3'"):
+        Wheel(r="0.3")
