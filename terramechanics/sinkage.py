@@ -138,9 +138,10 @@ def _raise_unsolved(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil
     if too_heavy.any():
         i = int(np.argmax(too_heavy))
         raise ValueError(
-            f"load={load[i]!r} N at slip={slip[i]!r}: the wheel (r={wheel.r} m) cannot carry it with "
+            f"load={float(load[i])!r} N at slip={float(slip[i])!r}: the wheel (r={wheel.r} m) cannot carry it with "
             f"a sinkage below its radius; the most it carries at that slip is {capacity[i]:.6g} N")
-    raise RuntimeError(f"sinkage iteration did not converge for load={load[0]!r} N, slip={slip[0]!r}")
+    raise RuntimeError(f"sinkage iteration did not converge for load={float(load[0])!r} N, "
+                       f"slip={float(slip[0])!r}")
 
 
 def wheel_state(
@@ -164,9 +165,6 @@ def wheel_state(
     w, kappa = np.broadcast_arrays(w, kappa)
     shape = w.shape
     w, kappa = w.ravel().copy(), kappa.ravel().copy()
-    if not np.isfinite(w).all():
-        i = int(np.argmin(np.isfinite(w)))
-        raise ValueError(f"load[{i}]={w[i]!r} N: expected a finite load > 0 N")
 
     h, forces = solve_sinkage(w, kappa, wheel, soil, rtol, nodes)
     theta_f = entry_angle(h, wheel)

@@ -1,0 +1,73 @@
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from orchestrator import cli, fig3
+from orchestrator.outputs import write_all
+
+
+def test_fig3_writes_csv_png_and_record(tmp_path, capsys):
+    assert cli.main(["fig3", "--out", str(tmp_path)]) == 0
+    table = pd.read_csv(tmp_path / "fig3_fx_vs_slip.csv")
+    assert list(table.columns) == ["load_N", "slip", "sinkage_m", "Fx_N", "Fz_N", "Tx_Nm"]
+    assert sorted(table["load_N"].unique()) == [100.0 * i for i in range(1, 9)]
+    assert table["slip"].min() == 0.0 and table["slip"].max() == pytest.approx(0.9)
+    assert len(table) == 8 * 91
+    np.testing.assert_allclose(table["Fz_N"], table["load_N"], rtol=1e-6)
+    assert (table["sinkage_m"] > 0).all()
+    assert (tmp_path / "fig3_fx_vs_slip.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    record = json.loads((tmp_path / "fig3_fx_vs_slip.json").read_text())
+    assert record["command"] == "rover-cosim fig3"
+    assert record["parameters"]["soil"]["kphi"] == 8.14e5
+    assert "wrote" in capsys.readouterr().out
+    assert not list(tmp_path.glob(".*.part"))
+
+
+def test_custom_loads_and_step(tmp_path):
+    assert cli.main(["fig3", "--out", str(tmp_path), "--loads", "275,575", "--slip-step", "0.3"]) == 0
+    table = pd.read_csv(tmp_path / "fig3_fx_vs_slip.csv")
+    assert sorted(table["load_N"].unique()) == [275.0, 575.0]
+    np.testing.assert_allclose(sorted(table["slip"].unique()), [0.0, 0.3, 0.6, 0.9])
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--loads", "100,-5"], "load=-5.0 N"),
+    (["--loads", "heavy"], "loads='heavy'"),
+    (["--slip-step", "0"], "slip step=0.0"),
+])
+def test_bad_arguments_are_named(tmp_path, capsys, args, message):
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main(["fig3", "--out", str(tmp_path), *args])
+    assert exit_info.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_load_the_wheel_cannot_carry_fails_cleanly(tmp_path, capsys):
+    assert cli.main(["fig3", "--out", str(tmp_path), "--loads", "100,1e7"]) == 2
+    assert "load=10000000.0 N" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_failed_drawing_leaves_previous_results_untouched(tmp_path, monkeypatch):
+    old = tmp_path / "fig3_fx_vs_slip.csv"
+    old.write_text("previous\n")
+
+    def broken(table):
+        raise RuntimeError("renderer failed")
+
+    monkeypatch.setattr(fig3, "fig3_figure", broken)
+    with pytest.raises(RuntimeError, match="renderer failed"):
+        fig3.write_fig3(tmp_path)
+    assert old.read_text() == "previous\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig3_fx_vs_slip.csv"]
+
+
+def test_write_all_is_all_or_nothing(tmp_path):
+    blocker = tmp_path / "not_a_dir"
+    blocker.write_text("x")
+    with pytest.raises(OSError):
+        write_all({tmp_path / "a.csv": b"1", blocker / "b.csv": b"2"})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_dir"]
