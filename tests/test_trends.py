@@ -37,3 +37,10 @@ def test_fx_increase_per_100_N_shrinks_with_load_at_high_slip(fx):
     high_slip = SLIPS >= 0.7 - 1e-12
     increments = np.diff(fx[:, high_slip], axis=0)
     assert (np.diff(increments, axis=0) < 0).all()
+
+
+def test_fx_increase_per_100_N_grows_with_load_at_low_slip(fx):
+    """The other half of the finding above (README, 'One difference from the paper's text')."""
+    low_slip = (SLIPS > 0.0) & (SLIPS <= 0.3 + 1e-12)
+    increments = np.diff(fx[:, low_slip], axis=0)
+    assert (np.diff(increments, axis=0) > 0).all()
