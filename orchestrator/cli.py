@@ -12,7 +12,7 @@ def _positive_loads(text: str) -> tuple[float, ...]:
     try:
         loads = tuple(float(part) for part in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"loads={text!r}: expected comma-separated numbers in N, e.g. 100,200")
+        raise argparse.ArgumentTypeError(f"loads={text!r}: expected comma-separated numbers in N, e.g. 100,200") from None
     bad = [w for w in loads if not (0 < w < float("inf"))]
     if bad:
         raise argparse.ArgumentTypeError(f"load={bad[0]!r} N: expected a finite load > 0 N")
@@ -23,7 +23,7 @@ def _slip_step(text: str) -> float:
     try:
         step = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"slip step={text!r}: expected a number in (0, 0.9]")
+        raise argparse.ArgumentTypeError(f"slip step={text!r}: expected a number in (0, 0.9]") from None
     if not 0 < step <= 0.9:
         raise argparse.ArgumentTypeError(f"slip step={step!r}: expected a number in (0, 0.9]")
     return step

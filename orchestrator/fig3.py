@@ -51,7 +51,9 @@ def fig3_figure(table: pd.DataFrame) -> Figure:
     axes.set_title("Slip ratio and longitudinal force for wheel loads "
                    f"{loads[0]:g}–{loads[-1]:g} N", fontsize=10)
     axes.grid(True, alpha=0.3)
-    axes.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=8, title="Wheel load", title_fontsize=8)
+    handles, labels = axes.get_legend_handles_labels()
+    axes.legend(handles[::-1], labels[::-1], loc="center left", bbox_to_anchor=(1.01, 0.5),
+                fontsize=8, title="Wheel load", title_fontsize=8)
     figure.tight_layout()
     return figure
 

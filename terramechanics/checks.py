@@ -32,3 +32,9 @@ def checked_array(name: str, value: ArrayLike, low: float, high: float, unit: st
             accepted = f"in {'(' if low_open else '['}{low!r}, {high!r}]{unit}"
         raise ValueError(f"{where}={float(bad)!r}{unit}: expected a finite value {accepted}")
     return array
+
+
+def check_nodes(nodes: int) -> None:
+    """ValueError unless ``nodes`` is a quadrature node count: an integer in [2, 10000]."""
+    if isinstance(nodes, bool) or not isinstance(nodes, (int, np.integer)) or not 2 <= nodes <= 10_000:
+        raise ValueError(f"nodes={nodes!r}: expected an integer in [2, 10000]")

@@ -16,8 +16,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.interpolate import RegularGridInterpolator
 
-from .checks import checked_array
-from .forces import DEFAULT_NODES, ContactForces, _check_nodes, contact_integrals
+from .checks import check_nodes, checked_array
+from .forces import DEFAULT_NODES, ContactForces, contact_integrals
 from .kinematics import FloatArray, entry_angle, exit_angle, max_stress_angle
 from .parameters import Soil, Wheel
 
@@ -45,7 +45,11 @@ class WheelState:
 
 
 def bekker_sinkage(load: ArrayLike, wheel: Wheel, soil: Soil) -> FloatArray:
-    """Bekker's rigid-wheel estimate h = [3W / ((3 - n) b k √(2r))]^(2/(2n+1)) [m], no slip."""
+    """Bekker's rigid-wheel estimate h = [3W / ((3 - n) b k √(2r))]^(2/(2n+1)) [m], no slip.
+
+    Only a starting point for the iteration; the (3 - n) factor needs n < 3, so n is capped at
+    2.9 here.
+    """
     k = soil.bekker_modulus(wheel.b)
     base = 3.0 * np.asarray(load, dtype=float) / ((3.0 - min(soil.n, 2.9)) * wheel.b * k * math.sqrt(2 * wheel.r))
     return base ** (2.0 / (2.0 * soil.n + 1.0))
@@ -65,7 +69,9 @@ def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
 
     Small batches start from Bekker's estimate and slope n + 1/2. Large batches first solve a
     coarse (log W, κ) grid spanning the batch and interpolate its log h and slope linearly;
-    the grid costs a few hundred solves and saves about two iterations per element.
+    the grid costs a few hundred solves and saves over one evaluation per element (4.4 -> 3.1
+    on 100 000 random states). If the grid cannot be solved (a load in the batch is more than
+    the wheel can carry), Bekker's start is used and the iteration reports the load.
     """
     log_bekker = np.log(bekker_sinkage(load, wheel, soil))
     if load.size < GRID_BATCH_SIZE:
@@ -73,7 +79,10 @@ def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
     log_w = _grid_axis(np.log(load.min()), np.log(load.max()), GRID_SHAPE[0], 0.01, (-np.inf, np.inf))
     kappa = _grid_axis(slip.min(), slip.max(), GRID_SHAPE[1], 0.01, (-1.0, 1.0))
     grid_w, grid_k = (a.ravel() for a in np.meshgrid(np.exp(log_w), kappa, indexing="ij"))
-    h_grid, _ = solve_sinkage(grid_w, grid_k, wheel, soil, 1e-10, nodes)
+    try:
+        h_grid, _ = solve_sinkage(grid_w, grid_k, wheel, soil, 1e-10, nodes)
+    except ValueError:
+        return log_bekker, soil.n + 0.5
     log_h = np.log(h_grid).reshape(GRID_SHAPE)
     correction = log_h - np.log(bekker_sinkage(grid_w, wheel, soil)).reshape(GRID_SHAPE)
     slope = 1.0 / np.gradient(log_h, log_w, axis=0)
@@ -91,8 +100,8 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
     1-D arrays ``load`` and ``slip``.
 
     Iterates on x = log h with the residual f = log Fz - log W: the first step is Newton's with
-    an estimated slope d log Fz / d log h (see _initial_guess), later steps are secant steps; a step that
-    leaves the bracket (or a residual that is undefined because Fz <= 0, possible for a
+    an estimated slope d log Fz / d log h (see _initial_guess), later steps are secant steps;
+    a step that leaves the bracket (or a residual that is undefined because Fz <= 0, possible for a
     skidding wheel that has barely sunk) falls back to bisection. Only unconverged elements
     are evaluated again.
     """
@@ -112,7 +121,8 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
         xa = x[active]
         forces = contact_integrals(np.exp(xa), slip[active], wheel, soil, nodes)
         with np.errstate(divide="ignore", invalid="ignore"):
-            fa = np.where(forces.Fz > 0, np.log(np.maximum(forces.Fz, 1e-300)), -np.inf) - log_load[active]
+            log_fz = np.where(forces.Fz > 0, np.log(np.maximum(forces.Fz, 1e-300)), -np.inf)
+        fa = log_fz - log_load[active]
         done = np.abs(fa) <= tol
         for target, value in zip(out, forces):
             target[active[done]] = value[done]
@@ -133,13 +143,14 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
 
 
 def _raise_unsolved(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil, nodes: int) -> None:
-    capacity = contact_integrals(np.full(load.shape, wheel.r), slip, wheel, soil, nodes, only_fz=True).Fz
+    capacity = contact_integrals(np.full(load.shape, wheel.r), slip, wheel, soil, nodes).Fz
     too_heavy = load > capacity
     if too_heavy.any():
         i = int(np.argmax(too_heavy))
         raise ValueError(
-            f"load={float(load[i])!r} N at slip={float(slip[i])!r}: the wheel (r={wheel.r} m) cannot carry it with "
-            f"a sinkage below its radius; the most it carries at that slip is {capacity[i]:.6g} N")
+            f"load={float(load[i])!r} N at slip={float(slip[i])!r}: the wheel (r={wheel.r} m) cannot "
+            f"carry it with a sinkage below its radius; the most it carries at that slip is "
+            f"{capacity[i]:.6g} N")
     raise RuntimeError(f"sinkage iteration did not converge for load={float(load[0])!r} N, "
                        f"slip={float(slip[0])!r}")
 
@@ -159,7 +170,7 @@ def wheel_state(
     """
     if not (isinstance(rtol, (int, float)) and 1e-15 <= rtol <= 1e-2):
         raise ValueError(f"rtol={rtol!r}: expected a number in [1e-15, 1e-2]")
-    _check_nodes(nodes)
+    check_nodes(nodes)
     w = checked_array("load", load, 0.0, math.inf, "N", low_open=True)
     kappa = checked_array("slip", slip, -1.0, 1.0, "")
     w, kappa = np.broadcast_arrays(w, kappa)

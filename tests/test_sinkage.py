@@ -81,3 +81,10 @@ def test_bad_slip_and_options_are_named(kwargs, message):
 def test_capacity_error_in_a_batch_names_the_heavy_load():
     with pytest.raises(ValueError, match=r"load=90000.0 N"):
         wheel_state(np.array([100.0, 90000.0, 300.0]), 0.1)
+
+
+def test_capacity_error_in_a_large_batch_names_the_exact_load():
+    loads = np.full(GRID_BATCH_SIZE + 10, 300.0)
+    loads[123] = 54321.0
+    with pytest.raises(ValueError, match=r"load=54321.0 N at slip=0.3"):
+        wheel_state(loads, 0.3)
