@@ -12,7 +12,8 @@ def _positive_loads(text: str) -> tuple[float, ...]:
     try:
         loads = tuple(float(part) for part in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"loads={text!r}: expected comma-separated numbers in N, e.g. 100,200") from None
+        raise argparse.ArgumentTypeError(
+            f"loads={text!r}: expected comma-separated numbers in N, e.g. 100,200") from None
     bad = [w for w in loads if not (0 < w < float("inf"))]
     if bad:
         raise argparse.ArgumentTypeError(f"load={bad[0]!r} N: expected a finite load > 0 N")

@@ -8,6 +8,7 @@ stresses in Pa, angles in rad.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, fields
 
 
@@ -18,11 +19,13 @@ def _check(name: str, value: float, ok: bool, expected: str) -> None:
 
 
 def _check_finite(obj: object) -> None:
+    """Every field a finite real number, stored as a Python float (numpy scalars accepted)."""
     for f in fields(obj):  # type: ignore[arg-type]
         value = getattr(obj, f.name)
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise TypeError(f"{f.name}={value!r}: expected a real number")
         _check(f.name, value, math.isfinite(value), "a finite number")
+        object.__setattr__(obj, f.name, float(value))
 
 
 @dataclass(frozen=True)

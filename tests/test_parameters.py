@@ -54,3 +54,11 @@ def test_soil_rejects_non_physical(field, value, expected):
 def test_non_numbers_are_rejected():
     with pytest.raises(TypeError, match="r='0.3'"):
         Wheel(r="0.3")
+
+
+def test_numpy_scalars_are_accepted_as_floats():
+    import numpy as np
+
+    wheel = Wheel(r=np.float32(0.3), b=np.int64(1))
+    assert type(wheel.r) is float and type(wheel.b) is float
+    assert wheel.r == pytest.approx(0.3)

@@ -88,3 +88,19 @@ def test_capacity_error_in_a_large_batch_names_the_exact_load():
     loads[123] = 54321.0
     with pytest.raises(ValueError, match=r"load=54321.0 N at slip=0.3"):
         wheel_state(loads, 0.3)
+
+
+@pytest.mark.parametrize("load, slip", [(50.0, 0.0), (424.0, 0.3), (875.0, 0.9), (275.0, -0.6), (3000.0, -0.2)])
+def test_sinkage_matches_an_independent_root_finder_on_the_reference_integrals(load, slip):
+    """brentq on the 20 000-point Simpson integrals: a different integrator and root finder."""
+    from reference_quadrature import reference_forces
+    from scipy.optimize import brentq
+
+    wheel, soil = Wheel(), Soil()
+    h_ref = brentq(lambda h: reference_forces(h, slip, wheel, soil)[1] - load, 1e-6, 0.99 * wheel.r,
+                   xtol=1e-13, rtol=1e-12)
+    state = wheel_state(load, slip)
+    assert float(state.sinkage) == pytest.approx(h_ref, rel=1e-6)
+    ref = reference_forces(h_ref, slip, wheel, soil)
+    assert float(state.Fx) == pytest.approx(ref[0], rel=1e-6, abs=1e-6 * load)
+    assert float(state.Tx) == pytest.approx(ref[2], rel=1e-6, abs=1e-6 * load * wheel.r)
