@@ -27,8 +27,8 @@ def write_all(files: Mapping[Path, bytes]) -> None:
     try:
         for target, payload in files.items():
             target.parent.mkdir(parents=True, exist_ok=True)
-            handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
-            staged.append((Path(temporary), target))
+            handle, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+            staged.append((Path(name), target))
             with os.fdopen(handle, "wb") as stream:
                 stream.write(payload)
         for temporary, target in staged:

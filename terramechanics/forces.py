@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .checks import check_nodes, checked_array
-from .kinematics import FloatArray, entry_angle, exit_angle, max_stress_angle
+from .kinematics import BoolArray, FloatArray, IndexArray, entry_angle, exit_angle, max_stress_angle
 from .parameters import Soil, Wheel
 from .stress import normal_stress, pressure_from_cosines, shear_displacement, shear_stress
 
@@ -112,7 +112,7 @@ def _shear_reversal_angles(theta_f: FloatArray, theta_r: FloatArray, slip: Float
 
 
 def _monotone_root(low: FloatArray, high: FloatArray, guesses: tuple[FloatArray, ...], theta_f: FloatArray,
-                   slip: FloatArray, exists: FloatArray, wheel: Wheel, iterations: int = 50) -> FloatArray:
+                   slip: FloatArray, exists: BoolArray, wheel: Wheel, iterations: int = 50) -> FloatArray:
     """Root of jx(θ) in [low, high] where ``exists`` (jx monotone there, opposite signs at the
     ends), NaN elsewhere: Newton's method from the best of ``guesses``, falling back to
     bisection when a step leaves the bracket."""
@@ -141,7 +141,8 @@ def _monotone_root(low: FloatArray, high: FloatArray, guesses: tuple[FloatArray,
         root[i] = theta = new
         if not going.any():
             break
-        i, lo, hi, tf, kappa, rising, theta = (a[going] for a in (i, lo, hi, tf, kappa, rising, theta))
+        i, rising = i[going], rising[going]
+        lo, hi, tf, kappa, theta = (a[going] for a in (lo, hi, tf, kappa, theta))
     return root
 
 
@@ -190,7 +191,7 @@ def contact_integrals(sinkage: FloatArray, slip: FloatArray, wheel: Wheel, soil:
 
 
 def _integrate_block(h: FloatArray, kappa: FloatArray, wheel: Wheel, soil: Soil, nodes: int,
-                     results: list[FloatArray], into: FloatArray) -> None:
+                     results: list[FloatArray], into: IndexArray) -> None:
     """contact_integrals on 1-D arrays small enough for the temporaries to stay in cache,
     written into ``results`` (the caller's Fx, Fz, Tx arrays) at the indices ``into``."""
     theta_f = entry_angle(h, wheel)
@@ -199,7 +200,7 @@ def _integrate_block(h: FloatArray, kappa: FloatArray, wheel: Wheel, soil: Soil,
     reversal_front, reversal_rear = _shear_reversal_angles(theta_f, theta_r, kappa, wheel)
     simple = np.isnan(reversal_front) & np.isnan(reversal_rear)
 
-    def store(index: FloatArray, forces: ContactForces) -> None:
+    def store(index: IndexArray, forces: ContactForces) -> None:
         for out, value in zip(results, forces):
             out[into[index]] = value
 
@@ -224,10 +225,10 @@ def _integrate_block(h: FloatArray, kappa: FloatArray, wheel: Wheel, soil: Soil,
                                    np.where(np.isnan(reversal_front[i]), m, reversal_front[i]), m,
                                    theta_f[i]]), axis=0)
         theta, dtheta = _patch_nodes(breaks, ("start", "start", "end", "end"), nodes)
-        angles = [a[i, None, None] for a in (theta_f, theta_r, theta_m)]
+        tf, tr, tm = (a[i, None, None] for a in (theta_f, theta_r, theta_m))
 
         def stress(cos: FloatArray) -> FloatArray:
-            return normal_stress(theta, *angles, wheel, soil)
+            return normal_stress(theta, tf, tr, tm, wheel, soil)
 
         store(i, _sum_over_patch(theta, dtheta, stress, theta_f[i], kappa[i], wheel, soil))
 

@@ -12,6 +12,8 @@ from numpy.typing import ArrayLike, NDArray
 from .parameters import Soil, Wheel
 
 FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+IndexArray = NDArray[np.intp]
 
 
 def slip_ratio(r_omega: ArrayLike, v: ArrayLike, v_eps: float = 0.0) -> FloatArray:

@@ -24,8 +24,9 @@ def _check_finite(obj: object) -> None:
         value = getattr(obj, f.name)
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise TypeError(f"{f.name}={value!r}: expected a real number")
+        value = float(value)
         _check(f.name, value, math.isfinite(value), "a finite number")
-        object.__setattr__(obj, f.name, float(value))
+        object.__setattr__(obj, f.name, value)
 
 
 @dataclass(frozen=True)

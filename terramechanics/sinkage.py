@@ -64,7 +64,7 @@ def _grid_axis(low: float, high: float, count: int, pad: float, limits: tuple[fl
 
 
 def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
-                   nodes: int) -> tuple[FloatArray, FloatArray | float]:
+                   nodes: int) -> tuple[FloatArray, FloatArray]:
     """Starting log h and slope d log Fz / d log h for the iteration.
 
     Small batches start from Bekker's estimate and slope n + 1/2. Large batches first solve a
@@ -74,18 +74,19 @@ def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
     the wheel can carry), Bekker's start is used and the iteration reports the load.
     """
     log_bekker = np.log(bekker_sinkage(load, wheel, soil))
+    bekker_slope = np.full(load.shape, soil.n + 0.5)
     if load.size < GRID_BATCH_SIZE:
-        return log_bekker, soil.n + 0.5
+        return log_bekker, bekker_slope
     log_w = _grid_axis(np.log(load.min()), np.log(load.max()), GRID_SHAPE[0], 0.01, (-np.inf, np.inf))
     kappa = _grid_axis(slip.min(), slip.max(), GRID_SHAPE[1], 0.01, (-1.0, 1.0))
     grid_w, grid_k = (a.ravel() for a in np.meshgrid(np.exp(log_w), kappa, indexing="ij"))
     try:
         h_grid, _ = solve_sinkage(grid_w, grid_k, wheel, soil, 1e-10, nodes)
     except ValueError:
-        return log_bekker, soil.n + 0.5
+        return log_bekker, bekker_slope
     log_h = np.log(h_grid).reshape(GRID_SHAPE)
     correction = log_h - np.log(bekker_sinkage(grid_w, wheel, soil)).reshape(GRID_SHAPE)
-    slope = 1.0 / np.gradient(log_h, log_w, axis=0)
+    slope = 1.0 / np.asarray(np.gradient(log_h, log_w, axis=0))
     points = np.column_stack([np.log(load), slip])
 
     def interpolate(values: FloatArray) -> FloatArray:
@@ -130,8 +131,7 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
         upper[active] = np.where(fa > 0, xa, upper[active])
         xp, fp = x_prev[active], f_prev[active]
         with np.errstate(divide="ignore", invalid="ignore"):
-            first_slope = slope if np.isscalar(slope) else slope[active]
-            step = np.where(np.isnan(xp), xa - fa / first_slope, xa - fa * (xa - xp) / (fa - fp))
+            step = np.where(np.isnan(xp), xa - fa / slope[active], xa - fa * (xa - xp) / (fa - fp))
         lo, hi = lower[active], upper[active]
         step = np.where(~np.isfinite(step) | (step <= lo) | (step >= hi), 0.5 * (lo + hi), step)
         x_prev[active], f_prev[active] = xa, fa
