@@ -62,11 +62,11 @@ def _unit_nodes(nodes: int) -> tuple[FloatArray, FloatArray]:
 def _piece_maps(clusters: tuple[str, ...], nodes: int) -> tuple[FloatArray, FloatArray]:
     """Node positions s and weights ds/du·w on [0, 1], shape (pieces, nodes), per piece.
 
-    A piece [start, end] gets θ = start + (end - start) s. ``cluster`` "start" is s = u² (nodes
-    crowd at start), "end" is s = 1 - u² (crowd at end), "none" is s = u.
+    A piece [start, end] gets θ = start + (end - start) s, with s = u² where ``clusters`` says
+    "start" (nodes crowd at the start) and s = 1 - u² where it says "end".
     """
     u, w = _unit_nodes(nodes)
-    maps = {"start": (u * u, 2.0 * u * w), "end": (1.0 - u * u, 2.0 * u * w), "none": (u, w)}
+    maps = {"start": (u * u, 2.0 * u * w), "end": (1.0 - u * u, 2.0 * u * w)}
     s = np.stack([maps[c][0] for c in clusters])
     ds = np.stack([maps[c][1] for c in clusters])
     s.flags.writeable = False
