@@ -45,14 +45,10 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "fig3":
-        import numpy as np
+        from .fig3 import PAPER_LOADS, slip_grid, write_fig3
 
-        from .fig3 import PAPER_LOADS, write_fig3
-
-        count = int(round(0.9 / args.slip_step)) + 1
-        slips = tuple(np.round(np.linspace(0.0, 0.9, count), 10))
         try:
-            written = write_fig3(args.out, args.loads or PAPER_LOADS, slips)
+            written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step))
         except ValueError as error:
             print(f"rover-cosim fig3: {error}", file=sys.stderr)
             return 2

@@ -23,8 +23,16 @@ PNG_NAME = "fig3_fx_vs_slip.png"
 RECORD_NAME = "fig3_fx_vs_slip.json"
 COLUMNS = ["load_N", "slip", "sinkage_m", "Fx_N", "Fz_N", "Tx_Nm"]
 
+
+
+def slip_grid(step: float, last: float = 0.9) -> tuple[float, ...]:
+    """Slip ratios 0, step, ..., last [-] (``last`` included, rounded to 10 decimals)."""
+    count = int(round(last / step)) + 1
+    return tuple(float(k) for k in np.round(np.linspace(0.0, last, count), 10))
+
+
 PAPER_LOADS = tuple(float(w) for w in range(100, 801, 100))  # [N], Sec. 2.2.7
-PAPER_SLIPS = tuple(np.round(np.linspace(0.0, 0.9, 91), 10))  # [-]
+PAPER_SLIPS = slip_grid(0.01)  # [-]
 
 
 def fig3_table(loads: tuple[float, ...] = PAPER_LOADS, slips: tuple[float, ...] = PAPER_SLIPS,
