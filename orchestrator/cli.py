@@ -38,7 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     fig3.add_argument("--loads", type=_positive_loads, default=None,
                       help="comma-separated wheel loads [N] (default: 100,200,...,800)")
     fig3.add_argument("--slip-step", type=_slip_step, default=0.01,
-                      help="slip spacing over 0..0.9 (default: 0.01)")
+                      help="slip spacing over 0..0.9, adjusted so that 0.9 is a point (default: 0.01)")
     return parser
 
 
