@@ -14,7 +14,6 @@ for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_variable] = "1"
 
 import argparse  # noqa: E402
-import json  # noqa: E402
 import platform  # noqa: E402
 import statistics  # noqa: E402
 import time  # noqa: E402
@@ -22,7 +21,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from orchestrator.outputs import run_record, write_all  # noqa: E402
+from orchestrator.outputs import json_bytes, run_record, write_all  # noqa: E402
 from terramechanics import DEFAULT_NODES, contact_forces, wheel_state  # noqa: E402
 
 FLOOR_STATES_PER_S = 100_000
@@ -92,10 +91,9 @@ def main() -> None:
         print(f"{name:12s} {results[name]['states_per_s_median']:>10,.0f} states/s (median of {args.repeats}), "
               f"best {results[name]['states_per_s_best']:,.0f}; max |Fz/W-1| = "
               f"{results[name]['max_relative_Fz_error']:.1e}")
-    record = json.loads(run_record("make bench", {"nodes": DEFAULT_NODES, "pinned_cpu": cpu,
-                                                  "processor": platform.processor()}))
-    record["results"] = results
-    write_all({args.out: (json.dumps(record, indent=2) + "\n").encode()})
+    record = run_record("make bench", {"nodes": DEFAULT_NODES, "pinned_cpu": cpu,
+                                       "processor": platform.processor()})
+    write_all({args.out: json_bytes({**record, "results": results})})
     print(f"wrote {args.out}")
 
 

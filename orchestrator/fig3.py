@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 
 from terramechanics import Soil, Wheel, wheel_state
 
-from .outputs import run_record, write_all
+from .outputs import json_bytes, run_record, write_all
 
 CSV_NAME = "fig3_fx_vs_slip.csv"
 PNG_NAME = "fig3_fx_vs_slip.png"
@@ -77,7 +77,7 @@ def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
     files = {
         out_dir / CSV_NAME: table.to_csv(index=False, float_format="%.10g").encode(),
         out_dir / PNG_NAME: png.getvalue(),
-        out_dir / RECORD_NAME: run_record("rover-cosim fig3", parameters),
+        out_dir / RECORD_NAME: json_bytes(run_record("rover-cosim fig3", parameters)),
     }
     write_all(files)
     return list(files)

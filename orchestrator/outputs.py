@@ -54,9 +54,14 @@ def _git_commit() -> str | None:
     return result.stdout.strip() or None if result.returncode == 0 else None
 
 
-def run_record(command: str, parameters: Mapping[str, object]) -> bytes:
-    """JSON bytes describing a run: command, parameters, versions, commit, machine, time."""
-    record = {
+def json_bytes(value: object) -> bytes:
+    """``value`` as indented JSON text, UTF-8, ending in a newline."""
+    return (json.dumps(value, indent=2, default=str) + "\n").encode()
+
+
+def run_record(command: str, parameters: Mapping[str, object]) -> dict[str, object]:
+    """What a run did: command, parameters, versions, git commit, machine, time."""
+    return {
         "command": command,
         "parameters": parameters,
         "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
@@ -65,4 +70,3 @@ def run_record(command: str, parameters: Mapping[str, object]) -> bytes:
         "platform": platform.platform(),
         "versions": {name: _version(name) for name in PACKAGES},
     }
-    return (json.dumps(record, indent=2, default=str) + "\n").encode()
