@@ -1,0 +1,54 @@
+within RoverTerramechanics.Components;
+model Chassis "Rover body in the pitch plane (x, z, pitch) on six vertical compliant limbs, cut at the wheel hubs"
+  parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
+  input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub";
+  input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the body";
+  output Real W[6](each unit="N") "Wheel loads: the limb forces pressing each wheel into the soil";
+  output Real v_hub[6](each unit="m/s") "Forward speed of each wheel hub";
+  output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity";
+  output Real v(unit="m/s", start=0, fixed=true) "Forward velocity of the centre of gravity";
+  output Real z(unit="m", start=0, fixed=true) "Heave of the centre of gravity from static equilibrium";
+  output Real pitch(unit="rad", start=0, fixed=true) "Pitch angle, nose up positive";
+  Real w(unit="m/s", start=0, fixed=true) "Heave velocity";
+  Real q(unit="rad/s", start=0, fixed=true) "Pitch rate";
+  Real deflection[6](each unit="m") "Limb compression";
+  Real deflectionRate[6](each unit="m/s") "Limb compression rate";
+  Real xHubWorld[6](each unit="m") "Hub position ahead of the centre of gravity";
+  Real zHubWorld[6](each unit="m") "Hub height relative to the centre of gravity";
+protected
+  parameter Real xHub[6](each unit="m") = {rover.xLimb[1], rover.xLimb[2], rover.xLimb[3], rover.xLimb[1], rover.xLimb[2], rover.xLimb[3]} "Hub positions in the body frame; limbs 4-6 mirror 1-3";
+  parameter Real staticDeflection(unit="m") = rover.M*rover.g/(6*rover.kLimb) "Limb compression at rest";
+equation
+  der(x) = v;
+  der(z) = w;
+  der(pitch) = q;
+  for i in 1:6 loop
+    xHubWorld[i] = xHub[i]*cos(pitch) + rover.hCoG*sin(pitch);
+    zHubWorld[i] = xHub[i]*sin(pitch) - rover.hCoG*cos(pitch);
+    deflection[i] = staticDeflection - z - (zHubWorld[i] + rover.hCoG);
+    deflectionRate[i] = -w - q*xHubWorld[i];
+    W[i] = noEvent(max(rover.kLimb*deflection[i] + rover.dLimb*deflectionRate[i], 0.0));
+    v_hub[i] = v - q*zHubWorld[i];
+  end for;
+  rover.M*der(v) = sum(Fx);
+  rover.M*der(w) = sum(W) - rover.M*rover.g;
+  rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*Fx[i] + tau[i] for i in 1:6);
+  annotation (Documentation(info="<html>
+<p>A rigid body of mass M and pitch inertia Iyy with three limbs per side (limb 1 front,
+2 middle, 3 rear; 4-6 mirror them). Each limb is a vertical spring-damper between the body and a
+wheel hub that rides at a fixed height over the undisturbed soil; its force is the wheel load
+W<sub>i</sub> = max(k&delta;<sub>i</sub> + d d&delta;<sub>i</sub>/dt, 0) (a wheel can lift, not
+pull). With hub position p<sub>i</sub> = R(pitch)(x<sub>i</sub>, -h<sub>CoG</sub>) relative to the
+centre of gravity:</p>
+<ul>
+<li>M dv/dt = &Sigma; F<sub>x,i</sub></li>
+<li>M dw/dt = &Sigma; W<sub>i</sub> - M g</li>
+<li>Iyy dq/dt = &Sigma; (p<sub>x,i</sub> W<sub>i</sub> - p<sub>z,i</sub> F<sub>x,i</sub> +
+&tau;<sub>i</sub>): loads, hub forces below the centre of gravity, and the reaction of the wheel
+motors.</li>
+</ul>
+<p>Driving forward, the hub forces and motor reactions pitch the nose up: the front limbs extend
+and unload, the rear limbs compress and load (paper Fig. 10c). Parameters and their reasoning:
+<code>Parameters.RoverParameters</code>.</p>
+</html>"));
+end Chassis;

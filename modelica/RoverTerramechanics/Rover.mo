@@ -1,0 +1,47 @@
+within RoverTerramechanics;
+model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechanics wheels (monolithic)"
+  parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
+  parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
+  parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
+  parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  parameter Integer nIterations = 30 "Bound on the force evaluations of the sinkage solve";
+  parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
+  input Real tau[6](each unit="N.m") "Drive torque of each wheel";
+  output Real x(unit="m") "Position of the centre of gravity";
+  output Real v(unit="m/s") "Forward velocity of the centre of gravity";
+  output Real pitch(unit="rad") "Pitch angle, nose up positive";
+  output Real Fz[6](each unit="N") "Vertical force of each wheel, Eq. (11) (= its load)";
+  output Real Fx[6](each unit="N") "Longitudinal force of each wheel, Eq. (12)";
+  output Real Tx[6](each unit="N.m") "Resistance torque of each wheel, Eq. (13)";
+  output Real slip[6](each unit="1") "Slip ratio of each wheel, Eq. (4)";
+  output Real sinkage[6](each unit="m") "Sinkage of each wheel";
+  output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
+  RoverTerramechanics.Components.Chassis body(rover=rover) "Body and limbs";
+  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nPanels=nPanels, each nIterations=nIterations, each vEps=vEps) "Wheels 1-6";
+equation
+  for i in 1:6 loop
+    wheels[i].tau = tau[i];
+    wheels[i].W = body.W[i];
+    wheels[i].v_hub = body.v_hub[i];
+    body.Fx[i] = wheels[i].Fx;
+    body.tau[i] = tau[i];
+    Fz[i] = wheels[i].Fz;
+    Fx[i] = wheels[i].Fx;
+    Tx[i] = wheels[i].Tx;
+    slip[i] = wheels[i].slip;
+    sinkage[i] = wheels[i].sinkage;
+    omega[i] = wheels[i].omega;
+  end for;
+  x = body.x;
+  v = body.v;
+  pitch = body.pitch;
+  annotation (Documentation(info="<html>
+<p>Paper Sec. 4: a 1570 kg rover under lunar gravity on six wheels. Body:
+<code>Components.Chassis</code> (x, z, pitch; three compliant limbs per side, mirror-symmetric);
+wheels: <code>Components.RigidWheel</code> (Eqs. 1-13) loaded by the limb forces. Inputs
+<code>tau[1..6]</code>; limb 1 is the front, 3 the rear of one side, 4-6 mirror them.
+Accelerating pitches the nose up: limb 1 unloads and limb 3 loads (paper Fig. 10c). Every
+parameter the paper does not give is in <code>Parameters.RoverParameters</code> and
+<code>Parameters.WheelParameters</code>.</p>
+</html>"));
+end Rover;
