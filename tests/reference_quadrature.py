@@ -9,8 +9,16 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import simpson
 
-from terramechanics import Soil, Wheel, entry_angle, exit_angle, max_stress_angle
-from terramechanics import normal_stress, shear_displacement, shear_stress
+from terramechanics import (
+    Soil,
+    Wheel,
+    entry_angle,
+    exit_angle,
+    max_stress_angle,
+    normal_stress,
+    shear_displacement,
+    shear_stress,
+)
 
 POINTS = 20_000
 

@@ -3,7 +3,14 @@ import math
 import numpy as np
 import pytest
 
-from terramechanics import Soil, Wheel, entry_angle, exit_angle, max_stress_angle, slip_ratio
+from terramechanics import (
+    Soil,
+    Wheel,
+    entry_angle,
+    exit_angle,
+    max_stress_angle,
+    slip_ratio,
+)
 
 
 @pytest.mark.parametrize("r_omega, v, expected", [

@@ -1,0 +1,102 @@
+"""The Modelica package RoverTerramechanics: where it is, its classes, and rumoca's view of them.
+
+rumoca (pinned in pyproject.toml) parses, resolves and flattens the package; its ``simulate``
+runs a model with its own solver. rumoca does not read the ``experiment`` annotation, so
+:func:`experiment` reads it from the source.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+#: The folder that holds the top-level Modelica package (a rumoca source root).
+MODELICA_ROOT = Path(__file__).resolve().parent.parent / "modelica"
+#: Name of the top-level Modelica package.
+PACKAGE = "RoverTerramechanics"
+
+_CLASS_KEYWORDS = r"(?:partial\s+)?(?:encapsulated\s+)?(?:model|block|function|record|package|connector|type|class)"
+
+
+def package_file() -> Path:
+    """The top-level ``package.mo`` of RoverTerramechanics."""
+    return MODELICA_ROOT / PACKAGE / "package.mo"
+
+
+def class_files() -> dict[str, Path]:
+    """Every class of the package by qualified name, mapped to the file that defines it
+    (``package.mo`` for packages)."""
+    files: dict[str, Path] = {}
+    for path in sorted((MODELICA_ROOT / PACKAGE).rglob("*.mo")):
+        parts = path.relative_to(MODELICA_ROOT).with_suffix("").parts
+        if parts[-1] == "package":
+            parts = parts[:-1]
+        files[".".join(parts)] = path
+    return files
+
+
+def class_file(name: str) -> Path:
+    """The file defining the class ``name`` (qualified, e.g. ``RoverTerramechanics.Rover``)."""
+    files = class_files()
+    if name not in files:
+        raise ValueError(f"model {name!r}: no such class in {MODELICA_ROOT / PACKAGE}; "
+                         f"expected one of {sorted(files)}")
+    return files[name]
+
+
+def load(name: str):  # -> rumoca.Model (rumoca has no type stubs)
+    """Parse, resolve and flatten the class ``name`` with rumoca, in a fresh session (a rumoca
+    session cannot load the same package twice)."""
+    import rumoca
+
+    class_file(name)  # a clear error for an unknown class before rumoca's own
+    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
+    return session.load(str(package_file()), model=name)
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """The ``experiment`` annotation of a model: times in seconds."""
+
+    start: float
+    stop: float
+    interval: float
+    tolerance: float | None
+
+
+def experiment(name: str) -> Experiment:
+    """Read the ``experiment(...)`` annotation of the class ``name`` from its source file."""
+    text = class_file(name).read_text()
+    match = re.search(r"experiment\s*\(([^)]*)\)", text)
+    if match is None:
+        raise ValueError(f"model {name!r} has no experiment annotation in {class_file(name)}")
+    values = dict(re.findall(r"(\w+)\s*=\s*([-+0-9.eE]+)", match.group(1)))
+    stop = float(values.get("StopTime", 1.0))
+    start = float(values.get("StartTime", 0.0))
+    interval = float(values.get("Interval", (stop - start) / 500))
+    tolerance = float(values["Tolerance"]) if "Tolerance" in values else None
+    return Experiment(start, stop, interval, tolerance)
+
+
+def simulate(name: str, *, params: Mapping[str, float] | None = None, stop: float | None = None,
+             interval: float | None = None) -> pd.DataFrame:
+    """rumoca's simulation of the class ``name`` (which must bind all its inputs), sampled at
+    ``interval`` from the start to ``stop`` (defaults: its experiment annotation). Returns one
+    column per variable, indexed by time [s].
+
+    ``params`` overrides tunable parameters by flat name (e.g. ``{"W": 575.0}``); structural
+    parameters such as loop bounds cannot be overridden this way (rumoca compiles them in).
+    """
+    exp = experiment(name)
+    stop = exp.stop if stop is None else stop
+    interval = exp.interval if interval is None else interval
+    if not (stop > exp.start and interval > 0):
+        raise ValueError(f"stop={stop!r}, interval={interval!r}: expected stop > {exp.start} s and interval > 0 s")
+    model = load(name)
+    if params:
+        model = model.with_params(**params)
+    return model.simulate(t=(exp.start, stop), dt=interval).to_dataframe()

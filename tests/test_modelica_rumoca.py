@@ -1,0 +1,275 @@
+"""The Modelica source through rumoca (the Modelica compiler on PyPI, pinned in pyproject.toml):
+every model flattens balanced, every example simulates, and rumoca's simulation agrees with the
+numpy reference wheel and between the monolithic and the reconnected rover."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fmubuild import source
+from fmubuild.source import MODELICA_ROOT, PACKAGE
+from terramechanics import Wheel, contact_forces, slip_ratio, wheel_state
+
+rumoca = pytest.importorskip("rumoca", reason="rumoca is a pinned dependency; install the project with `make venv`")
+
+MODELS = ["SingleWheel", "Rover", "RoverBody", "Wheel", "RoverReconnected",
+          "Components.RigidWheel", "Components.Chassis"]
+EXAMPLES = ["Examples.SingleWheelStep", "Examples.RoverOpenLoop", "Examples.RoverReconnectedOpenLoop"]
+FMU_ROOTS = ["SingleWheel", "Rover", "RoverBody", "Wheel"]
+
+
+def full(name: str) -> str:
+    return f"{PACKAGE}.{name}"
+
+
+@pytest.mark.parametrize("name", MODELS + EXAMPLES)
+def test_model_is_balanced_without_algebraic_loops(name: str):
+    info = source.load(full(name)).structure()
+    assert info.is_balanced, f"{name}: {info}"
+    assert info.is_matched
+    assert info.n_equations == info.n_unknowns
+    assert info.n_algebraic_loops == 0, f"{name}: {info.n_algebraic_loops} algebraic loops"
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_every_real_variable_of_a_model_has_a_unit(name: str):
+    flat = source.load(full(name)).to_dict("flat")
+    types = flat["variable_type_names"]
+    missing = [v for v, info in flat["variables"].items() if types.get(v) == "Real" and not info["unit"]]
+    assert not missing
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+def test_example_simulates_over_its_experiment(name: str):
+    exp = source.experiment(full(name))
+    df = source.simulate(full(name))
+    expected_rows = round((exp.stop - exp.start) / exp.interval) + 1
+    assert len(df) == expected_rows
+    assert df.index[-1] == pytest.approx(exp.stop)
+    assert np.isfinite(df.to_numpy()).all()
+
+
+@pytest.mark.parametrize("name", FMU_ROOTS)
+def test_modelica_readme_lists_inputs_outputs_and_parameters(name: str):
+    readme = (MODELICA_ROOT / "README.md").read_text()
+    section = re.search(rf"^### `{name}`.*?(?=^### |\Z)", readme, re.MULTILINE | re.DOTALL)
+    assert section, f"modelica/README.md has no section '### `{name}`'"
+    model = source.load(full(name))
+    names = [n for n in list(model.inputs.names) + list(model.outputs.names) + list(model.states.names)
+             if "." not in n]
+    components = {n.split(".")[0].split("[")[0] for n in list(model.outputs.names) + list(model.states.names) if "." in n}
+    flat = model.to_dict("flat")["variables"]
+    names += sorted({p.name.split(".")[0].split("[")[0] for p in model.parameters
+                     if not flat.get(p.name, {}).get("is_protected", False)} - components)
+    for variable in names:
+        assert f"`{variable}" in section.group(0), f"{name}: `{variable}` not in its README section"
+
+
+# --- single-wheel step test against the numpy reference wheel -------------------------------
+
+STEP_LOADS = (275.0, 575.0, 875.0)
+STEP_TORQUES = (10.0, 30.0, 60.0, 100.0)
+
+
+@pytest.fixture(scope="module")
+def step_model():
+    return source.load(full("Examples.SingleWheelStep"))
+
+
+def assert_close(name: str, got: np.ndarray, ref: np.ndarray, rtol: float, atol: float) -> None:
+    error = np.abs(got - ref)
+    bound = rtol * np.abs(ref) + atol
+    worst = int(np.argmax(error - bound))
+    assert np.all(error <= bound), f"{name}: {got[worst]!r} vs reference {ref[worst]!r} at row {worst}"
+
+
+@pytest.mark.parametrize("load", STEP_LOADS)
+@pytest.mark.parametrize("torque", STEP_TORQUES)
+def test_single_wheel_step_agrees_with_the_reference_wheel(step_model, load: float, torque: float):
+    """At every output time, (sinkage, Fx, Fz, Tx) of rumoca's simulation equal
+    terramechanics.wheel_state at the same load and slip within 0.5 % (plus an absolute floor
+    of 1 mN, 1 mN·m, 0.1 µm for values that pass through zero), and the slip is Eq. (4) of the
+    simulated speeds."""
+    df = step_model.with_params(W=load, tauStep=torque).simulate(t=(0.0, 2.0), dt=0.002).to_dataframe()
+    slip = df["testBed.slip"].to_numpy()
+    state = wheel_state(np.full(slip.shape, load), slip)
+    assert_close("sinkage", df["testBed.sinkage"].to_numpy(), state.sinkage, 0.005, 1e-7)
+    assert_close("Fx", df["testBed.Fx"].to_numpy(), state.Fx, 0.005, 1e-3)
+    assert_close("Fz", df["testBed.Fz"].to_numpy(), state.Fz, 0.005, 1e-3)
+    assert_close("Tx", df["testBed.Tx"].to_numpy(), state.Tx, 0.005, 1e-3)
+    expected_slip = slip_ratio(Wheel().r * df["testBed.omega"].to_numpy(), df["testBed.v"].to_numpy(), 1e-3)
+    np.testing.assert_allclose(slip, expected_slip, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(df["testBed.Fz"], load, rtol=1e-9)
+
+
+def test_single_wheel_step_response_settles_to_a_driving_slip(step_model):
+    """A torque step from rest: the slip jumps towards 1 while the carriage is still, then
+    settles at a steady driving slip; wheel and carriage keep accelerating."""
+    df = step_model.with_params(W=575.0, tauStep=60.0).simulate(t=(0.0, 2.0), dt=0.001).to_dataframe()
+    slip = df["testBed.slip"].to_numpy()
+    assert 0.02 < slip[-1] < 0.5
+    assert np.max(np.abs(slip[-500:] - slip[-1])) < 1e-4
+    assert np.all(np.diff(df["testBed.v"].to_numpy()[1:]) > 0)
+
+
+# --- the functions on their own ------------------------------------------------------------
+
+PROBE = """
+model ForceProbe
+  parameter Real h0(unit="m") = 0.001;
+  parameter Real h1(unit="m") = 0.3;
+  parameter Real cycles = 7.0;
+  Real h(unit="m");
+  Real slip(unit="1");
+  Real Fx(unit="N");
+  Real Fz(unit="N");
+  Real Tx(unit="N.m");
+  Real clock(start=0, fixed=true);
+  RoverTerramechanics.Parameters.SoilParameters soil;
+  RoverTerramechanics.Parameters.WheelParameters wheel;
+equation
+  der(clock) = 1;
+  h = h0*(h1/h0)^time;
+  slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*cycles*time));
+  (Fx, Fz, Tx) = RoverTerramechanics.Functions.contactForces(h, slip, soil, wheel, PANELS);
+end ForceProbe;
+"""
+
+
+def probe_forces(panels: int) -> pd.DataFrame:
+    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
+    model = session.loads(PROBE.replace("PANELS", str(panels)), model="ForceProbe")
+    return model.simulate(t=(0.0, 1.0), dt=0.0005).to_dataframe()
+
+
+@pytest.fixture(scope="module")
+def probes() -> dict[int, pd.DataFrame]:
+    return {panels: probe_forces(panels) for panels in (8, 16)}
+
+
+def quadrature_errors(df: pd.DataFrame) -> dict[str, np.ndarray]:
+    ref = contact_forces(df["h"].to_numpy(), df["slip"].to_numpy())
+    return {k: np.abs(df[k].to_numpy() - getattr(ref, k)) / np.abs(getattr(ref, k)) for k in ("Fx", "Fz", "Tx")} | {
+        "scaled": np.max([np.abs(df[k].to_numpy() - getattr(ref, k)) for k in ("Fx", "Fz")], axis=0) / ref.Fz}
+
+
+def test_contact_forces_match_the_reference_quadrature_for_driving_slips(probes):
+    """Simpson with 8 panels per piece against the reference's Gauss-Legendre: sinkage 1 mm to
+    0.3 m, slip 0..1, pointwise relative error below 1e-4."""
+    df = probes[8]
+    driving = df["slip"].to_numpy() >= 0
+    for name, error in quadrature_errors(df).items():
+        assert np.max(error[driving]) < 1e-4, name
+
+
+def test_contact_forces_while_skidding_within_a_thousandth_of_the_load(probes):
+    """Skidding, jx changes sign inside the patch and the shear stress has a kink there, which
+    Simpson does not split at: the error stays below 1e-3 of Fz and shrinks with more panels."""
+    errors = {panels: quadrature_errors(df)["scaled"] for panels, df in probes.items()}
+    skidding = probes[8]["slip"].to_numpy() < 0
+    assert np.max(errors[8][skidding]) < 1e-3
+    assert np.max(errors[16][skidding]) < np.max(errors[8][skidding]) / 4
+
+
+SINKAGE_PROBE = """
+model SinkageProbe
+  Real W(unit="N");
+  Real slip(unit="1");
+  Real h(unit="m");
+  Real Fx(unit="N");
+  Real Fz(unit="N");
+  Real Tx(unit="N.m");
+  Real clock(start=0, fixed=true);
+  RoverTerramechanics.Parameters.SoilParameters soil;
+  RoverTerramechanics.Parameters.WheelParameters wheel;
+equation
+  der(clock) = 1;
+  W = 10^(0.5 + 3*time);
+  slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*5*time));
+  (h, Fx, Fz, Tx) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
+end SinkageProbe;
+"""
+
+
+def test_wheel_contact_carries_the_load_and_matches_the_reference_sinkage():
+    """Loads 3 N to 3 kN, slips -1..1: Fz = W to 1e-9 within the bounded iteration, and the
+    sinkage equals the reference wheel's to 1e-4 (the quadratures differ)."""
+    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
+    df = session.loads(SINKAGE_PROBE, model="SinkageProbe").simulate(t=(0.0, 1.0), dt=0.001).to_dataframe()
+    load, slip = df["W"].to_numpy(), df["slip"].to_numpy()
+    np.testing.assert_allclose(df["Fz"], load, rtol=1e-9)
+    state = wheel_state(load, slip)
+    np.testing.assert_allclose(df["h"], state.sinkage, rtol=1e-4)
+
+
+SLIP_PROBE = """
+model SlipProbe
+  Real rOmega(unit="m/s");
+  Real v(unit="m/s");
+  Real slip(unit="1");
+  Real clock(start=0, fixed=true);
+equation
+  der(clock) = 1;
+  rOmega = 2*sin(2*3.141592653589793*3*time) * (if time < 0.5 then 1 else 1e-3);
+  v = cos(2*3.141592653589793*5*time) * (if time < 0.25 or time > 0.75 then 1 else 1e-3);
+  slip = RoverTerramechanics.Functions.slipRatio(rOmega, v, 1e-3);
+end SlipProbe;
+"""
+
+
+def test_slip_ratio_matches_the_reference_including_rest_and_sign_changes():
+    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
+    df = session.loads(SLIP_PROBE, model="SlipProbe").simulate(t=(0.0, 1.0), dt=0.0005).to_dataframe()
+    expected = slip_ratio(df["rOmega"].to_numpy(), df["v"].to_numpy(), 1e-3)
+    np.testing.assert_allclose(df["slip"], expected, rtol=0, atol=1e-12)
+    assert np.all(np.abs(df["slip"]) <= 1)
+
+
+# --- the rover ----------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def rover_runs() -> dict[str, pd.DataFrame]:
+    return {name: source.simulate(full(f"Examples.{name}"))
+            for name in ("RoverOpenLoop", "RoverReconnectedOpenLoop")}
+
+
+ROVER_OUTPUTS = ["x", "v", "pitch"] + [f"{k}[{i}]" for k in ("Fz", "Fx", "Tx", "slip", "sinkage", "omega")
+                                       for i in range(1, 7)]
+
+
+def test_reconnected_rover_gives_the_monolithic_trajectories(rover_runs):
+    mono, split = rover_runs["RoverOpenLoop"], rover_runs["RoverReconnectedOpenLoop"]
+    assert np.array_equal(mono.index, split.index)
+    for name in ROVER_OUTPUTS:
+        a, b = mono[f"rover.{name}"].to_numpy(), split[f"rover.{name}"].to_numpy()
+        scale = max(np.max(np.abs(a)), 1e-9)
+        assert np.max(np.abs(a - b)) <= 1e-6 * scale, name
+
+
+def test_rover_starts_in_static_equilibrium_on_equal_loads(rover_runs):
+    df = rover_runs["RoverOpenLoop"]
+    weight = 1570 * 1.62
+    first = df.iloc[0]
+    for i in range(1, 7):
+        assert first[f"rover.Fz[{i}]"] == pytest.approx(weight / 6, rel=1e-9)
+
+
+def test_acceleration_unloads_the_front_limbs_and_loads_the_rear(rover_runs):
+    """Paper Fig. 10c: while accelerating (here 0.3-2.5 s) Fz of limb 1 falls and Fz of limb 3
+    rises; the mirrored limbs 4-6 carry the same loads; the total still carries the weight."""
+    df = rover_runs["RoverOpenLoop"]
+    weight = 1570 * 1.62
+    accelerating = df.loc[0.3:2.5]
+    assert np.all(np.diff(df["rover.v"].loc[0.0:2.5].to_numpy()) > 0)
+    assert np.all(accelerating["rover.Fz[1]"] < 0.9 * weight / 6)
+    assert np.all(accelerating["rover.Fz[3]"] > 1.1 * weight / 6)
+    assert np.all(accelerating["rover.pitch"] > 0)
+    for i in range(1, 4):
+        np.testing.assert_allclose(df[f"rover.Fz[{i}]"], df[f"rover.Fz[{i + 3}]"], rtol=1e-12)
+    total = sum(accelerating[f"rover.Fz[{i}]"] for i in range(1, 7))
+    np.testing.assert_allclose(total, weight, rtol=0.01)
+    assert df["rover.v"].iloc[-1] == pytest.approx(1.0, abs=0.1)
