@@ -4,7 +4,7 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
   parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
-  parameter Integer nIterations = 30 "Bound on the force evaluations of the sinkage solve";
+  parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel";
   output Real x(unit="m") "Position of the centre of gravity";

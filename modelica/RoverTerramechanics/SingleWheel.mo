@@ -5,7 +5,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   parameter Real W(unit="N") = 424 "Vertical load on the wheel (the carriage weight)";
   parameter Real g(unit="m/s2") = 1.62 "Gravity (lunar)";
   parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
-  parameter Integer nIterations = 30 "Bound on the force evaluations of the sinkage solve";
+  parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   input Real tau(unit="N.m") "Drive torque";
   output Real Fx(unit="N") "Longitudinal force, Eq. (12)";

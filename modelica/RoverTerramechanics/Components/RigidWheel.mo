@@ -3,7 +3,7 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
-  parameter Integer nIterations = 30 "Bound on the force evaluations of the sinkage solve";
+  parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   input Real tau(unit="N.m") "Drive torque applied to the wheel by its motor";
   input Real W(unit="N") "Vertical load on the wheel";

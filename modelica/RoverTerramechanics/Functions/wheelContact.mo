@@ -5,7 +5,7 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   input RoverTerramechanics.Parameters.SoilParameters soil "Soil";
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
   input Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
-  input Integer nIterations = 30 "Bound on the number of force evaluations";
+  input Integer nIterations = 12 "Bound on the number of force evaluations";
   input Real tolerance(unit="1") = 1e-10 "Relative tolerance on Fz/W - 1";
   input Real WMin(unit="N") = 1e-3 "Smallest load considered (a lifted wheel)";
   output Real h(unit="m") "Sinkage";
@@ -79,8 +79,9 @@ equals the load. Here the equation log F<sub>z</sub>(h, &kappa;) = log W is solv
 the function, so that a model that calls it has no nonlinear algebraic loop: the first step is
 Newton's with the slope (2n+1)/2 of Bekker's law from Bekker's sinkage, later steps are secant
 steps, and any step that leaves the bracket [10<sup>-12</sup> r, r] (narrowed by every evaluation)
-is replaced by bisection. The loop is bounded by <code>nIterations</code> evaluations; on this
-soil it converges to 1e-10 in 4-8. If the soil cannot carry W even at h = r the result is h = r
+is replaced by bisection. The loop is bounded by <code>nIterations</code> evaluations (default 12); on the
+Table 2 soil it converges to 1e-10 in at most 5 for loads 1 N to 5 kN and slips -1 to 1
+(measured with the same algorithm on the Python reference). If the soil cannot carry W even at h = r the result is h = r
 with F<sub>z</sub> &lt; W.</p>
 <p>Same method as the Python reference <code>terramechanics.wheel_state</code> (which uses
 Gauss-Legendre quadrature instead of Simpson).</p>
