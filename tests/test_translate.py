@@ -40,7 +40,7 @@ def test_single_wheel_step_ode_matches_rumocas_simulation():
 
 def test_open_loop_rover_ode_matches_rumocas_simulation():
     name = "RoverTerramechanics.Examples.RoverOpenLoop"
-    grid, ours = integrate(translate(source.load(name), name), {}, 1.0, 0.01)
+    _, ours = integrate(translate(source.load(name), name), {}, 1.0, 0.01)
     theirs = source.simulate(name, stop=1.0, interval=0.01)
     for column, atol in (("rover.v", 1e-5), ("rover.Fz[1]", 0.05), ("rover.Fz[3]", 0.05),
                          ("rover.pitch", 1e-6), ("rover.slip[3]", 1e-4)):
@@ -58,7 +58,7 @@ def test_fmu_models_translate_with_their_interfaces(name: str, inputs: list[str]
     assert ode.inputs == inputs
     outputs = [v.name for v in ode.variables.values() if v.role == "output"]
     assert outputs and all(o in ode.observed or o in ode.states for o in outputs)
-    f, _, initial = ode.functions()
+    _, _, initial = ode.functions()
     p = ca.DM([ode.parameter_values[n] for n in ode.parameters])
     jac = ca.Function("j", [ode.t, ode.x, ode.u, ode.p], [ca.jacobian(ode.xdot, ode.x)])
     u = ca.DM([424.0 if n == "W" else 10.0 for n in ode.inputs])
