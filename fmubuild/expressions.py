@@ -55,7 +55,7 @@ def _sign(a: Value) -> Value:
 
 def _integer_division(a: Value, b: Value) -> Value:
     if is_symbolic(a) or is_symbolic(b):
-        return ca.trunc(a / b) if hasattr(ca, "trunc") else ca.sign(a / b) * ca.floor(ca.fabs(a / b))
+        return ca.sign(a / b) * ca.floor(ca.fabs(a / b))
     return int(a / b)
 
 
@@ -99,9 +99,7 @@ EVENT_BUILTINS = {"Pre", "Edge", "Change", "Initial", "Terminal", "Sample", "Rei
 
 
 def _compare(op: str, a: Value, b: Value) -> Value:
-    if is_symbolic(a) or is_symbolic(b):
-        return {"Lt": a < b, "Le": a <= b, "Gt": a > b, "Ge": a >= b,
-                "Eq": a == b, "Neq": a != b}[op]
+    """A relation; CasADi overloads the operators, so one form serves both kinds of values."""
     return {"Lt": a < b, "Le": a <= b, "Gt": a > b, "Ge": a >= b, "Eq": a == b, "Neq": a != b}[op]
 
 
@@ -201,8 +199,6 @@ class Evaluator:
         if op in ("Mul", "MulElem"):
             return a * b
         if op in ("Div", "DivElem"):
-            if not is_symbolic(a) and not is_symbolic(b):
-                return a / b
             return a / b
         if op in ("Exp", "ExpElem"):
             return power(a, b)
