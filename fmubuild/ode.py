@@ -15,6 +15,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any
 
 import casadi as ca
@@ -170,22 +171,21 @@ def translate(model: Any, name: str) -> OdeModel:
         s for s in infos if s not in known and _role_names(infos[s][0])[0] not in ("Parameter", "Constant")]
 
     # --- equations, matching, BLT ----------------------------------------------------------
-    equations = []  # (residual node, targets of a tuple equation or None, where)
+    equations: list[tuple[Any, list[str] | None, str]] = []  # (residual, tuple targets or None, where)
     for equation in flat["equations"]:
         where = f"{name}: equation at {locate(equation.get('span'))}"
         residual = equation["residual"]
         (kind, body), = residual.items()
         if kind == "Binary" and body["op"] == "Sub" and "Tuple" in body["lhs"]:
-            targets = [_ref_name(e, where) for e in body["lhs"]["Tuple"]["elements"]]
-            equations.append((body["rhs"], targets, where))
+            equations.append((body["rhs"], [_ref_name(e, where) for e in body["lhs"]["Tuple"]["elements"]], where))
         else:
             equations.append((residual, None, where))
     slots: list[tuple[int, set[str]]] = []  # (equation, unknowns it can be solved for)
     depends: list[set[str]] = []  # unknowns each slot's equation reads
-    for index, (residual, targets, where) in enumerate(equations):
-        incidence = _incidence(residual, known, unknowns)
-        if targets is not None:
-            for target in targets:
+    for index, (residual, tuple_targets, _) in enumerate(equations):
+        incidence = _incidence(residual, unknowns)
+        if tuple_targets is not None:
+            for target in tuple_targets:
                 slots.append((index, {target}))
                 depends.append(incidence)
         else:
@@ -286,7 +286,7 @@ def _states(equations: list[Mapping[str, Any]]) -> set[str]:
     return states
 
 
-def _incidence(residual: Mapping[str, Any], known: Mapping[str, Value], unknowns: list[str]) -> set[str]:
+def _incidence(residual: Mapping[str, Any], unknowns: list[str]) -> set[str]:
     wanted = set(unknowns)
     found = set()
     for node in _walk(residual):
@@ -397,8 +397,9 @@ def _solve_block(eq_indices: list[int], block_unknowns: list[str], equations: li
             raise UnsupportedConstruct("a multi-output function call inside an algebraic loop",
                                        equations[tuple_equations[0]][2])
         residual, targets, where = equations[eq_indices[0]]
-        evaluator = Evaluator(lambda n: _lookup(env, n, where), library.call, where, allow_events=False)
+        evaluator = Evaluator(partial(_lookup, env, where=where), library.call, where, allow_events=False)
         outputs = evaluator.call_outputs(residual)
+        assert targets is not None  # a tuple equation
         for target, value in zip(targets, outputs):
             env[target] = value
         return
@@ -408,7 +409,7 @@ def _solve_block(eq_indices: list[int], block_unknowns: list[str], equations: li
     residuals = []
     for i in eq_indices:
         residual, _, where = equations[i]
-        evaluator = Evaluator(lambda n, w=where: _lookup(trial, n, w), library.call, where, allow_events=False)
+        evaluator = Evaluator(partial(_lookup, trial, where=where), library.call, where, allow_events=False)
         residuals.append(_mx(evaluator(residual)))
     unknown_vector = ca.vertcat(*symbols)
     residual_vector = ca.vertcat(*residuals)

@@ -19,9 +19,6 @@ MODELICA_ROOT = Path(__file__).resolve().parent.parent / "modelica"
 #: Name of the top-level Modelica package.
 PACKAGE = "RoverTerramechanics"
 
-_CLASS_KEYWORDS = r"(?:partial\s+)?(?:encapsulated\s+)?(?:model|block|function|record|package|connector|type|class)"
-
-
 def package_file() -> Path:
     """The top-level ``package.mo`` of RoverTerramechanics."""
     return MODELICA_ROOT / PACKAGE / "package.mo"

@@ -118,13 +118,8 @@ def test_single_wheel_step_response_settles_to_a_driving_slip(step_model):
 
 # --- the functions on their own ------------------------------------------------------------
 
-PROBE = """
-model ForceProbe
-  parameter Real h0(unit="m") = 0.001;
-  parameter Real h1(unit="m") = 0.3;
-  parameter Real cycles = 7.0;
-  Real h(unit="m");
-  Real slip(unit="1");
+#: Declarations shared by the force probes: outputs, a clock state, the Table 2 records.
+PROBE_COMMON = """
   Real Fx(unit="N");
   Real Fz(unit="N");
   Real Tx(unit="N.m");
@@ -133,7 +128,23 @@ model ForceProbe
   RoverTerramechanics.Parameters.WheelParameters wheel;
 equation
   der(clock) = 1;
-  h = h0*(h1/h0)^time;
+"""
+
+
+def simulate_inline(text: str, model: str, dt: float) -> pd.DataFrame:
+    """rumoca's simulation over 0..1 s of a probe model that uses the package."""
+    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
+    return session.loads(text, model=model).simulate(t=(0.0, 1.0), dt=dt).to_dataframe()
+
+
+PROBE = """
+model ForceProbe
+  parameter Real h0(unit="m") = 0.001;
+  parameter Real h1(unit="m") = 0.3;
+  parameter Real cycles = 7.0;
+  Real h(unit="m");
+  Real slip(unit="1");
+""" + PROBE_COMMON + """  h = h0*(h1/h0)^time;
   slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*cycles*time));
   (Fx, Fz, Tx) = RoverTerramechanics.Functions.contactForces(h, slip, soil, wheel, PANELS);
 end ForceProbe;
@@ -141,9 +152,7 @@ end ForceProbe;
 
 
 def probe_forces(panels: int) -> pd.DataFrame:
-    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
-    model = session.loads(PROBE.replace("PANELS", str(panels)), model="ForceProbe")
-    return model.simulate(t=(0.0, 1.0), dt=0.0005).to_dataframe()
+    return simulate_inline(PROBE.replace("PANELS", str(panels)), "ForceProbe", 0.0005)
 
 
 @pytest.fixture(scope="module")
@@ -180,15 +189,7 @@ model SinkageProbe
   Real W(unit="N");
   Real slip(unit="1");
   Real h(unit="m");
-  Real Fx(unit="N");
-  Real Fz(unit="N");
-  Real Tx(unit="N.m");
-  Real clock(start=0, fixed=true);
-  RoverTerramechanics.Parameters.SoilParameters soil;
-  RoverTerramechanics.Parameters.WheelParameters wheel;
-equation
-  der(clock) = 1;
-  W = 10^(0.5 + 3*time);
+""" + PROBE_COMMON + """  W = 10^(0.5 + 3*time);
   slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*5*time));
   (h, Fx, Fz, Tx) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
 end SinkageProbe;
@@ -198,8 +199,7 @@ end SinkageProbe;
 def test_wheel_contact_carries_the_load_and_matches_the_reference_sinkage():
     """Loads 3 N to 3 kN, slips -1..1: Fz = W to 1e-9 within the bounded iteration, and the
     sinkage equals the reference wheel's to 1e-4 (the quadratures differ)."""
-    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
-    df = session.loads(SINKAGE_PROBE, model="SinkageProbe").simulate(t=(0.0, 1.0), dt=0.001).to_dataframe()
+    df = simulate_inline(SINKAGE_PROBE, "SinkageProbe", 0.001)
     load, slip = df["W"].to_numpy(), df["slip"].to_numpy()
     np.testing.assert_allclose(df["Fz"], load, rtol=1e-9)
     state = wheel_state(load, slip)
@@ -222,8 +222,7 @@ end SlipProbe;
 
 
 def test_slip_ratio_matches_the_reference_including_rest_and_sign_changes():
-    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
-    df = session.loads(SLIP_PROBE, model="SlipProbe").simulate(t=(0.0, 1.0), dt=0.0005).to_dataframe()
+    df = simulate_inline(SLIP_PROBE, "SlipProbe", 0.0005)
     expected = slip_ratio(df["rOmega"].to_numpy(), df["v"].to_numpy(), 1e-3)
     np.testing.assert_allclose(df["slip"], expected, rtol=0, atol=1e-12)
     assert np.all(np.abs(df["slip"]) <= 1)
