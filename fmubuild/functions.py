@@ -117,11 +117,7 @@ class FunctionLibrary:
         return expanded if expanded.n_instructions() <= EXPAND_LIMIT else function
 
     def _execute(self, statements: list[Any], env: dict[str, Value], where: str) -> None:
-        def lookup(n: str) -> Value:
-            if n not in env:
-                raise UnsupportedConstruct(f"variable {n} used before it is assigned", where)
-            return env[n]
-        evaluate = Evaluator(lookup, self.call, where)
+        evaluate = Evaluator(lambda n: _lookup(env, n, where), self.call, where)
         for statement in statements:
             (kind, body), = statement.items()
             if kind == "Assignment":
@@ -161,32 +157,82 @@ class FunctionLibrary:
         env.pop(index["ident"], None)
 
     def _if(self, body: Mapping[str, Any], env: dict[str, Value], where: str, evaluate: Evaluator) -> None:
-        blocks = [(evaluate(b["cond"]), b["stmts"]) for b in body["cond_blocks"]]
+        blocks = [(b["cond"], b["stmts"]) for b in body["cond_blocks"]]
         self._if_chain(blocks, body.get("else_block") or [], env, where)
 
-    def _if_chain(self, blocks: list[tuple[Value, list[Any]]], otherwise: list[Any], env: dict[str, Value],
+    def _if_chain(self, blocks: list[tuple[Any, list[Any]]], otherwise: list[Any], env: dict[str, Value],
                   where: str) -> None:
+        """Execute ``if c1 then s1 elseif c2 then s2 ... else otherwise`` on ``env`` (conditions
+        are rumoca expressions, evaluated in order on the values they see)."""
         if not blocks:
             self._execute(otherwise, env, where)
             return
-        condition, statements = blocks[0]
+        condition = Evaluator(lambda n: _lookup(env, n, where), self.call, where)(blocks[0][0])
+        statements = blocks[0][1]
         if not is_symbolic(condition):
             if condition:
                 self._execute(statements, env, where)
             else:
                 self._if_chain(blocks[1:], otherwise, env, where)
             return
+        if _calls_function([statements, blocks[1:], otherwise]):
+            self._switch(condition, blocks, otherwise, env, where)
+            return
         then_env, else_env = dict(env), dict(env)
         self._execute(statements, then_env, where)
         self._if_chain(blocks[1:], otherwise, else_env, where)
-        for name in set(then_env) | set(else_env):
-            if name not in then_env or name not in else_env:
-                continue  # assigned in one branch only and unset before: stays local to it
-            a, b = then_env[name], else_env[name]
-            if a is b:
-                env[name] = a
-            else:
-                env[name] = select(condition, a, b)
+        for name in _merged(env, then_env, else_env):
+            env[name] = select(condition, then_env[name], else_env[name])
+
+    def _switch(self, condition: ca.MX, blocks: list[tuple[Any, list[Any]]], otherwise: list[Any],
+                env: dict[str, Value], where: str) -> None:
+        """A run-time if-statement whose branches call Modelica functions: only the branch taken is
+        evaluated (a CasADi Switch), e.g. the skipped iterations of a converged solve. Each branch
+        becomes a Function of the symbolic values it can see, so the graphs stay local."""
+        live = sorted(n for n, v in env.items() if is_symbolic(v))
+        inner = {n: ca.MX.sym(_safe(n)) for n in live}
+        then_env = {**env, **inner}
+        else_env = {**env, **inner}
+        self._execute(blocks[0][1], then_env, where)
+        self._if_chain(blocks[1:], otherwise, else_env, where)
+        merged = _merged(env, then_env, else_env)
+        if not merged:
+            return
+        arguments = [inner[n] for n in live]
+        branches = [ca.Function(f"branch_{i}", arguments, [ca.vertcat(*[_as_mx(e[n]) for n in merged])])
+                    for i, e in enumerate((then_env, else_env))]
+        chosen = ca.Function.if_else("switch", branches[0], branches[1])(condition, *[env[n] for n in live])
+        for i, name in enumerate(merged):
+            env[name] = chosen[i]
+
+
+def _merged(env: Mapping[str, Value], then_env: Mapping[str, Value], else_env: Mapping[str, Value]) -> list[str]:
+    """Variables the two branches of an if-statement leave with different values (a variable
+    assigned in one branch only and unset before stays local to that branch)."""
+    names = []
+    for name in sorted(set(then_env) & set(else_env)):
+        if then_env[name] is not else_env[name]:
+            names.append(name)
+    return names
+
+
+def _lookup(env: Mapping[str, Value], name: str, where: str) -> Value:
+    if name not in env:
+        raise UnsupportedConstruct(f"variable {name} used before it is assigned", where)
+    return env[name]
+
+
+def _calls_function(node: Any) -> bool:
+    """Whether statements or expressions (rumoca's nested dicts and lists) call a Modelica function."""
+    if isinstance(node, dict):
+        return "FunctionCall" in node or any(_calls_function(v) for v in node.values())
+    if isinstance(node, (list, tuple)):
+        return any(_calls_function(v) for v in node)
+    return False
+
+
+def _as_mx(value: Value) -> ca.MX:
+    return value if isinstance(value, ca.MX) else ca.MX(float(value))
 
 
 def _target(comp: Mapping[str, Any], evaluate: Evaluator, where: str) -> str:

@@ -40,6 +40,7 @@ class Variable:
     unit: str | None
     description: str | None
     start: float | None
+    is_output: bool = False  # a top-level output (a state can be one too)
 
 
 @dataclass
@@ -234,7 +235,8 @@ def translate(model: Any, name: str) -> OdeModel:
         start = values.get(s)
         if start is None and isinstance(parameters.get(s), (int, float)):
             start = float(parameters[s])
-        variables[s] = Variable(s, role, types.get(flat_name, "Real"), info["unit"], info["description"], start)
+        variables[s] = Variable(s, role, types.get(flat_name, "Real"), info["unit"], info["description"], start,
+                                causality == "Output" and "." not in flat_name)
     return OdeModel(name, variables, states, inputs, free, observed, t, x, u, p, xdot, y, x0, values, calculated)
 
 

@@ -1,0 +1,230 @@
+"""Build FMUs: Modelica class → (built-in backend) rumoca → CasADi → C → FMI 2.0 FMU in ``fmus/``.
+
+The FMU is assembled in a temporary folder and moved into place with one rename, so a failed
+build (an unsupported construct, a compiler error) leaves the output folder as it was. A build is
+skipped when the FMU already there was made from the same inputs (the digest of the Modelica
+package, this builder and the pinned tool versions is stored in ``documentation/build.json``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import zipfile
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+
+from . import codegen, description, ode, source
+
+#: The FMUs ``make fmus`` builds (classes of the Modelica package).
+FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel")
+
+RUNTIME = Path(__file__).parent / "runtime"
+RUNTIME_FILES = ("model.h", "ode23s.h", "ode23s.c", "fmi2_runtime.c")
+FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
+CFLAGS = ("-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-std=c99", "-D_POSIX_C_SOURCE=200809L")
+BUILD_RECORD = "documentation/build.json"
+
+
+@dataclass
+class BuildResult:
+    name: str
+    path: Path
+    rebuilt: bool
+    seconds: float
+    stages: dict[str, float] = field(default_factory=dict)  # translate, generate, compile, package [s]
+
+
+def platform_folder() -> str:
+    """The ``binaries/`` folder name of this platform (FMI 2.0 convention)."""
+    bits = "64" if sys.maxsize > 2**32 else "32"
+    system = platform.system()
+    if system == "Linux":
+        return "linux" + bits
+    if system == "Darwin":
+        return "darwin" + bits
+    if system == "Windows":
+        return "win" + bits
+    raise RuntimeError(f"platform {system!r}: no FMI 2.0 binaries folder name for it")
+
+
+def shared_library_suffix() -> str:
+    return {"Darwin": ".dylib", "Windows": ".dll"}.get(platform.system(), ".so")
+
+
+def fmi_headers() -> Path:
+    """The FMI 2.0 standard headers, as shipped with FMPy (not copied into this repository)."""
+    import fmpy  # a dependency; its c-code folder holds the Modelica Association's headers
+
+    folder = Path(fmpy.__file__).parent / "c-code"
+    missing = [h for h in FMI_HEADERS if not (folder / h).exists()]
+    if missing:
+        raise RuntimeError(f"FMI 2.0 headers {missing} not found in {folder} (is FMPy installed?)")
+    return folder
+
+
+def input_digest(name: str) -> str:
+    """Digest of everything a built-in FMU of ``name`` is made from."""
+    digest = hashlib.sha256(name.encode())
+    files = sorted((source.MODELICA_ROOT / source.PACKAGE).rglob("*")) + sorted(Path(__file__).parent.glob("*.py"))
+    files += [RUNTIME / f for f in RUNTIME_FILES]
+    for path in files:
+        if path.is_file():
+            digest.update(str(path.relative_to(path.parents[1])).encode())
+            digest.update(path.read_bytes())
+    for package in ("rumoca", "casadi"):
+        digest.update(f"{package}=={metadata.version(package)}".encode())
+    digest.update(" ".join(CFLAGS).encode())
+    return digest.hexdigest()
+
+
+def stored_digest(fmu: Path) -> str | None:
+    """The input digest recorded in an FMU built by this module, or None."""
+    try:
+        with zipfile.ZipFile(fmu) as archive:
+            return json.loads(archive.read(BUILD_RECORD))["input_sha256"]
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return None
+
+
+def _class_description(name: str) -> str:
+    text = source.class_file(f"{source.PACKAGE}.{name}").read_text()
+    head = text.split("\n", 3)
+    for line in head:
+        if line.strip().startswith(("model ", "block ")) and '"' in line:
+            return line.split('"')[1]
+    return name
+
+
+def compiler() -> str:
+    cc = os.environ.get("CC", "cc")
+    if shutil.which(cc) is None:
+        raise RuntimeError(f"C compiler {cc!r} not found on PATH (set CC, or install gcc)")
+    return cc
+
+
+def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
+    """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date)."""
+    started = time.perf_counter()
+    out_dir = Path(out_dir)
+    target = out_dir / f"{name}.fmu"
+    digest = input_digest(name)
+    if not force and target.exists() and stored_digest(target) == digest:
+        return BuildResult(name, target, False, time.perf_counter() - started)
+    stages: dict[str, float] = {}
+    with tempfile.TemporaryDirectory(prefix=f"fmubuild-{name}-") as tmp_name:
+        tmp = Path(tmp_name)
+        t0 = time.perf_counter()
+        model = ode.translate(source.load(f"{source.PACKAGE}.{name}"), name)
+        model_layout = codegen.layout(model)
+        stages["translate"] = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        root = tmp / "fmu"
+        sources = root / "sources"
+        guid = codegen.write_sources(model, model_layout, sources)
+        for file in RUNTIME_FILES:
+            shutil.copy2(RUNTIME / file, sources / file)
+        headers = fmi_headers()
+        for file in FMI_HEADERS:
+            shutil.copy2(headers / file, sources / file)
+        source_files = sorted(p.name for p in sources.iterdir())
+        version = metadata.version("rover-cosim")
+        (root / "modelDescription.xml").write_text(
+            description.model_description(model_layout, guid, source_files, _class_description(name), version))
+        stages["generate"] = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        binaries = root / "binaries" / platform_folder()
+        binaries.mkdir(parents=True)
+        library = binaries / f"{name}{shared_library_suffix()}"
+        command = [compiler(), *CFLAGS, "-I", str(sources), *(str(sources / f) for f in source_files if f.endswith(".c")),
+                   "-o", str(library), "-lm"]
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            raise RuntimeError(f"{name}: the C compiler failed ({' '.join(command[:1])}, exit {result.returncode}):\n"
+                               + result.stderr[-4000:])
+        stages["compile"] = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        record = {"input_sha256": digest, "backend": "builtin", "model": f"{source.PACKAGE}.{name}",
+                  "guid": guid, "rover_cosim": version,
+                  "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")}, "cflags": list(CFLAGS),
+                  "states": model_layout.n_states, "inputs": model_layout.n_inputs,
+                  "parameters": model_layout.n_parameters, "observed": model_layout.n_observed}
+        (root / "documentation").mkdir()
+        (root / BUILD_RECORD).write_text(json.dumps(record, indent=2) + "\n")
+        out_dir.mkdir(parents=True, exist_ok=True)
+        partial = out_dir / f".{name}.fmu.partial"
+        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
+            for path in sorted(root.rglob("*")):
+                if path.is_file():
+                    archive.write(path, path.relative_to(root).as_posix())
+        os.replace(partial, target)
+        stages["package"] = time.perf_counter() - t0
+    return BuildResult(name, target, True, time.perf_counter() - started, stages)
+
+
+def _build_one(args: tuple[str, Path, bool, str]) -> BuildResult:
+    name, out_dir, force, backend = args
+    if backend == "omc":
+        from .omc import build_fmu_omc
+        return build_fmu_omc(name, out_dir, force=force)
+    return build_fmu(name, out_dir, force=force)
+
+
+def resolve_backend(backend: str) -> str:
+    """``auto`` → ``omc`` where OpenModelica's ``omc`` is on PATH, else ``builtin``."""
+    if backend not in ("auto", "builtin", "omc"):
+        raise ValueError(f"backend={backend!r}: expected auto, builtin or omc")
+    if backend == "auto":
+        return "omc" if shutil.which("omc") else "builtin"
+    if backend == "omc" and not shutil.which("omc"):
+        raise RuntimeError("backend omc: `omc` (OpenModelica) is not on PATH; use BACKEND=builtin")
+    return backend
+
+
+def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *, force: bool = False,
+              jobs: int | None = None, backend: str = "builtin",
+              report: Callable[[BuildResult], None] | None = None) -> list[BuildResult]:
+    """Build several FMUs, ``jobs`` at a time (default: the number of CPUs). The first failure
+    is raised after the other builds finished; FMUs already built stay."""
+    unknown = [n for n in names if n not in FMU_MODELS]
+    if unknown:
+        raise ValueError(f"model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}")
+    backend = resolve_backend(backend)
+    jobs = max(1, min(jobs or os.cpu_count() or 1, len(names)))
+    tasks = [(n, Path(out_dir), force, backend) for n in names]
+    results: list[BuildResult] = []
+    errors: list[BaseException] = []
+    if jobs == 1:
+        for task in tasks:
+            try:
+                results.append(_build_one(task))
+                if report:
+                    report(results[-1])
+            except Exception as error:  # noqa: BLE001 - reported after the others
+                errors.append(error)
+    else:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            futures = [pool.submit(_build_one, task) for task in tasks]
+            for future in futures:
+                try:
+                    results.append(future.result())
+                    if report:
+                        report(results[-1])
+                except Exception as error:  # noqa: BLE001
+                    errors.append(error)
+    if errors:
+        raise errors[0]
+    return results

@@ -1,0 +1,215 @@
+"""An :class:`~fmubuild.ode.OdeModel` → the C sources of one FMU and the layout of its variables.
+
+Generated per model (the runtime in ``fmubuild/runtime`` is the same for all):
+
+- ``model_casadi.c``: CasADi's C code of ``model_ode``, ``model_outputs``, ``model_initial``,
+  ``model_ode_jacobian`` (dense df/dx and df/dt, for the Co-Simulation integrator) and
+  ``model_directional`` (forward directional derivatives of derivatives and observed variables,
+  for ``fmi2GetDirectionalDerivative``);
+- ``model_data.c``: the ``ModelInfo`` of ``runtime/model.h`` (sizes, defaults, names, GUID).
+
+Real value references follow ``runtime/model.h``: parameters, states, derivatives, inputs, observed
+variables (outputs and locals), then the two solver parameters.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import casadi as ca
+
+from .ode import OdeModel
+
+#: Solver parameters appended after the model's variables (Co-Simulation only).
+SOLVER_PARAMETERS = (
+    ("solver.tolerance", 1e-6, "1",
+     "Relative (and absolute) tolerance of the Co-Simulation integrator (Rosenbrock 2(3), error-controlled)"),
+    ("solver.maxStep", 0.0, "s",
+     "Largest internal step of the Co-Simulation integrator; 0: only the communication step limits it"),
+)
+
+
+@dataclass(frozen=True)
+class FmuVariable:
+    """One ScalarVariable of the model description (value reference = position in the layout)."""
+
+    name: str
+    value_reference: int
+    kind: str  # "parameter", "state", "derivative", "input", "observed", "solver"
+    causality: str
+    variability: str
+    initial: str | None
+    start: float | None
+    unit: str | None
+    description: str | None
+    derivative_of: int | None = None  # value reference of the state, for derivatives
+
+
+@dataclass(frozen=True)
+class ModelLayout:
+    """What the model description and the C data need, in value-reference order."""
+
+    name: str
+    variables: list[FmuVariable]
+    n_states: int
+    n_inputs: int
+    n_parameters: int
+    n_observed: int
+    dependencies: dict[int, list[int]]  # value reference of a derivative/observed -> state/input refs
+
+
+def _functions(model: OdeModel) -> list[ca.Function]:
+    t, x, u, p = model.t, model.x, model.u, model.p
+    dx = ca.MX.sym("dx", x.numel())
+    du = ca.MX.sym("du", u.numel())
+    knowns = ca.vertcat(x, u)
+    seeds = ca.vertcat(dx, du)
+    sensitivity = ca.jtimes(ca.vertcat(model.xdot, model.y), knowns, seeds) if knowns.numel() else ca.MX(
+        model.xdot.numel() + model.y.numel(), 1)
+    nx = x.numel()
+    return [
+        ca.Function("model_ode", [t, x, u, p], [model.xdot], ["t", "x", "u", "p"], ["xdot"]),
+        ca.Function("model_outputs", [t, x, u, p], [model.y], ["t", "x", "u", "p"], ["y"]),
+        ca.Function("model_initial", [p], [model.x0], ["p"], ["x0"]),
+        ca.Function("model_ode_jacobian", [t, x, u, p],
+                    [ca.densify(ca.jacobian(model.xdot, x)), ca.densify(ca.jacobian(model.xdot, t))],
+                    ["t", "x", "u", "p"], ["dfdx", "dfdt"]),
+        ca.Function("model_directional", [t, x, u, p, dx, du],
+                    [ca.densify(sensitivity[:nx]), ca.densify(sensitivity[nx:])],
+                    ["t", "x", "u", "p", "dx", "du"], ["dxdot", "dy"]),
+    ]
+
+
+def layout(model: OdeModel) -> ModelLayout:
+    """Value references, causality/variability/initial, start values and dependencies."""
+    variables: list[FmuVariable] = []
+    vr = 0
+
+    def add(**kwargs: object) -> FmuVariable:
+        nonlocal vr
+        variable = FmuVariable(value_reference=vr, **kwargs)  # type: ignore[arg-type]
+        variables.append(variable)
+        vr += 1
+        return variable
+
+    info = model.variables
+    for name in model.parameters:
+        v = info[name]
+        add(name=name, kind="parameter", causality="parameter", variability="fixed", initial="exact",
+            start=model.parameter_values[name], unit=v.unit, description=v.description)
+    x0 = ca.Function("x0", [model.p], [model.x0])
+    default_p = [model.parameter_values[n] for n in model.parameters]
+    x_start = [float(value) for value in ca.DM(x0(default_p)).full().ravel()] if model.states else []
+    state_refs = []
+    for i, name in enumerate(model.states):
+        v = info[name]
+        calculated = bool(ca.depends_on(model.x0[i], model.p)) if model.p.numel() else False
+        state_refs.append(add(name=name, kind="state", causality="output" if v.is_output else "local",
+                              variability="continuous", initial="calculated" if calculated else "exact",
+                              start=None if calculated else x_start[i], unit=v.unit, description=v.description))
+    for state, name in zip(state_refs, model.states):
+        v = info[name]
+        unit = _derivative_unit(v.unit)
+        add(name=f"der({name})", kind="derivative", causality="local", variability="continuous", initial="calculated",
+            start=None, unit=unit, description=f"time derivative of {name}", derivative_of=state.value_reference)
+    for name in model.inputs:
+        v = info[name]
+        add(name=name, kind="input", causality="input", variability="continuous", initial=None,
+            start=v.start if v.start is not None else 0.0, unit=v.unit, description=v.description)
+    for name in model.observed:
+        v = info[name]
+        add(name=name, kind="observed", causality="output" if v.is_output else "local", variability="continuous",
+            initial="calculated", start=None, unit=v.unit, description=v.description)
+    for name, value, unit, description in SOLVER_PARAMETERS:
+        add(name=name, kind="solver", causality="parameter", variability="tunable", initial="exact", start=value,
+            unit=unit, description=description)
+
+    # Structural dependencies of derivatives and observed variables on states and inputs.
+    knowns = ca.vertcat(model.x, model.u)
+    known_refs = [v.value_reference for v in variables if v.kind in ("state", "input")]
+    unknown_refs = [v.value_reference for v in variables if v.kind in ("derivative", "observed")]
+    dependencies: dict[int, list[int]] = {ref: [] for ref in unknown_refs}
+    if knowns.numel() and unknown_refs:
+        pattern = ca.jacobian_sparsity(ca.vertcat(model.xdot, model.y), knowns)
+        rows, cols = pattern.get_triplet()
+        for r, c in zip(rows, cols):
+            dependencies[unknown_refs[r]].append(known_refs[c])
+    for ref in dependencies:
+        dependencies[ref].sort()
+    return ModelLayout(model.name, variables, len(model.states), len(model.inputs), len(model.parameters),
+                       len(model.observed), dependencies)
+
+
+def _derivative_unit(unit: str | None) -> str | None:
+    if unit is None:
+        return None
+    if unit in ("", "1"):
+        return "1/s"
+    if "/" in unit:
+        numerator, denominator = unit.split("/", 1)
+        if denominator == "s":
+            return f"{numerator}/s2"
+        if denominator == "s2":
+            return f"{numerator}/s3"
+        return f"{numerator}/({denominator}.s)"
+    return f"{unit}/s"
+
+
+def _c_doubles(values: list[float]) -> str:
+    return "{" + ", ".join(repr(float(v)) for v in values) + "}" if values else "{0.0}"
+
+
+def _c_string(text: str) -> str:
+    return json.dumps(text)  # a valid C string literal for printable text
+
+
+def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path) -> str:
+    """Write ``model_casadi.c`` and ``model_data.c`` to ``directory``; returns the GUID, a digest of
+    the generated code and the layout (same model, same GUID)."""
+    directory.mkdir(parents=True, exist_ok=True)
+    generator = ca.CodeGenerator("model_casadi.c", {"with_export": False, "with_header": False,
+                                                     "casadi_int": "long long int", "casadi_real": "double"})
+    for function in _functions(model):
+        generator.add(function)
+    code = generator.dump()
+    digest = hashlib.sha256(code.encode())
+    digest.update(json.dumps([model.name, [(v.name, v.kind, v.causality, v.start, v.unit) for v in model_layout.variables],
+                              sorted(model_layout.dependencies.items())]).encode())
+    h = digest.hexdigest()
+    guid = "{" + f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:32]}" + "}"
+    (directory / "model_casadi.c").write_text(
+        "/* Generated by rover-cosim fmubuild with CasADi " + ca.__version__ + " from the Modelica model "
+        + model.name + ". Do not edit. */\n" + code)
+
+    by_kind: dict[str, list[FmuVariable]] = {}
+    for v in model_layout.variables:
+        by_kind.setdefault(v.kind, []).append(v)
+    p_default = [v.start or 0.0 for v in by_kind.get("parameter", [])]
+    u_default = [v.start or 0.0 for v in by_kind.get("input", [])]
+    x0 = ca.Function("x0", [model.p], [model.x0])
+    states = by_kind.get("state", [])
+    x_start = [float(v) for v in ca.DM(x0(p_default)).full().ravel()] if states else []
+    calculated = [1 if v.initial == "calculated" else 0 for v in states]
+    names = ",\n    ".join(_c_string(v.name) for v in model_layout.variables)
+    data = f"""/* Generated by rover-cosim fmubuild: the layout of {model.name}. Do not edit. */
+#include "model.h"
+
+static const double P_DEFAULT[] = {_c_doubles(p_default)};
+static const double U_DEFAULT[] = {_c_doubles(u_default)};
+static const double X_START[] = {_c_doubles(x_start)};
+static const int X_START_CALCULATED[] = {{{", ".join(map(str, calculated)) or "0"}}};
+static const char *const REAL_NAMES[] = {{
+    {names}
+}};
+
+const ModelInfo model_info = {{
+    {_c_string(model.name)}, {_c_string(guid)},
+    {model_layout.n_states}, {model_layout.n_inputs}, {model_layout.n_parameters}, {model_layout.n_observed},
+    P_DEFAULT, U_DEFAULT, X_START, X_START_CALCULATED, REAL_NAMES
+}};
+"""
+    (directory / "model_data.c").write_text(data)
+    return guid

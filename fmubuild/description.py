@@ -1,0 +1,113 @@
+"""``modelDescription.xml`` (FMI 2.0) for a built-in FMU: ModelExchange and CoSimulation in one,
+unit definitions in SI base units, every variable with causality/variability/initial, and the
+complete ModelStructure (outputs and derivatives with their dependencies on states and inputs;
+the initial unknowns)."""
+
+from __future__ import annotations
+
+import datetime
+import xml.etree.ElementTree as ET
+
+from .codegen import FmuVariable, ModelLayout
+from .units import base_units
+
+GENERATOR = "rover-cosim fmubuild (rumoca + CasADi + own FMI 2.0 runtime)"
+
+
+def _number(value: float) -> str:
+    return repr(float(value))
+
+
+def model_description(model_layout: ModelLayout, guid: str, sources: list[str], description: str,
+                      version: str) -> str:
+    root = ET.Element("fmiModelDescription", {
+        "fmiVersion": "2.0",
+        "modelName": model_layout.name,
+        "guid": guid,
+        "description": description,
+        "generationTool": f"{GENERATOR} {version}",
+        "generationDateAndTime": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "variableNamingConvention": "structured",
+        "numberOfEventIndicators": "0",
+    })
+    common = {"modelIdentifier": model_layout.name, "providesDirectionalDerivative": "true",
+              "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
+              "canNotUseMemoryManagementFunctions": "false"}
+    for element, extra in (("ModelExchange", {"completedIntegratorStepNotNeeded": "true"}),
+                           ("CoSimulation", {"canHandleVariableCommunicationStepSize": "true",
+                                             "canInterpolateInputs": "false", "maxOutputDerivativeOrder": "0",
+                                             "canRunAsynchronuously": "false"})):
+        node = ET.SubElement(root, element, {**common, **extra})
+        files = ET.SubElement(node, "SourceFiles")
+        for name in sources:
+            if name.endswith(".c"):
+                ET.SubElement(files, "File", {"name": name})
+
+    units = sorted({v.unit for v in model_layout.variables if v.unit is not None})
+    if units:
+        definitions = ET.SubElement(root, "UnitDefinitions")
+        for unit in units:
+            exponents, factor = base_units(unit)
+            node = ET.SubElement(definitions, "Unit", {"name": unit})
+            attributes = {k: str(e) for k, e in exponents.items()}
+            if factor != 1.0:
+                attributes["factor"] = _number(factor)
+            ET.SubElement(node, "BaseUnit", attributes)
+
+    categories = ET.SubElement(root, "LogCategories")
+    ET.SubElement(categories, "Category", {"name": "logStatusError", "description": "errors, always reported"})
+
+    ET.SubElement(root, "DefaultExperiment", {"startTime": "0.0", "tolerance": "1e-06"})
+
+    variables = ET.SubElement(root, "ModelVariables")
+    index: dict[int, int] = {}
+    for position, v in enumerate(model_layout.variables, start=1):
+        index[v.value_reference] = position
+        attributes = {"name": v.name, "valueReference": str(v.value_reference), "causality": v.causality,
+                      "variability": v.variability}
+        if v.description:
+            attributes["description"] = v.description
+        if v.initial is not None:
+            attributes["initial"] = v.initial
+        node = ET.SubElement(variables, "ScalarVariable", attributes)
+        real: dict[str, str] = {}
+        if v.unit is not None:
+            real["unit"] = v.unit
+        if v.start is not None:
+            real["start"] = _number(v.start)
+        if v.derivative_of is not None:
+            real["derivative"] = str(index[v.derivative_of])
+        ET.SubElement(node, "Real", real)
+
+    structure = ET.SubElement(root, "ModelStructure")
+    outputs = [v for v in model_layout.variables if v.causality == "output"]
+    derivatives = [v for v in model_layout.variables if v.kind == "derivative"]
+    if outputs:
+        node = ET.SubElement(structure, "Outputs")
+        for v in outputs:
+            ET.SubElement(node, "Unknown", {"index": str(index[v.value_reference]),
+                                            "dependencies": _dependencies(v, model_layout, index)})
+    if derivatives:
+        node = ET.SubElement(structure, "Derivatives")
+        for v in derivatives:
+            ET.SubElement(node, "Unknown", {"index": str(index[v.value_reference]),
+                                            "dependencies": _dependencies(v, model_layout, index)})
+    initial = [v for v in model_layout.variables
+               if (v.causality == "output" and v.initial in ("approx", "calculated"))
+               or (v.kind in ("state", "derivative") and v.initial in ("approx", "calculated"))]
+    if initial:
+        node = ET.SubElement(structure, "InitialUnknowns")
+        for v in sorted(initial, key=lambda v: index[v.value_reference]):
+            # No dependencies attribute: may depend on every known (parameters, inputs, exact states).
+            ET.SubElement(node, "Unknown", {"index": str(index[v.value_reference])})
+
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _dependencies(v: FmuVariable, model_layout: ModelLayout, index: dict[int, int]) -> str:
+    if v.kind == "state":
+        refs = [v.value_reference]  # an output that is a state depends on that state only
+    else:
+        refs = model_layout.dependencies.get(v.value_reference, [])
+    return " ".join(str(index[r]) for r in refs)

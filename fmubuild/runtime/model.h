@@ -1,0 +1,49 @@
+/* The contract between a generated model and the rover-cosim FMI 2.0 runtime.
+ *
+ * fmubuild generates, per model, model_casadi.c (CasADi's C code of the functions below) and
+ * model_data.c (sizes, value-reference layout, defaults: the ModelInfo below). The runtime
+ * (fmi2_runtime.c, ode23s.c) is the same for every model.
+ *
+ * Real value references are indices into one array laid out as
+ *   [parameters | states | derivatives | inputs | observed | tolerance, maxStep]
+ * with the offsets given in ModelInfo.
+ */
+#ifndef ROVER_COSIM_MODEL_H
+#define ROVER_COSIM_MODEL_H
+
+typedef long long int casadi_int;
+
+typedef struct {
+    const char *identifier;           /* modelIdentifier */
+    const char *guid;
+    int nx, nu, np, ny;               /* states, inputs, tunable parameters, observed variables */
+    const double *p_default;          /* [np] parameter start values */
+    const double *u_default;          /* [nu] input start values */
+    const double *x_start;            /* [nx] constant state start values */
+    const int *x_start_calculated;    /* [nx] 1: start computed from the parameters (model_initial) */
+    const char *const *real_names;    /* [n_real] variable names, for messages */
+} ModelInfo;
+
+extern const ModelInfo model_info;
+
+/* Signature of CasADi's generated functions. */
+typedef int (*casadi_eval)(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+typedef int (*casadi_work)(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+
+/* model_ode(t, x, u, p) -> xdot */
+int model_ode(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+int model_ode_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+/* model_outputs(t, x, u, p) -> y (observed variables) */
+int model_outputs(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+int model_outputs_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+/* model_initial(p) -> x0 */
+int model_initial(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+int model_initial_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+/* model_ode_jacobian(t, x, u, p) -> (dxdot/dx [nx*nx, column-major, dense], dxdot/dt [nx]) */
+int model_ode_jacobian(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+int model_ode_jacobian_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+/* model_directional(t, x, u, p, dx, du) -> (dxdot, dy): forward directional derivatives */
+int model_directional(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+int model_directional_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+
+#endif

@@ -1,0 +1,34 @@
+/* Adaptive, error-controlled integration of stiff ODEs xdot = f(t, x) with the L-stable
+ * Rosenbrock (W-)method of order 2(3) of Shampine and Reichelt (the formula of MATLAB's ode23s,
+ * SIAM J. Sci. Comput. 18(1), 1997). It stays second order with an approximate Jacobian, so the
+ * Jacobian is refreshed once per call and after a rejected step, not at every step. */
+#ifndef ROVER_COSIM_ODE23S_H
+#define ROVER_COSIM_ODE23S_H
+
+typedef struct {
+    /* f(t, x) -> xdot; returns 0 on success. */
+    int (*rhs)(void *ctx, double t, const double *x, double *xdot);
+    /* df/dx (n*n, column-major) and df/dt (n) at (t, x); returns 0 on success. */
+    int (*jacobian)(void *ctx, double t, const double *x, double *dfdx, double *dfdt);
+    void *ctx;
+    int n;
+    double rtol, atol;   /* error per component <= atol + rtol * |x_i| */
+    double max_step;     /* <= 0: no limit besides the interval */
+    long max_steps;      /* accepted + rejected steps per call */
+    /* work (allocated by ode23s_alloc) */
+    double *J, *T, *W, *F0, *F1, *F2, *k1, *k2, *k3, *xn, *tmp;
+    int *pivot;
+    double h;            /* step size to try next (kept between calls) */
+    int f0_valid;        /* F0 = f(t, x) at the current point is known */
+    long steps, rejected, jacobians, rhs_calls;  /* counters since allocation */
+} Ode23s;
+
+/* Allocate work arrays for n states with the given allocator; returns 0 on success. */
+int ode23s_alloc(Ode23s *s, int n, void *(*alloc)(size_t, size_t));
+void ode23s_free(Ode23s *s, void (*release)(void *));
+
+/* Integrate x from *t to t_end in place. Returns 0 on success; otherwise a message is written
+ * to msg (size msg_len) and *t, x are left at the last accepted point. */
+int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, size_t msg_len);
+
+#endif
