@@ -56,6 +56,8 @@ def model_description(model_layout: ModelLayout, guid: str, sources: list[str], 
 
     categories = ET.SubElement(root, "LogCategories")
     ET.SubElement(categories, "Category", {"name": "logStatusError", "description": "errors, always reported"})
+    ET.SubElement(categories, "Category", {"name": "logStatistics",
+                                           "description": "Co-Simulation integrator counts, at fmi2Terminate"})
 
     ET.SubElement(root, "DefaultExperiment", {"startTime": "0.0", "tolerance": "1e-06"})
 

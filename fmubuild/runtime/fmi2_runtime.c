@@ -154,6 +154,7 @@ static void set_defaults(Instance *c) {
     c->has_stop = 0;
     c->mode = MODE_INSTANTIATED;
     c->solver.h = 0.0;
+    c->solver.jac_valid = 0;
     invalidate(c);
 }
 
@@ -309,12 +310,16 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
     c->mode = c->type == fmi2ModelExchange ? MODE_EVENT : MODE_STEP;
     c->solver.h = 0.0;
     c->solver.f0_valid = 0;
+    c->solver.jac_valid = 0;
     return fmi2OK;
 }
 
 fmi2Status fmi2Terminate(fmi2Component component) {
     Instance *c = check(component, "fmi2Terminate", RUNNING | S(MODE_ERROR) | S(MODE_TERMINATED));
     if (!c) return fmi2Error;
+    if (c->type == fmi2CoSimulation)
+        log_message(c, fmi2OK, "logStatistics", "integrator: %ld steps, %ld rejected, %ld Jacobians, %ld derivative evaluations",
+                    c->solver.steps, c->solver.rejected, c->solver.jacobians, c->solver.rhs_calls);
     c->mode = MODE_TERMINATED;
     return fmi2OK;
 }
@@ -458,6 +463,7 @@ static fmi2Status state_read(Instance *c, const unsigned char *buffer, size_t si
     c->rtol = head.rtol;
     c->max_step = head.max_step;
     invalidate(c);
+    c->solver.jac_valid = 0;
     c->solver.h = head.h;
     return fmi2OK;
 }

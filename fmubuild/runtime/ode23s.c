@@ -24,6 +24,8 @@ int ode23s_alloc(Ode23s *s, int n, void *(*alloc)(size_t, size_t)) {
     s->pivot = alloc(m, sizeof(int));
     s->h = 0.0;
     s->f0_valid = 0;
+    s->jac_valid = s->jac_current = s->jac_age = 0;
+    s->jacobian_max_age = 20;
     s->steps = s->rejected = s->jacobians = s->rhs_calls = 0;
     return (s->J && s->W && s->T && s->F0 && s->F1 && s->F2 && s->k1 && s->k2 && s->k3 && s->xn &&
             s->tmp && s->pivot) ? 0 : -1;
@@ -62,8 +64,12 @@ static int lu_factor(double *A, int n, int *pivot) {
 }
 
 static void lu_solve(const double *LU, int n, const int *pivot, double *b) {
+    /* The row interchanges were applied to whole rows (multipliers included): apply them all
+     * to b first, then solve L y = P b and U x = y. */
     for (int k = 0; k < n; k++) {
         if (pivot[k] != k) { double t = b[k]; b[k] = b[pivot[k]]; b[pivot[k]] = t; }
+    }
+    for (int k = 0; k < n; k++) {
         for (int i = k + 1; i < n; i++) b[i] -= LU[i + k * n] * b[k];
     }
     for (int k = n - 1; k >= 0; k--) {
@@ -84,9 +90,7 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
     const double h_min = 16.0 * 2.220446049250313e-16 * fmax(fabs(*t), fabs(t_end));
     double h_max = s->max_step > 0.0 ? fmin(s->max_step, span) : span;
     double h = s->h > 0.0 ? fmin(s->h, h_max) : fmin(h_max, 1e-3 * span + 0.0);
-    int jac_current = 0;  /* J was evaluated at the current point */
-    int jac_valid = 0;    /* J may be used (refreshed once per call, every 50 steps, after rejections) */
-    long accepted = 0, attempts = 0;
+    long attempts = 0;
 
     if (!s->f0_valid) {
         if (s->rhs(s->ctx, *t, x, s->F0) || !all_finite(s->F0, n)) {
@@ -108,13 +112,14 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
     }
 
     while (*t < t_end) {
-        if (!jac_valid) {
+        if (!s->jac_valid || s->jac_age >= s->jacobian_max_age) {
             if (s->jacobian(s->ctx, *t, x, s->J, s->T) || !all_finite(s->J, n * n) || !all_finite(s->T, n)) {
                 snprintf(msg, msg_len, "the Jacobian is not finite at t = %.17g", *t);
                 return -1;
             }
             s->jacobians++;
-            jac_valid = jac_current = 1;
+            s->jac_valid = s->jac_current = 1;
+            s->jac_age = 0;
         }
         double remaining = t_end - *t;
         double h_try = h;
@@ -159,14 +164,13 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
             *t = (h == remaining) ? t_end : *t + h;
             for (int i = 0; i < n; i++) { x[i] = s->xn[i]; s->F0[i] = s->F2[i]; }
             s->steps++;
-            accepted++;
             double grow = err > 0.0 ? fmin(5.0, 0.8 * pow(err, -1.0 / 3.0)) : 5.0;
             /* A step shortened to land on t_end says little about the next one: keep the proposal. */
             s->h = h < h_try ? h_try : h * grow;
             if (s->max_step > 0.0) s->h = fmin(s->h, s->max_step);
             h = fmin(s->h, h_max);
-            jac_current = 0;
-            if (accepted % 50 == 0) jac_valid = 0;
+            s->jac_current = 0;
+            s->jac_age++;
         } else {
             s->rejected++;
             double shrink = isfinite(err) ? fmax(0.1, 0.8 * pow(err, -1.0 / 3.0)) : 0.25;
@@ -177,7 +181,7 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
                          h, *t, err);
                 return -1;
             }
-            if (!jac_current) jac_valid = 0;  /* re-linearise at the current point */
+            if (!s->jac_current) s->jac_valid = 0;  /* re-linearise at the current point */
         }
     }
     return 0;

@@ -1,7 +1,8 @@
 /* Adaptive, error-controlled integration of stiff ODEs xdot = f(t, x) with the L-stable
  * Rosenbrock (W-)method of order 2(3) of Shampine and Reichelt (the formula of MATLAB's ode23s,
- * SIAM J. Sci. Comput. 18(1), 1997). It stays second order with an approximate Jacobian, so the
- * Jacobian is refreshed once per call and after a rejected step, not at every step. */
+ * SIAM J. Sci. Comput. 18(1), 1997). It stays second order with an approximate Jacobian (a
+ * W-method), so the Jacobian is kept across steps and calls and refreshed after a rejected step
+ * or when it is jacobian_max_age steps old. */
 #ifndef ROVER_COSIM_ODE23S_H
 #define ROVER_COSIM_ODE23S_H
 
@@ -15,11 +16,15 @@ typedef struct {
     double rtol, atol;   /* error per component <= atol + rtol * |x_i| */
     double max_step;     /* <= 0: no limit besides the interval */
     long max_steps;      /* accepted + rejected steps per call */
+    int jacobian_max_age; /* accepted steps after which the Jacobian is re-evaluated */
     /* work (allocated by ode23s_alloc) */
     double *J, *T, *W, *F0, *F1, *F2, *k1, *k2, *k3, *xn, *tmp;
     int *pivot;
     double h;            /* step size to try next (kept between calls) */
     int f0_valid;        /* F0 = f(t, x) at the current point is known */
+    int jac_valid;       /* J may be used; clear it when the model changes (parameters, reset) */
+    int jac_current;     /* J was evaluated at the current point */
+    int jac_age;         /* accepted steps since J was evaluated */
     long steps, rejected, jacobians, rhs_calls;  /* counters since allocation */
 } Ode23s;
 
