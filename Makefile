@@ -9,7 +9,12 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test fig3 bench venv clean
+.PHONY: run test fig3 fmus bench venv clean
+
+# FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
+# rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
+BACKEND ?= auto
+FMU_NAMES := SingleWheel Rover RoverBody Wheel
 
 # The virtualenv is (re)installed when pyproject.toml changes; the stamp records success.
 $(STAMP): pyproject.toml
@@ -28,6 +33,10 @@ run: fig3
 fig3: $(STAMP)
 	$(VENV)/bin/rover-cosim fig3 --out $(RESULTS)
 
+## fmus: FMI 2.0 FMUs (ME + CS) of the Modelica models -> fmus/*.fmu (skipped when up to date)
+fmus: $(STAMP)
+	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) $(FMU_NAMES)
+
 ## test: the test suite
 test: $(STAMP)
 	$(PY) -m pytest
@@ -37,4 +46,4 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
 
 clean:
-	rm -rf $(VENV) $(RESULTS) .pytest_cache
+	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

@@ -85,6 +85,7 @@ def simulate(name: str, *, params: Mapping[str, float] | None = None, stop: floa
     ``interval`` from the start to ``stop`` (defaults: its experiment annotation). Returns one
     column per variable, indexed by time [s].
 
+    The solver tolerance is the annotation's ``Tolerance`` (relative and absolute), if it has one.
     ``params`` overrides tunable parameters by flat name (e.g. ``{"W": 575.0}``); structural
     parameters such as loop bounds cannot be overridden this way (rumoca compiles them in).
     """
@@ -93,7 +94,11 @@ def simulate(name: str, *, params: Mapping[str, float] | None = None, stop: floa
     interval = exp.interval if interval is None else interval
     if not (stop > exp.start and interval > 0):
         raise ValueError(f"stop={stop!r}, interval={interval!r}: expected stop > {exp.start} s and interval > 0 s")
+    import rumoca
+
     model = load(name)
     if params:
         model = model.with_params(**params)
-    return model.simulate(t=(exp.start, stop), dt=interval).to_dataframe()
+    # rumoca's default tolerance (~1e-6) is not the annotation's; pass the annotation's on.
+    config = rumoca.SimConfig(rtol=exp.tolerance, atol=exp.tolerance) if exp.tolerance else None
+    return model.simulate(t=(exp.start, stop), dt=interval, config=config).to_dataframe()

@@ -20,8 +20,9 @@ typedef enum { MODE_INSTANTIATED, MODE_INITIALIZATION, MODE_EVENT, MODE_CONTINUO
 typedef struct {
     unsigned magic, nx, nu, np;
     int mode;
+    int f0_valid, jac_valid, jac_current, jac_age;  /* integrator memory, so a restored run repeats exactly */
     double t, rtol, max_step, h;
-    /* followed by x[nx], u[nu], p[np], x_set[nx] (as doubles) */
+    /* followed by x[nx], u[nu], p[np], x_set[nx], F0[nx], J[nx*nx] (doubles) */
 } StateHeader;
 
 typedef struct {
@@ -61,12 +62,20 @@ static int n_real(void) { return vr_max_step() + 1; }
 static void log_message(Instance *c, fmi2Status status, const char *category, const char *format, ...) {
     if (!c || !c->cb.logger) return;
     if (status == fmi2OK && !c->logging) return;
-    char buffer[1024];
+    char buffer[1024], escaped[2048];
     va_list args;
     va_start(args, format);
     vsnprintf(buffer, sizeof buffer, format, args);
     va_end(args);
-    c->cb.logger(c->cb.componentEnvironment, c->name ? c->name : "?", status, category, "%s", buffer);
+    /* The logger takes a printf format: pass the text itself with '%' doubled, so importers
+     * that do not expand the variable arguments (e.g. ctypes callbacks) still get the text. */
+    size_t j = 0;
+    for (size_t i = 0; buffer[i] && j + 2 < sizeof escaped; i++) {
+        if (buffer[i] == '%') escaped[j++] = '%';
+        escaped[j++] = buffer[i];
+    }
+    escaped[j] = '\0';
+    c->cb.logger(c->cb.componentEnvironment, c->name ? c->name : "?", status, category, escaped);
 }
 
 static fmi2Status fail(Instance *c, const char *function, const char *format, ...) {
@@ -214,10 +223,13 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         return NULL;
     }
     if (!fmuGUID || strcmp(fmuGUID, model_info.guid) != 0) {
-        if (functions->logger)
+        if (functions->logger) {
+            char text[512];
+            snprintf(text, sizeof text, "fmi2Instantiate: GUID %s does not match this binary of %s (%s)",
+                     fmuGUID ? fmuGUID : "(null)", model_info.identifier, model_info.guid);
             functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
-                              "fmi2Instantiate: GUID %s does not match this binary of %s (%s)",
-                              fmuGUID ? fmuGUID : "(null)", model_info.identifier, model_info.guid);
+                              strchr(text, '%') ? "fmi2Instantiate: GUID does not match this binary" : text);
+        }
         return NULL;
     }
     Instance *c = functions->allocateMemory(1, sizeof(Instance));
@@ -432,18 +444,22 @@ fmi2Status fmi2SetString(fmi2Component component, const fmi2ValueReference vr[],
 
 /* ---- FMU state -------------------------------------------------------------------------- */
 static size_t state_size(void) {
-    return sizeof(StateHeader) + sizeof(double) * (size_t)(2 * model_info.nx + model_info.nu + model_info.np);
+    return sizeof(StateHeader) +
+           sizeof(double) * (size_t)(3 * model_info.nx + model_info.nu + model_info.np + model_info.nx * model_info.nx);
 }
 
 static void state_write(const Instance *c, unsigned char *buffer) {
     StateHeader head = {FMU_STATE_MAGIC, (unsigned)model_info.nx, (unsigned)model_info.nu, (unsigned)model_info.np,
-                        (int)c->mode, c->t, c->rtol, c->max_step, c->solver.h};
+                        (int)c->mode, c->solver.f0_valid, c->solver.jac_valid, c->solver.jac_current,
+                        c->solver.jac_age, c->t, c->rtol, c->max_step, c->solver.h};
     memcpy(buffer, &head, sizeof head);
     double *v = (double *)(buffer + sizeof head);
     memcpy(v, c->x, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->u, sizeof(double) * model_info.nu); v += model_info.nu;
     memcpy(v, c->p, sizeof(double) * model_info.np); v += model_info.np;
-    memcpy(v, c->x_set, sizeof(double) * model_info.nx);
+    memcpy(v, c->x_set, sizeof(double) * model_info.nx); v += model_info.nx;
+    memcpy(v, c->solver.F0, sizeof(double) * model_info.nx); v += model_info.nx;
+    memcpy(v, c->solver.J, sizeof(double) * model_info.nx * model_info.nx);
 }
 
 static fmi2Status state_read(Instance *c, const unsigned char *buffer, size_t size, const char *function) {
@@ -457,13 +473,18 @@ static fmi2Status state_read(Instance *c, const unsigned char *buffer, size_t si
     memcpy(c->x, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->u, v, sizeof(double) * model_info.nu); v += model_info.nu;
     memcpy(c->p, v, sizeof(double) * model_info.np); v += model_info.np;
-    memcpy(c->x_set, v, sizeof(double) * model_info.nx);
+    memcpy(c->x_set, v, sizeof(double) * model_info.nx); v += model_info.nx;
+    memcpy(c->solver.F0, v, sizeof(double) * model_info.nx); v += model_info.nx;
+    memcpy(c->solver.J, v, sizeof(double) * model_info.nx * model_info.nx);
     c->mode = (Mode)head.mode;
     c->t = head.t;
     c->rtol = head.rtol;
     c->max_step = head.max_step;
     invalidate(c);
-    c->solver.jac_valid = 0;
+    c->solver.f0_valid = head.f0_valid;
+    c->solver.jac_valid = head.jac_valid;
+    c->solver.jac_current = head.jac_current;
+    c->solver.jac_age = head.jac_age;
     c->solver.h = head.h;
     return fmi2OK;
 }

@@ -1,0 +1,433 @@
+"""The FMUs of `make fmus` (built-in backend): FMI 2.0 conformance as FMPy checks it, ME and CS
+runs, agreement with the numpy reference wheel and with rumoca's simulation of the same Modelica,
+an independent importer (libcosimpy), and the runtime's contract (errors through the logger,
+FMU state, reset, directional derivatives, instances in threads)."""
+
+from __future__ import annotations
+
+import ctypes
+import shutil
+import threading
+import subprocess
+import xml.etree.ElementTree as ET
+import zipfile
+from pathlib import Path
+
+import fmpy
+import numpy as np
+import pytest
+from fmpy.fmi2 import (
+    FMU2Model,
+    FMU2Slave,
+    defaultCallbacks,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+from fmpy.validation import validate_fmu
+
+from fmubuild import build, source
+from fmubuild.expressions import UnsupportedConstruct
+from terramechanics import Wheel, slip_ratio, wheel_state
+
+REPO = Path(__file__).resolve().parent.parent
+FMU_DIR = REPO / "fmus"
+STEP_LOADS = (275.0, 575.0, 875.0)
+
+
+@pytest.fixture(scope="session")
+def fmus() -> dict[str, Path]:
+    """The four FMUs, built into fmus/ as `make fmus` does (skipped when up to date)."""
+    results = build.build_all(build.FMU_MODELS, FMU_DIR, backend="builtin")
+    return {r.name: r.path for r in results}
+
+
+def variables(path: Path) -> dict[str, fmpy.model_description.ScalarVariable]:
+    return {v.name: v for v in fmpy.read_model_description(str(path)).modelVariables}
+
+
+def assert_close(name: str, got: np.ndarray, ref: np.ndarray, rtol: float, atol: float) -> None:
+    error = np.abs(got - ref)
+    bound = rtol * np.abs(ref) + atol
+    worst = int(np.argmax(error - bound))
+    assert np.all(error <= bound), f"{name}: {got[worst]!r} vs reference {ref[worst]!r} at row {worst}"
+
+
+# --- conformance --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", build.FMU_MODELS)
+def test_fmpy_validation_reports_no_problem(fmus, name: str):
+    assert validate_fmu(str(fmus[name])) == []
+
+
+@pytest.mark.parametrize("name", build.FMU_MODELS)
+def test_fmu_is_me_and_cs_with_sources_units_and_solver_parameters(fmus, name: str):
+    md = fmpy.read_model_description(str(fmus[name]))
+    assert md.modelExchange is not None and md.coSimulation is not None
+    assert md.coSimulation.providesDirectionalDerivative and md.coSimulation.canGetAndSetFMUstate
+    with zipfile.ZipFile(fmus[name]) as archive:
+        members = set(archive.namelist())
+        root = ET.fromstring(archive.read("modelDescription.xml"))
+    for kind in ("ModelExchange", "CoSimulation"):
+        listed = [f.get("name") for f in root.findall(f"{kind}/SourceFiles/File")]
+        assert "fmi2_runtime.c" in listed and all(f"sources/{f}" in members for f in listed)
+    assert {"sources/fmi2_runtime.c", "sources/model_casadi.c", "sources/model.h"} <= members
+    assert f"binaries/{build.platform_folder()}/{name}{build.shared_library_suffix()}" in members
+    reals = [v for v in md.modelVariables if v.type == "Real"]
+    assert all(v.unit is not None for v in reals), [v.name for v in reals if v.unit is None]
+    names = {v.name: v for v in md.modelVariables}
+    assert names["solver.tolerance"].causality == "parameter" and names["solver.maxStep"].unit == "s"
+    assert len(md.derivatives) == sum(v.derivative is not None for v in md.modelVariables) > 0
+
+
+def test_model_description_interfaces_match_the_modelica_readme(fmus):
+    """The interfaces DESIGN.md and modelica/README.md promise (spot checks per FMU)."""
+    single = variables(fmus["SingleWheel"])
+    assert single["tau"].causality == "input" and single["tau"].unit == "N.m"
+    assert single["W"].causality == "parameter" and single["W"].unit == "N"
+    assert {"Fx", "Fz", "Tx", "slip", "sinkage", "omega", "v"} <= {n for n, v in single.items() if v.causality == "output"}
+    wheel = variables(fmus["Wheel"])
+    assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub"}
+    body = variables(fmus["RoverBody"])
+    assert {f"Fx[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "input"}
+    assert {f"W[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "output"}
+    rover = variables(fmus["Rover"])
+    assert {f"tau[{i}]" for i in range(1, 7)} == {n for n, v in rover.items() if v.causality == "input"}
+
+
+@pytest.mark.parametrize("name", build.FMU_MODELS)
+def test_fmpy_simulates_each_fmu_as_cs_and_as_me_with_the_same_result(fmus, name: str):
+    inputs = {"SingleWheel": {"tau": 40.0}, "Wheel": {"tau": 40.0, "W": 424.0, "v_hub": 0.2},
+              "RoverBody": {f"Fx[{i}]": 20.0 for i in range(1, 7)},
+              "Rover": {f"tau[{i}]": 40.0 for i in range(1, 7)}}[name]
+    runs = {kind: fmpy.simulate_fmu(str(fmus[name]), fmi_type=kind, stop_time=0.3, step_size=1e-3,
+                                    output_interval=0.01, start_values=inputs, relative_tolerance=1e-8)
+            for kind in ("CoSimulation", "ModelExchange")}
+    cs, me = runs["CoSimulation"], runs["ModelExchange"]
+    assert len(cs) == len(me) >= 30
+    for column in cs.dtype.names[1:]:
+        assert np.all(np.isfinite(cs[column])), column
+        scale = max(1.0, float(np.abs(me[column]).max()))
+        np.testing.assert_allclose(cs[column], me[column], rtol=0, atol=1e-4 * scale, err_msg=column)
+
+
+# --- physics against the references -------------------------------------------------------------
+
+def single_wheel_step(path: Path, load: float, torque: float, stop: float = 2.0, **kwargs) -> np.ndarray:
+    return fmpy.simulate_fmu(str(path), stop_time=stop, step_size=1e-3, output_interval=0.002,
+                             start_values={"W": load, "tau": torque}, **kwargs)
+
+
+@pytest.mark.parametrize("load", STEP_LOADS)
+def test_single_wheel_fmu_step_agrees_with_the_reference_wheel(fmus, load: float):
+    """Torque step from rest (60 N·m): every recorded (sinkage, Fx, Fz, Tx) equals
+    terramechanics.wheel_state at the same load and slip within 0.5 % (absolute floors of 0.1 µm
+    and 1 mN for values passing through zero); the slip is Eq. (4) of the recorded speeds."""
+    result = single_wheel_step(fmus["SingleWheel"], load, 60.0)
+    slip = result["slip"]
+    assert slip.max() > 0.02  # the step really drives the wheel
+    state = wheel_state(np.full(slip.shape, load), slip)
+    assert_close("sinkage", result["sinkage"], state.sinkage, 0.005, 1e-7)
+    assert_close("Fx", result["Fx"], state.Fx, 0.005, 1e-3)
+    assert_close("Fz", result["Fz"], state.Fz, 0.005, 1e-3)
+    assert_close("Tx", result["Tx"], state.Tx, 0.005, 1e-3)
+    np.testing.assert_allclose(slip, slip_ratio(Wheel().r * result["omega"], result["v"], 1e-3), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("load", STEP_LOADS)
+def test_single_wheel_fmu_trajectories_agree_with_rumoca(fmus, load: float):
+    """The FMU (CS, 1 ms, integrator tolerance 1e-8) against rumoca's simulation of
+    Examples.SingleWheelStep (its annotation's tolerance 1e-8) with the same load and torque,
+    at rumoca's output times."""
+    torque = 60.0
+    reference = source.simulate(f"{source.PACKAGE}.Examples.SingleWheelStep", params={"W": load, "tauStep": torque},
+                                stop=2.0, interval=0.01)
+    result = fmpy.simulate_fmu(str(fmus["SingleWheel"]), stop_time=2.0, step_size=1e-3, output_interval=0.01,
+                               start_values={"W": load, "tau": torque, "solver.tolerance": 1e-8})
+    times = reference.index.to_numpy()
+    for column, atol in (("slip", 1e-4), ("v", 1e-5), ("omega", 1e-4), ("Fx", 0.05), ("sinkage", 1e-6)):
+        got = np.interp(times, result["time"], result[column])
+        ref = reference[f"testBed.{column}"].to_numpy()
+        assert_close(column, got, ref, 1e-3, atol)
+
+
+def test_libcosimpy_runs_single_wheel_and_reports_what_fmpy_reports(fmus):
+    """Open Simulation Platform's libcosim (an independent FMI importer) steps SingleWheel.fmu at
+    1 ms and ends with the same outputs as FMPy."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    log_output_level(CosimLogLevel.ERROR)
+    path = str(fmus["SingleWheel"])
+    refs = {name: v.valueReference for name, v in variables(fmus["SingleWheel"]).items()}
+    execution = CosimExecution.from_step_size(int(1e6))  # ns
+    index = execution.add_local_slave(CosimLocalSlave(fmu_path=path, instance_name="wheel"))
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    execution.real_initial_value(index, refs["W"], 575.0)
+    execution.real_initial_value(index, refs["tau"], 60.0)
+    assert execution.simulate_until(int(0.5e9))
+    names = ["v", "omega", "slip", "sinkage", "Fx", "Fz", "Tx"]
+    cosim = dict(zip(names, observer.last_real_values(index, [refs[n] for n in names])))
+    result = single_wheel_step(fmus["SingleWheel"], 575.0, 60.0, stop=0.5)
+    for name in names:
+        assert cosim[name] == pytest.approx(float(result[name][-1]), rel=1e-9, abs=1e-12), name
+    assert cosim["v"] > 0.1
+
+
+# --- the runtime's contract ---------------------------------------------------------------------
+
+class Messages:
+    """A logger that records what the FMU reports."""
+
+    def __init__(self) -> None:
+        self.lines: list[tuple[int, str]] = []
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = fmi2CallbackLoggerTYPE(self)
+        self.callbacks.allocateMemory = defaultCallbacks.allocateMemory
+        self.callbacks.freeMemory = defaultCallbacks.freeMemory
+
+    def __call__(self, env, instance, status, category, message) -> None:  # noqa: ANN001
+        self.lines.append((status, message.decode()))
+
+    def errors(self) -> list[str]:
+        return [m for s, m in self.lines if s >= 3]
+
+
+def unpacked(fmus, name: str, tmp_path: Path) -> tuple[str, fmpy.model_description.ModelDescription]:
+    """The FMU extracted under tmp_path (once: later instances load the same binary)."""
+    folder = tmp_path / name
+    if not folder.exists():
+        fmpy.extract(str(fmus[name]), str(folder))
+    return str(folder), fmpy.read_model_description(str(fmus[name]))
+
+
+def slave(fmus, name: str, tmp_path: Path, messages: Messages, instance: str = "a") -> tuple[FMU2Slave, dict[str, int]]:
+    folder, md = unpacked(fmus, name, tmp_path)
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=name, instanceName=instance)
+    fmu.instantiate(callbacks=messages.callbacks)
+    return fmu, {v.name: v.valueReference for v in md.modelVariables}
+
+
+def test_errors_come_through_the_logger_as_fmi2error_not_crashes(fmus, tmp_path):
+    messages = Messages()
+    fmu, vr = slave(fmus, "SingleWheel", tmp_path, messages)
+    with pytest.raises(Exception, match="status 3"):
+        fmu.setReal([vr["W"]], [float("nan")])
+    assert any("W = nan" in m and "finite" in m for m in messages.errors())
+    with pytest.raises(Exception, match="status 3"):
+        fmu.setReal([9999], [1.0])
+    assert any("9999" in m for m in messages.errors())
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    with pytest.raises(Exception, match="status 3"):
+        fmu.setReal([vr["W"]], [500.0])  # fixed parameter after initialization
+    assert any("fixed parameter" in m for m in messages.errors())
+    with pytest.raises(Exception, match="status 3"):
+        fmu.doStep(0.0, -1e-3)
+    assert any("communication step size" in m for m in messages.errors())
+    with pytest.raises(Exception, match="status 3"):
+        fmu.setReal([vr["solver.tolerance"]], [2.0])
+    fmu.doStep(0.0, 1e-3)  # still usable after rejected calls
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_wrong_guid_is_refused_with_a_message(fmus, tmp_path):
+    folder, md = unpacked(fmus, "Wheel", tmp_path)
+    messages = Messages()
+    fmu = FMU2Slave(guid="{not-the-guid}", unzipDirectory=folder, modelIdentifier="Wheel", instanceName="w")
+    with pytest.raises(Exception):
+        fmu.instantiate(callbacks=messages.callbacks)
+    assert any("GUID" in m for m in messages.errors())
+
+
+def run_steps(fmu: FMU2Slave, vr: dict[str, int], t0: float, steps: int, names: list[str]) -> np.ndarray:
+    rows = []
+    for k in range(steps):
+        fmu.doStep(t0 + k * 1e-3, 1e-3)
+        rows.append(fmu.getReal([vr[n] for n in names]))
+    return np.array(rows)
+
+
+def started(fmus, name: str, tmp_path: Path, values: dict[str, float], instance: str = "a"):
+    messages = Messages()
+    fmu, vr = slave(fmus, name, tmp_path, messages, instance)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.setReal([vr[k] for k in values], list(values.values()))
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    return fmu, vr
+
+
+def test_fmu_state_get_set_and_serialize_reproduce_the_trajectory(fmus, tmp_path):
+    fmu, vr = started(fmus, "SingleWheel", tmp_path, {"W": 575.0, "tau": 60.0})
+    names = ["v", "omega", "slip", "Fx"]
+    run_steps(fmu, vr, 0.0, 100, names)
+    state = fmu.getFMUstate()
+    first = run_steps(fmu, vr, 0.1, 100, names)
+    fmu.setFMUstate(state)
+    again = run_steps(fmu, vr, 0.1, 100, names)
+    np.testing.assert_array_equal(first, again)
+    serialized = fmu.serializeFMUstate(state)
+    fmu.freeFMUstate(state)
+    restored = fmu.deSerializeFMUstate(serialized)
+    fmu.setFMUstate(restored)
+    np.testing.assert_array_equal(run_steps(fmu, vr, 0.1, 100, names), first)
+    fmu.freeFMUstate(restored)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_reset_returns_to_the_start(fmus, tmp_path):
+    fmu, vr = started(fmus, "SingleWheel", tmp_path, {"W": 275.0, "tau": 30.0})
+    first = run_steps(fmu, vr, 0.0, 50, ["v", "slip"])
+    fmu.reset()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.setReal([vr["W"], vr["tau"]], [275.0, 30.0])
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    np.testing.assert_array_equal(run_steps(fmu, vr, 0.0, 50, ["v", "slip"]), first)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_directional_derivatives_match_finite_differences(fmus, tmp_path):
+    """d(outputs, derivatives)/d(states, inputs) of Wheel.fmu from fmi2GetDirectionalDerivative
+    against central differences of fmi2GetReal (Model Exchange)."""
+    folder, md = unpacked(fmus, "Wheel", tmp_path)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = FMU2Model(guid=md.guid, unzipDirectory=folder, modelIdentifier="Wheel", instanceName="me")
+    fmu.instantiate(callbacks=(keep := Messages()).callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    fmu.enterContinuousTimeMode()
+    base = {"tau": 30.0, "W": 424.0, "v_hub": 0.3}
+    fmu.setReal([vr[k] for k in base], list(base.values()))
+    fmu.setContinuousStates((ctypes.c_double * 1)(2.0), 1)
+    unknowns = ["der(omega)", "Fx", "Tx", "slip", "sinkage"]
+    for known, step in (("omega", 1e-5), ("W", 1e-3), ("v_hub", 1e-6), ("tau", 1e-4)):
+        analytic = fmu.getDirectionalDerivative([vr[u] for u in unknowns], [vr[known]], [1.0])
+
+        def at(value: float) -> np.ndarray:
+            if known == "omega":
+                fmu.setContinuousStates((ctypes.c_double * 1)(value), 1)
+            else:
+                fmu.setReal([vr[known]], [value])
+            return np.array(fmu.getReal([vr[u] for u in unknowns]))
+
+        centre = 2.0 if known == "omega" else base[known]
+        numeric = (at(centre + step) - at(centre - step)) / (2 * step)
+        at(centre)
+        np.testing.assert_allclose(analytic, numeric, rtol=1e-4, atol=1e-6, err_msg=known)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_instances_in_parallel_threads_do_not_share_state(fmus, tmp_path):
+    """Two instances of one binary stepped concurrently in two threads give what each gives alone."""
+    loads = (275.0, 875.0)
+    alone = []
+    for i, load in enumerate(loads):
+        fmu, vr = started(fmus, "SingleWheel", tmp_path / f"seq{i}", {"W": load, "tau": 60.0})
+        alone.append(run_steps(fmu, vr, 0.0, 300, ["v", "slip", "sinkage"]))
+        fmu.freeInstance()
+    together: dict[int, np.ndarray] = {}
+    pairs = [started(fmus, "SingleWheel", tmp_path / "par", {"W": load, "tau": 60.0}, instance=f"i{i}")
+             for i, load in enumerate(loads)]
+
+    def work(i: int) -> None:
+        fmu, refs = pairs[i]
+        together[i] = run_steps(fmu, refs, 0.0, 300, ["v", "slip", "sinkage"])
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    for i in range(2):
+        np.testing.assert_array_equal(together[i], alone[i])
+    assert not np.allclose(alone[0], alone[1])
+
+
+def test_fmu_sources_rebuild_the_binary(fmus, tmp_path):
+    """The C sources inside the FMU compile on their own into a binary that runs (RoverBody)."""
+    folder, md = unpacked(fmus, "RoverBody", tmp_path)
+    sources = Path(folder) / "sources"
+    library = Path(folder) / "binaries" / build.platform_folder() / "RoverBody.so"
+    library.unlink()
+    subprocess.run([build.compiler(), "-O1", "-fPIC", "-shared", "-I", str(sources),
+                    *map(str, sorted(sources.glob("*.c"))), "-o", str(library), "-lm"], check=True)
+    result = fmpy.simulate_fmu(folder, stop_time=0.2, step_size=1e-3,
+                               start_values={f"Fx[{i}]": 20.0 for i in range(1, 7)})
+    reference = fmpy.simulate_fmu(str(fmus["RoverBody"]), stop_time=0.2, step_size=1e-3,
+                                  start_values={f"Fx[{i}]": 20.0 for i in range(1, 7)})
+    np.testing.assert_allclose(result["v"], reference["v"], rtol=1e-12, atol=1e-15)
+    assert result["v"][-1] > 0
+
+
+# --- the build ----------------------------------------------------------------------------------
+
+def test_unchanged_sources_are_not_rebuilt(fmus):
+    before = {name: path.stat().st_mtime_ns for name, path in fmus.items()}
+    results = build.build_all(build.FMU_MODELS, FMU_DIR, backend="builtin", jobs=1)
+    assert [r.rebuilt for r in results] == [False] * 4
+    assert {r.name: r.path.stat().st_mtime_ns for r in results} == before
+
+
+BAD_PACKAGE = """package Bad
+end Bad;
+"""
+BAD_MODEL = """within Bad;
+model SingleWheel "a model with an event"
+  input Real tau(unit="N.m");
+  Real omega(start=0, unit="rad/s");
+equation
+  der(omega) = tau;
+  when omega > 1 then
+    terminate("spun up");
+  end when;
+end SingleWheel;
+"""
+
+
+def test_unsupported_construct_is_rejected_and_leaves_the_output_folder_untouched(tmp_path, monkeypatch):
+    root = tmp_path / "modelica"
+    (root / "Bad").mkdir(parents=True)
+    (root / "Bad" / "package.mo").write_text(BAD_PACKAGE)
+    (root / "Bad" / "SingleWheel.mo").write_text(BAD_MODEL)
+    (root / "Bad" / "package.order").write_text("SingleWheel\n")
+    monkeypatch.setattr(source, "MODELICA_ROOT", root)
+    monkeypatch.setattr(source, "PACKAGE", "Bad")
+    out = tmp_path / "fmus"
+    out.mkdir()
+    (out / "SingleWheel.fmu").write_bytes(b"previous build")
+    with pytest.raises(UnsupportedConstruct) as error:
+        build.build_fmu("SingleWheel", out, force=True)
+    message = str(error.value)
+    assert "when" in message and "SingleWheel.mo:" in message and "omc" in message
+    assert sorted(p.name for p in out.iterdir()) == ["SingleWheel.fmu"]
+    assert (out / "SingleWheel.fmu").read_bytes() == b"previous build"
+
+
+def test_build_cli_reports_up_to_date_fmus(fmus, capsys):
+    from orchestrator.cli import main
+
+    assert main(["build-fmus", "--out", str(FMU_DIR), "--backend", "builtin", "--jobs", "1", "Wheel"]) == 0
+    assert "Wheel.fmu is up to date" in capsys.readouterr().out
+    assert main(["build-fmus", "--out", str(FMU_DIR), "NoSuchModel"]) == 1
+    assert "NoSuchModel" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(shutil.which("omc") is None, reason="omc not on PATH")
+def test_omc_backend_builds_a_single_wheel_fmu_that_agrees_with_the_reference(tmp_path):
+    from fmubuild.omc import build_fmu_omc
+
+    result = build_fmu_omc("SingleWheel", tmp_path)
+    assert validate_fmu(str(result.path)) == []
+    out = single_wheel_step(result.path, 575.0, 60.0)
+    state = wheel_state(np.full(out["slip"].shape, 575.0), out["slip"])
+    assert_close("Fx", out["Fx"], state.Fx, 0.005, 1e-3)
