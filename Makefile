@@ -44,6 +44,7 @@ test: $(STAMP)
 ## bench: benchmarks (not tests) -> results/bench/*.json
 bench: $(STAMP)
 	$(PY) benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
+	$(PY) benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
 
 clean:
 	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

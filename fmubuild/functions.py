@@ -114,7 +114,12 @@ class FunctionLibrary:
         function = ca.Function(_safe(name) + (f"_{suffix}" if suffix else ""), symbols, outputs,
                                [s.name() for s in symbols], [d["name"] for d in definition["outputs"]])
         expanded = function.expand()
-        return expanded if expanded.n_instructions() <= EXPAND_LIMIT else function
+        if expanded.n_instructions() > EXPAND_LIMIT:
+            return function
+        # Common subexpressions of the unrolled loops (e.g. tan(phi) per quadrature point) once.
+        inputs = expanded.sx_in()
+        return ca.Function(expanded.name(), inputs, ca.cse(expanded.call(inputs)),
+                           expanded.name_in(), expanded.name_out())
 
     def _execute(self, statements: list[Any], env: dict[str, Value], where: str) -> None:
         evaluate = Evaluator(lambda n: _lookup(env, n, where), self.call, where)

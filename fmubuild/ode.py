@@ -399,12 +399,22 @@ def _solve_block(eq_indices: list[int], block_unknowns: list[str], equations: li
             raise UnsupportedConstruct("a multi-output function call inside an algebraic loop",
                                        equations[tuple_equations[0]][2])
         residual, targets, where = equations[eq_indices[0]]
+        assert targets is not None  # a tuple equation
+        if all(target in env for target in targets):
+            return  # solved with its first target: one call for all outputs
         evaluator = Evaluator(partial(_lookup, env, where=where), library.call, where, allow_events=False)
         outputs = evaluator.call_outputs(residual)
-        assert targets is not None  # a tuple equation
         for target, value in zip(targets, outputs):
             env[target] = value
         return
+    if len(eq_indices) == 1 and len(block_unknowns) == 1:
+        residual, _, where = equations[eq_indices[0]]
+        explicit = _explicit_side(residual, block_unknowns[0])
+        if explicit is not None:
+            # unknown = expression (the common case): evaluated as it stands, keeping shared nodes
+            evaluator = Evaluator(partial(_lookup, env, where=where), library.call, where, allow_events=False)
+            env[block_unknowns[0]] = evaluator(explicit)
+            return
     symbols = [ca.MX.sym(f"unknown_{i}") for i in range(len(block_unknowns))]
     trial = dict(env)
     trial.update(zip(block_unknowns, symbols))
@@ -420,13 +430,33 @@ def _solve_block(eq_indices: list[int], block_unknowns: list[str], equations: li
         wheres = "; ".join(equations[i][2] for i in eq_indices)
         kind = "a nonlinear equation in its unknown" if len(eq_indices) == 1 else "a nonlinear algebraic loop"
         raise UnsupportedConstruct(f"{kind} for {', '.join(block_unknowns)}", wheres)
-    offset = ca.substitute(residual_vector, unknown_vector, ca.DM.zeros(len(symbols)))
+    # graph_substitute keeps the nodes that do not depend on the unknowns (function calls stay shared)
+    offset = ca.graph_substitute(residual_vector, [unknown_vector], [ca.MX.zeros(len(symbols))])
     if len(symbols) == 1:
         solution = -offset / jacobian
     else:
         solution = -ca.solve(jacobian, offset)
     for i, variable in enumerate(block_unknowns):
         env[variable] = ca.simplify(solution[i]) if len(symbols) == 1 else solution[i]
+
+
+def _explicit_side(residual: Mapping[str, Any], unknown: str) -> Mapping[str, Any] | None:
+    """For a residual ``unknown - e`` or ``e - unknown`` with ``e`` free of the unknown, ``e``."""
+    (kind, body), = residual.items()
+    if kind != "Binary" or body["op"] != "Sub":
+        return None
+    for mine, other in ((body["lhs"], body["rhs"]), (body["rhs"], body["lhs"])):
+        if _incidence(mine, [unknown]) == {unknown} and _is_reference(mine) and not _incidence(other, [unknown]):
+            return other
+    return None
+
+
+def _is_reference(node: Mapping[str, Any]) -> bool:
+    """A plain variable reference (constant subscripts) or der() of one."""
+    (kind, body), = node.items()
+    if kind == "VarRef":
+        return all("Index" in s for s in body.get("subscripts", []))
+    return kind == "BuiltinCall" and body.get("function") == "Der"
 
 
 def _lookup(env: Mapping[str, Value], name: str, where: str) -> Value:
