@@ -67,7 +67,7 @@ def time_cs(path: Path, name: str, values: dict[str, float], seconds: float, fol
     fmu.setReal([refs[k] for k in values], list(values.values()))
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
-    steps = int(round(seconds / STEP))
+    steps = round(seconds / STEP)
     start = time.perf_counter()
     for k in range(steps):
         fmu.doStep(k * STEP, STEP)

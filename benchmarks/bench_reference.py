@@ -13,16 +13,16 @@ import os
 for _variable in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_variable] = "1"
 
-import argparse  # noqa: E402
-import platform  # noqa: E402
-import statistics  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+import argparse
+import platform
+import statistics
+import time
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from orchestrator.outputs import json_bytes, run_record, write_all  # noqa: E402
-from terramechanics import DEFAULT_NODES, contact_forces, wheel_state  # noqa: E402
+from orchestrator.outputs import json_bytes, run_record, write_all
+from terramechanics import DEFAULT_NODES, contact_forces, wheel_state
 
 FLOOR_STATES_PER_S = 100_000
 BATCH = 100_000

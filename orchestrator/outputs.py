@@ -8,10 +8,10 @@ import platform
 import subprocess
 import sys
 import tempfile
-from datetime import datetime, timezone
+from collections.abc import Mapping
+from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
-from typing import Mapping
 
 PACKAGES = ("rover-cosim", "numpy", "scipy", "pandas", "matplotlib")
 
@@ -64,7 +64,7 @@ def run_record(command: str, parameters: Mapping[str, object]) -> dict[str, obje
     return {
         "command": command,
         "parameters": parameters,
-        "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "git_commit": _git_commit(),
         "python": sys.version.split()[0],
         "platform": platform.platform(),

@@ -6,9 +6,10 @@ FMU state, reset, directional derivatives, instances in threads)."""
 from __future__ import annotations
 
 import ctypes
+import os
 import shutil
-import threading
 import subprocess
+import threading
 import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
@@ -188,7 +189,7 @@ class Messages:
         self.callbacks.allocateMemory = defaultCallbacks.allocateMemory
         self.callbacks.freeMemory = defaultCallbacks.freeMemory
 
-    def __call__(self, env, instance, status, category, message) -> None:  # noqa: ANN001
+    def __call__(self, env, instance, status, category, message) -> None:
         self.lines.append((status, message.decode()))
 
     def errors(self) -> list[str]:
@@ -236,10 +237,10 @@ def test_errors_come_through_the_logger_as_fmi2error_not_crashes(fmus, tmp_path)
 
 
 def test_wrong_guid_is_refused_with_a_message(fmus, tmp_path):
-    folder, md = unpacked(fmus, "Wheel", tmp_path)
+    folder, _ = unpacked(fmus, "Wheel", tmp_path)
     messages = Messages()
     fmu = FMU2Slave(guid="{not-the-guid}", unzipDirectory=folder, modelIdentifier="Wheel", instanceName="w")
-    with pytest.raises(Exception):
+    with pytest.raises(Exception, match="Failed to instantiate"):
         fmu.instantiate(callbacks=messages.callbacks)
     assert any("GUID" in m for m in messages.errors())
 
@@ -300,7 +301,8 @@ def test_directional_derivatives_match_finite_differences(fmus, tmp_path):
     folder, md = unpacked(fmus, "Wheel", tmp_path)
     vr = {v.name: v.valueReference for v in md.modelVariables}
     fmu = FMU2Model(guid=md.guid, unzipDirectory=folder, modelIdentifier="Wheel", instanceName="me")
-    fmu.instantiate(callbacks=(keep := Messages()).callbacks)
+    messages = Messages()  # kept alive while the FMU may call its logger
+    fmu.instantiate(callbacks=messages.callbacks)
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
@@ -312,7 +314,7 @@ def test_directional_derivatives_match_finite_differences(fmus, tmp_path):
     for known, step in (("omega", 1e-5), ("W", 1e-3), ("v_hub", 1e-6), ("tau", 1e-4)):
         analytic = fmu.getDirectionalDerivative([vr[u] for u in unknowns], [vr[known]], [1.0])
 
-        def at(value: float) -> np.ndarray:
+        def at(value: float, known: str = known) -> np.ndarray:
             if known == "omega":
                 fmu.setContinuousStates((ctypes.c_double * 1)(value), 1)
             else:
@@ -355,7 +357,7 @@ def test_instances_in_parallel_threads_do_not_share_state(fmus, tmp_path):
 
 def test_fmu_sources_rebuild_the_binary(fmus, tmp_path):
     """The C sources inside the FMU compile on their own into a binary that runs (RoverBody)."""
-    folder, md = unpacked(fmus, "RoverBody", tmp_path)
+    folder, _ = unpacked(fmus, "RoverBody", tmp_path)
     sources = Path(folder) / "sources"
     library = Path(folder) / "binaries" / build.platform_folder() / "RoverBody.so"
     library.unlink()
@@ -420,6 +422,48 @@ def test_build_cli_reports_up_to_date_fmus(fmus, capsys):
     assert "Wheel.fmu is up to date" in capsys.readouterr().out
     assert main(["build-fmus", "--out", str(FMU_DIR), "NoSuchModel"]) == 1
     assert "NoSuchModel" in capsys.readouterr().err
+
+
+def test_backend_choice_and_the_omc_script(monkeypatch):
+    from fmubuild.omc import script
+
+    monkeypatch.setenv("PATH", "/nonexistent")
+    assert build.resolve_backend("auto") == "builtin"
+    with pytest.raises(RuntimeError, match="omc.*not on PATH"):
+        build.resolve_backend("omc")
+    with pytest.raises(ValueError, match="backend='cmake'"):
+        build.resolve_backend("cmake")
+    text = script("Rover")
+    assert 'buildModelFMU(RoverTerramechanics.Rover, version="2.0", fmuType="me_cs"' in text
+    assert "--fmiFlags=s:cvode" in text and source.package_file().as_posix() in text
+
+
+FAKE_OMC = """#!/bin/sh
+# Stands in for OpenModelica: checks the script it is given and "exports" a prepared FMU.
+if [ "$1" = "--version" ]; then echo "OpenModelica 0.0-stand-in"; exit 0; fi
+grep -q 'buildModelFMU(RoverTerramechanics.Wheel, version="2.0", fmuType="me_cs"' "$1" || exit 3
+cp "$PREPARED_FMU" Wheel.fmu
+"""
+
+
+def test_omc_backend_plumbing_with_a_stand_in_omc(fmus, tmp_path, monkeypatch):
+    """build_fmu_omc runs omc on its script in a scratch folder, records its inputs in the FMU and
+    moves it into place; a second call is skipped. (OpenModelica itself: the hosted workflow.)"""
+    from fmubuild.omc import build_fmu_omc
+
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    (bin_dir / "omc").write_text(FAKE_OMC)
+    (bin_dir / "omc").chmod(0o755)
+    monkeypatch.setenv("PATH", f"{bin_dir}:{os.environ['PATH']}")
+    monkeypatch.setenv("PREPARED_FMU", str(fmus["Wheel"]))
+    out = tmp_path / "fmus"
+    first = build_fmu_omc("Wheel", out)
+    assert first.rebuilt and validate_fmu(str(first.path)) == []
+    with zipfile.ZipFile(first.path) as archive:
+        assert "omc" in archive.read(build.BUILD_RECORD).decode()
+    assert not build_fmu_omc("Wheel", out).rebuilt
+    assert sorted(p.name for p in out.iterdir()) == ["Wheel.fmu"]
 
 
 @pytest.mark.skipif(shutil.which("omc") is None, reason="omc not on PATH")
