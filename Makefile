@@ -26,8 +26,8 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
-## run: the whole pipeline that exists so far (now: the paper's Fig. 3 from the reference wheel)
-run: fig3
+## run: the whole pipeline that exists so far (now: the FMUs and the paper's Fig. 3 from the reference wheel)
+run: fmus fig3
 
 ## fig3: Fx against slip for loads 100..800 N -> results/fig3_fx_vs_slip.{csv,png}
 fig3: $(STAMP)

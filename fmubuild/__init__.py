@@ -1,4 +1,4 @@
-"""FMU build from the Modelica source in ``modelica/`` (the built-in backend; issue 4, in progress).
+"""FMU build from the Modelica source in ``modelica/``.
 
 - ``fmubuild.source``: locates the Modelica package, loads classes with rumoca (the Modelica front
   end) and runs rumoca's own simulation, the reference the FMUs are checked against.
@@ -6,6 +6,9 @@
   algorithms → CasADi.
 - ``fmubuild.ode``: a flat model → explicit ODE xdot = f(t, x, u, p), y = g(t, x, u, p) by matching
   and BLT, with clear errors for what it cannot translate.
-
-Not yet: C code generation, the FMI 2.0 runtime, modelDescription.xml, packaging, ``make fmus``.
+- ``fmubuild.codegen``: the ODE → C (CasADi) and the value-reference layout;
+  ``fmubuild.description``: modelDescription.xml; ``fmubuild.units``: unit strings → SI base units.
+- ``fmubuild.runtime``: the FMI 2.0 C runtime (ME + CS, Rosenbrock integrator) the FMUs link.
+- ``fmubuild.build``: compile and package, incremental and atomic; ``fmubuild.omc``: the
+  OpenModelica backend.
 """
