@@ -411,36 +411,20 @@ static fmi2Status no_such(Instance *c, const char *function, const char *type, s
     return fail(c, function, "value reference %u: this model has no %s variables", vr ? vr[0] : 0u, type);
 }
 
-fmi2Status fmi2GetInteger(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
-    (void)value;
-    Instance *c = check(component, "fmi2GetInteger", ANY_MODE);
-    return c ? no_such(c, "fmi2GetInteger", "Integer", nvr, vr) : fmi2Error;
-}
-fmi2Status fmi2GetBoolean(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
-    (void)value;
-    Instance *c = check(component, "fmi2GetBoolean", ANY_MODE);
-    return c ? no_such(c, "fmi2GetBoolean", "Boolean", nvr, vr) : fmi2Error;
-}
-fmi2Status fmi2GetString(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-    (void)value;
-    Instance *c = check(component, "fmi2GetString", ANY_MODE);
-    return c ? no_such(c, "fmi2GetString", "String", nvr, vr) : fmi2Error;
-}
-fmi2Status fmi2SetInteger(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
-    (void)value;
-    Instance *c = check(component, "fmi2SetInteger", ANY_MODE);
-    return c ? no_such(c, "fmi2SetInteger", "Integer", nvr, vr) : fmi2Error;
-}
-fmi2Status fmi2SetBoolean(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
-    (void)value;
-    Instance *c = check(component, "fmi2SetBoolean", ANY_MODE);
-    return c ? no_such(c, "fmi2SetBoolean", "Boolean", nvr, vr) : fmi2Error;
-}
-fmi2Status fmi2SetString(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-    (void)value;
-    Instance *c = check(component, "fmi2SetString", ANY_MODE);
-    return c ? no_such(c, "fmi2SetString", "String", nvr, vr) : fmi2Error;
-}
+/* The models have Real variables only: the other types' get/set accept empty requests. */
+#define NO_VARIABLES_OF_TYPE(function, type_name, value_type)                                          \
+    fmi2Status function(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,             \
+                        value_type value[]) {                                                           \
+        (void)value;                                                                                    \
+        Instance *c = check(component, #function, ANY_MODE);                                            \
+        return c ? no_such(c, #function, type_name, nvr, vr) : fmi2Error;                               \
+    }
+NO_VARIABLES_OF_TYPE(fmi2GetInteger, "Integer", fmi2Integer)
+NO_VARIABLES_OF_TYPE(fmi2GetBoolean, "Boolean", fmi2Boolean)
+NO_VARIABLES_OF_TYPE(fmi2GetString, "String", fmi2String)
+NO_VARIABLES_OF_TYPE(fmi2SetInteger, "Integer", const fmi2Integer)
+NO_VARIABLES_OF_TYPE(fmi2SetBoolean, "Boolean", const fmi2Boolean)
+NO_VARIABLES_OF_TYPE(fmi2SetString, "String", const fmi2String)
 
 /* ---- FMU state -------------------------------------------------------------------------- */
 static size_t state_size(void) {
