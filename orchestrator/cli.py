@@ -7,6 +7,10 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+#: Example systems shipped with the package (FMU paths relative to --fmu-dir, default fmus/).
+SYSTEMS = Path(__file__).resolve().parent / "systems"
+EXAMPLES = {p.stem: p for p in sorted(SYSTEMS.glob("*.toml"))}
+
 
 def _positive_loads(text: str) -> tuple[float, ...]:
     try:
@@ -39,6 +43,19 @@ def build_parser() -> argparse.ArgumentParser:
                       help="comma-separated wheel loads [N] (default: 100,200,...,800)")
     fig3.add_argument("--slip-step", type=_slip_step, default=0.01,
                       help="slip spacing over 0..0.9, adjusted so that 0.9 is a point (default: 0.01)")
+    run = commands.add_parser("run", help="co-simulate a system file (TOML) with FMPy -> CSV + JSON sidecar")
+    run.add_argument("system", help="system file, or the name of a shipped example: "
+                     + ", ".join(EXAMPLES))
+    run.add_argument("-o", "--output", type=Path, default=None,
+                     help="CSV to write (default: results/<system name>.csv); a .json sidecar goes beside it")
+    run.add_argument("--fmu-dir", type=Path, default=None,
+                     help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
+    run.add_argument("--algorithm", choices=("jacobi", "gauss-seidel"), default=None,
+                     help="override the system file's master algorithm")
+    run.add_argument("--step", type=float, default=None, help="override the communication step [s]")
+    run.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
+    run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+
     build = commands.add_parser("build-fmus", help="build the FMI 2.0 FMUs (ME + CS) from modelica/ into fmus/")
     build.add_argument("models", nargs="*", help="models to build (default: SingleWheel Rover RoverBody Wheel)")
     build.add_argument("--out", type=Path, default=Path("fmus"), help="output folder (default: fmus)")
@@ -47,6 +64,50 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument("--force", action="store_true", help="rebuild even when the FMU is up to date")
     build.add_argument("--jobs", type=int, default=None, help="parallel builds (default: number of CPUs)")
     return parser
+
+
+def _run(args: argparse.Namespace) -> int:
+    from .master import RunError, run
+    from .progress import ProgressBar
+    from .runs import write_run
+    from .system import SystemFileError, load_system, system_from_dict
+
+    path = Path(args.system)
+    fmu_dir = args.fmu_dir
+    if not path.exists() and args.system in EXAMPLES:
+        path = EXAMPLES[args.system]
+        fmu_dir = fmu_dir or Path("fmus")
+    try:
+        system = load_system(path, fmu_dir=fmu_dir)
+        if args.algorithm or args.step is not None or args.stop_time is not None:
+            import tomllib
+
+            data = tomllib.loads(path.read_text())
+            simulation = data.setdefault("simulation", {})
+            if args.algorithm:
+                simulation["algorithm"] = args.algorithm
+            if args.step is not None:
+                simulation["step"] = args.step
+            if args.stop_time is not None:
+                simulation["stop_time"] = args.stop_time
+            system = system_from_dict(data, name=f"{path} (with command-line overrides)",
+                                      base=fmu_dir or path.parent, path=path)
+    except SystemFileError as error:
+        print(f"rover-cosim run: {error}", file=sys.stderr)
+        return 2
+    output = args.output or Path("results") / f"{path.stem}.csv"
+    bar = ProgressBar(path.stem, enabled=not args.quiet)
+    try:
+        result = run(system, progress=bar)
+    except RunError as error:
+        bar.close()
+        print(f"rover-cosim run: {error} (nothing written)", file=sys.stderr)
+        return 1
+    bar.close()
+    for written in write_run(system, result, output):
+        print(f"wrote {written}")
+    print(f"{result.steps} steps of {system.step:g} s ({system.algorithm}) in {result.wall_seconds:.2f} s")
+    return 0
 
 
 def _build_fmus(args: argparse.Namespace) -> int:
@@ -76,6 +137,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "build-fmus":
         return _build_fmus(args)
+    if args.command == "run":
+        return _run(args)
     if args.command == "fig3":
         from .fig3 import PAPER_LOADS, slip_grid, write_fig3
 

@@ -1,0 +1,7 @@
+"""``python -m orchestrator`` is ``rover-cosim``."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

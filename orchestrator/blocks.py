@@ -1,0 +1,159 @@
+"""Python-side blocks that take part in a co-simulation like FMUs: sources and controllers.
+
+The interface is small and mirrors an FMU slave at a fixed communication step:
+
+- ``inputs`` and ``outputs``: variable names; ``units``: optional unit per variable (checked
+  against the FMU variables a block is connected to);
+- ``start(t0, u0) -> y0``: outputs at the start time, given the inputs there;
+- ``step(t, h, u) -> y``: advance from ``t`` to ``t + h`` with the inputs ``u`` (the values the
+  master algorithm makes available: at ``t`` for Jacobi, possibly at ``t + h`` for upstream
+  participants under Gauss-Seidel) and return the outputs at ``t + h``.
+
+Sources ignore their inputs (they have none). A user block is any class with this interface;
+``type = "python"`` in a system file loads it from ``factory = "module:callable"``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any, Protocol
+
+import numpy as np
+
+
+class Block(Protocol):
+    name: str
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    units: Mapping[str, str]
+
+    def start(self, t0: float, u0: np.ndarray) -> np.ndarray: ...
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray: ...
+
+
+class Source:
+    """A block without inputs whose single output ``y`` is a function of time."""
+
+    inputs: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ("y",)
+
+    def __init__(self, name: str, unit: str | None = None):
+        self.name = name
+        self.units = {"y": unit} if unit else {}
+
+    def value(self, t: float) -> float:
+        raise NotImplementedError
+
+    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+        return np.array([self.value(t0)])
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        return np.array([self.value(t + h)])
+
+
+class Constant(Source):
+    """y = value."""
+
+    def __init__(self, name: str, value: float, unit: str | None = None):
+        super().__init__(name, unit)
+        self.constant = float(value)
+
+    def value(self, t: float) -> float:
+        return self.constant
+
+
+class Step(Source):
+    """y = offset before ``time`` [s], offset + height from then on."""
+
+    def __init__(self, name: str, height: float, time: float = 0.0, offset: float = 0.0, unit: str | None = None):
+        super().__init__(name, unit)
+        self.height, self.time, self.offset = float(height), float(time), float(offset)
+
+    def value(self, t: float) -> float:
+        return self.offset + (self.height if t >= self.time else 0.0)
+
+
+class Ramp(Source):
+    """y rises linearly by ``height`` over ``duration`` [s] from ``time`` [s], from ``offset``."""
+
+    def __init__(self, name: str, height: float, duration: float, time: float = 0.0, offset: float = 0.0,
+                 unit: str | None = None):
+        super().__init__(name, unit)
+        if not duration > 0:
+            raise ValueError(f"block {name!r}: duration = {duration!r}: expected > 0 s")
+        self.height, self.duration, self.time, self.offset = float(height), float(duration), float(time), float(offset)
+
+    def value(self, t: float) -> float:
+        fraction = min(max((t - self.time) / self.duration, 0.0), 1.0)
+        return self.offset + self.height * fraction
+
+
+class TanhStep(Source):
+    """y = end + (begin - end) (1 - tanh((t - time)/width)) / 2: a smooth change from ``begin`` to
+    ``end`` around ``time`` [s] over about ``width`` [s] (the rover's open-loop torque profile)."""
+
+    def __init__(self, name: str, begin: float, end: float, time: float, width: float, unit: str | None = None):
+        super().__init__(name, unit)
+        if not width > 0:
+            raise ValueError(f"block {name!r}: width = {width!r}: expected > 0 s")
+        self.begin, self.end, self.time, self.width = float(begin), float(end), float(time), float(width)
+
+    def value(self, t: float) -> float:
+        return self.end + (self.begin - self.end) * 0.5 * (1.0 - math.tanh((t - self.time) / self.width))
+
+
+class Table(Source):
+    """y interpolated linearly in a table of (time [s], value); held constant outside it."""
+
+    def __init__(self, name: str, time: Sequence[float], values: Sequence[float], unit: str | None = None):
+        super().__init__(name, unit)
+        times = np.asarray(time, dtype=float)
+        data = np.asarray(values, dtype=float)
+        if times.ndim != 1 or times.size < 1 or times.shape != data.shape:
+            raise ValueError(f"block {name!r}: time and values must be lists of the same length >= 1 "
+                             f"(got {times.size} and {data.size})")
+        if np.any(np.diff(times) < 0):
+            raise ValueError(f"block {name!r}: time must not decrease")
+        self.times, self.data = times, data
+
+    def value(self, t: float) -> float:
+        return float(np.interp(t, self.times, self.data))
+
+
+BLOCK_TYPES: dict[str, type] = {
+    "constant": Constant,
+    "step": Step,
+    "ramp": Ramp,
+    "tanh_step": TanhStep,
+    "table": Table,
+}
+
+
+def make_block(name: str, kind: str, params: Mapping[str, Any]) -> Block:
+    """A block from its system-file entry; ValueError naming the block for bad entries."""
+    if kind == "python":
+        factory = params.get("factory")
+        if not isinstance(factory, str) or ":" not in factory:
+            raise ValueError(f"block {name!r}: type 'python' needs factory = \"module:callable\"")
+        module_name, _, attribute = factory.partition(":")
+        try:
+            constructor = getattr(importlib.import_module(module_name), attribute)
+        except (ImportError, AttributeError) as error:
+            raise ValueError(f"block {name!r}: cannot load factory {factory!r}: {error}") from None
+        options = {k: v for k, v in params.items() if k != "factory"}
+        block = constructor(name=name, **options)
+        for attribute in ("inputs", "outputs", "start", "step"):
+            if not hasattr(block, attribute):
+                raise ValueError(f"block {name!r}: {factory} made an object without {attribute!r}")
+        if not hasattr(block, "units"):
+            block.units = {}
+        return block
+    if kind not in BLOCK_TYPES:
+        raise ValueError(f"block {name!r}: type {kind!r}: expected one of {', '.join([*BLOCK_TYPES, 'python'])}")
+    try:
+        return BLOCK_TYPES[kind](name=name, **params)
+    except TypeError as error:
+        raise ValueError(f"block {name!r} (type {kind}): {error}") from None

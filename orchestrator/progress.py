@@ -1,0 +1,41 @@
+"""A one-line progress bar on stderr for runs longer than a couple of seconds.
+
+It stays silent when disabled (``--quiet``), when stderr is not a terminal, and during the first
+``delay`` seconds, so short runs and logs/CI print nothing."""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import TextIO
+
+
+class ProgressBar:
+    def __init__(self, label: str, *, enabled: bool = True, stream: TextIO | None = None,
+                 delay: float = 2.0, width: int = 30):
+        self.stream = stream or sys.stderr
+        self.enabled = enabled and hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.label, self.delay, self.width = label, delay, width
+        self.started = time.monotonic()
+        self.last_drawn = 0.0
+        self.drawn = False
+
+    def __call__(self, fraction: float) -> None:
+        if not self.enabled:
+            return
+        now = time.monotonic()
+        elapsed = now - self.started
+        if elapsed < self.delay or (now - self.last_drawn < 0.2 and fraction < 1.0):
+            return
+        self.last_drawn = now
+        filled = int(self.width * fraction)
+        remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
+        self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f}% "
+                          f"{elapsed:6.1f} s, ~{remaining:5.1f} s left")
+        self.stream.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        if self.drawn:
+            self.stream.write("\n")
+            self.stream.flush()

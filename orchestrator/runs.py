@@ -1,0 +1,47 @@
+"""A co-simulation run written to disk: the CSV of recorded trajectories and a JSON sidecar (the
+system file, SHA-256 of each FMU, package versions, wall time), both or neither."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from .master import RunResult
+from .outputs import json_bytes, run_record, write_all
+from .system import System
+
+
+def sha256(path: Path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for chunk in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def sidecar(system: System, result: RunResult, command: str) -> dict[str, object]:
+    record = run_record(command, {"algorithm": system.algorithm, "step_s": system.step,
+                                  "start_time_s": system.start_time, "stop_time_s": system.stop_time,
+                                  "order": system.order})
+    return {
+        **record,
+        "system_file": str(system.path) if system.path else None,
+        "system_sha256": sha256(system.path) if system.path else None,
+        "fmus": {fmu.name: {"path": str(fmu.path), "sha256": sha256(fmu.path), "guid": fmu.description.guid}
+                 for fmu in system.fmus},
+        "blocks": {block.name: block.kind for block in system.blocks},
+        "steps": result.steps,
+        "wall_seconds": result.wall_seconds,
+        "participant_seconds": result.step_seconds,
+        "master_overhead_seconds": result.master_overhead_seconds,
+        "columns": list(result.data.columns),
+    }
+
+
+def write_run(system: System, result: RunResult, csv_path: Path, command: str = "rover-cosim run") -> list[Path]:
+    """Write ``csv_path`` and ``csv_path`` with suffix ``.json`` atomically; returns both paths."""
+    csv_path = Path(csv_path)
+    json_path = csv_path.with_suffix(".json")
+    csv_bytes = result.data.to_csv(index=False, float_format="%.10g").encode()
+    write_all({csv_path: csv_bytes, json_path: json_bytes(sidecar(system, result, command))})
+    return [csv_path, json_path]
