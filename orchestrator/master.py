@@ -62,7 +62,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None) -> R
                 participant.close()
 
 
-def _run(system: System, entries, fmus, source_of, slots, progress, started) -> RunResult:  # noqa: ANN001
+def _run(system: System, entries, fmus, source_of, slots, progress, started) -> RunResult:
     # --- what each participant reads and where its inputs come from ------------------------------
     reads: dict[str, list[str]] = {name: [] for name in entries}
     constants: dict[int, float] = {}
@@ -109,7 +109,7 @@ def _run(system: System, entries, fmus, source_of, slots, progress, started) -> 
 
     # --- initialization ---------------------------------------------------------------------------
     t0, h = system.start_time, system.step
-    n_steps = int(round((system.stop_time - t0) / h))
+    n_steps = round((system.stop_time - t0) / h)
     order = system.order
     blocks = {e.name: e.block for e in system.blocks}
     for name in order:

@@ -9,7 +9,12 @@ from pathlib import Path
 
 import fmpy
 import numpy as np
-from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.fmi2 import (
+    FMU2Slave,
+    defaultCallbacks,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
 
 from .system import FmuEntry
 
@@ -40,11 +45,11 @@ class FmuParticipant:
         self.read_values = np.zeros(0)
         self.step_seconds = 0.0
 
-    def _log(self, env, instance, status, category, message) -> None:  # noqa: ANN001 - ctypes callback
+    def _log(self, env, instance, status, category, message) -> None:
         if status >= 2:  # discard, error, fatal
             self.messages.append(message.decode(errors="replace"))
 
-    def _call(self, what: str, action, t: float | None = None):  # noqa: ANN001
+    def _call(self, what: str, action, t: float | None = None):
         try:
             return action()
         except Exception as error:  # noqa: BLE001 - FMPy raises plain Exceptions on fmi2Error
@@ -102,5 +107,5 @@ class FmuParticipant:
                     break
         try:
             self.fmu.freeLibrary()
-        except Exception:  # noqa: BLE001
-            pass
+        except Exception as error:  # noqa: BLE001 - unloading is best effort
+            self.messages.append(f"freeLibrary: {error}")

@@ -87,6 +87,11 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
     const int n = s->n;
     const double span = t_end - *t;
     if (n == 0 || span <= 0.0) { *t = t_end; return 0; }
+    if (s->max_step > 0.0 && span / s->max_step > (double)s->max_steps) {
+        snprintf(msg, msg_len, "a largest step of %.3g s would need more than %ld steps to reach t = %.17g",
+                 s->max_step, s->max_steps, t_end);
+        return -1;
+    }
     const double h_min = 16.0 * 2.220446049250313e-16 * fmax(fabs(*t), fabs(t_end));
     double h_max = s->max_step > 0.0 ? fmin(s->max_step, span) : span;
     double h = s->h > 0.0 ? fmin(s->h, h_max) : fmin(h_max, 1e-3 * span + 0.0);
