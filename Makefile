@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test fig3 fmus bench venv clean
+.PHONY: run test fig3 fmus cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -37,6 +37,10 @@ fig3: $(STAMP)
 fmus: $(STAMP)
 	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) $(FMU_NAMES)
 
+## cosim-study: coupling error of the co-simulated rover vs the monolithic one -> results/cosim_study/
+cosim-study: fmus
+	$(VENV)/bin/rover-cosim cosim-study --out $(RESULTS)/cosim_study --fmu-dir fmus
+
 ## test: the test suite
 test: $(STAMP)
 	$(PY) -m pytest
@@ -45,6 +49,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
 	$(PY) benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
+	$(PY) benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
 
 clean:
 	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

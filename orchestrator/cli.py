@@ -56,6 +56,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
+    study = commands.add_parser("cosim-study", help="coupling error of the co-simulated rover against the "
+                                "monolithic one, Jacobi and Gauss-Seidel, steps 1-10 ms -> CSV + PNG")
+    study.add_argument("--out", type=Path, default=Path("results/cosim_study"), help="output folder")
+    study.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
+
     build = commands.add_parser("build-fmus", help="build the FMI 2.0 FMUs (ME + CS) from modelica/ into fmus/")
     build.add_argument("models", nargs="*", help="models to build (default: SingleWheel Rover RoverBody Wheel)")
     build.add_argument("--out", type=Path, default=Path("fmus"), help="output folder (default: fmus)")
@@ -110,6 +115,32 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cosim_study(args: argparse.Namespace) -> int:
+    import time
+
+    from .cosim_study import coupling_errors, figure_png
+    from .master import RunError
+    from .outputs import json_bytes, run_record, write_all
+    from .system import SystemFileError
+
+    started = time.perf_counter()
+    try:
+        table = coupling_errors(args.fmu_dir)
+    except (SystemFileError, RunError) as error:
+        print(f"rover-cosim cosim-study: {error} (nothing written)", file=sys.stderr)
+        return 1
+    record = run_record("rover-cosim cosim-study", {"fmu_dir": str(args.fmu_dir)})
+    record["wall_seconds"] = time.perf_counter() - started
+    files = {args.out / "coupling_error.csv": table.to_csv(index=False, float_format="%.6g").encode(),
+             args.out / "coupling_error.png": figure_png(table),
+             args.out / "coupling_error.json": json_bytes(record)}
+    write_all(files)
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for path in files:
+        print(f"wrote {path}")
+    return 0
+
+
 def _build_fmus(args: argparse.Namespace) -> int:
     from fmubuild.build import FMU_MODELS, build_all
     from fmubuild.expressions import UnsupportedConstruct
@@ -139,6 +170,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _build_fmus(args)
     if args.command == "run":
         return _run(args)
+    if args.command == "cosim-study":
+        return _cosim_study(args)
     if args.command == "fig3":
         from .fig3 import PAPER_LOADS, slip_grid, write_fig3
 

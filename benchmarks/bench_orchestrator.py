@@ -1,0 +1,96 @@
+"""Benchmark of the co-simulation master: the co-simulated rover (RoverBody + 6 Wheel FMUs) over
+20 s at a 1 ms communication step, run by our orchestrator (Jacobi and Gauss-Seidel) and by
+libcosimpy (Open Simulation Platform's libcosim, fixed-step) on the same FMUs in the same run.
+
+The torques are constant start values (20 N·m on every wheel and as reaction on the body), so
+the system has FMUs only and libcosim runs it in one ``simulate_until`` call. Reported: wall time,
+wall time per step, and our master's overhead per step (wall time minus the time spent inside
+the FMU calls, i.e. the Python master's own work). Written to results/bench/orchestrator.json
+by ``make bench``. Not a test: nothing asserts a time; the floor of issue 5 (within 3x of
+libcosim's wall time) is recorded beside the measured ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import tomllib
+from pathlib import Path
+
+from fmubuild import build
+from orchestrator.libcosim import run_libcosim
+from orchestrator.master import run
+from orchestrator.outputs import json_bytes, run_record, write_all
+from orchestrator.system import system_from_dict
+
+SYSTEM = Path(__file__).resolve().parent.parent / "orchestrator" / "systems" / "rover_cosim.toml"
+FLOOR_RATIO = 3.0
+TORQUE = 20.0  # N·m
+
+
+def bench_system(algorithm: str, stop_time: float, step: float):
+    data = tomllib.loads(SYSTEM.read_text())
+    data["simulation"].update(algorithm=algorithm, stop_time=stop_time, step=step)
+    data.pop("block")
+    data["connection"] = [c for c in data["connection"] if not c["from"].startswith("torque.")]
+    for fmu in data["fmu"]:
+        if fmu["name"] == "body":
+            fmu["start"] = {f"tau[{i}]": TORQUE for i in range(1, 7)}
+        else:
+            fmu["start"] = {"tau": TORQUE}
+    data["simulation"]["order"] = [f["name"] for f in data["fmu"]]
+    return system_from_dict(data, name="bench rover_cosim", base=Path("fmus"), path=SYSTEM)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--out", type=Path, default=Path("results/bench/orchestrator.json"))
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--stop-time", type=float, default=20.0)
+    parser.add_argument("--step", type=float, default=1e-3)
+    args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"--repeats={args.repeats}: expected an integer >= 1")
+
+    build.build_all(build.FMU_MODELS, Path("fmus"), backend="builtin")
+    steps = round(args.stop_time / args.step)
+    results: dict[str, dict] = {}
+    for name in ("ours_jacobi", "ours_gauss_seidel", "libcosim"):
+        walls, overheads, finals = [], [], []
+        for _ in range(args.repeats):
+            if name == "libcosim":
+                outcome = run_libcosim(bench_system("jacobi", args.stop_time, args.step), record=False)
+                walls.append(outcome.wall_seconds)
+            else:
+                algorithm = "jacobi" if name == "ours_jacobi" else "gauss-seidel"
+                result = run(bench_system(algorithm, args.stop_time, args.step))
+                walls.append(result.wall_seconds)
+                overheads.append(result.master_overhead_seconds)
+                finals.append(float(result.data["body.v"].iloc[-1]))
+        entry = {"wall_seconds": walls, "wall_seconds_median": statistics.median(walls),
+                 "wall_per_step_us_median": 1e6 * statistics.median(walls) / steps}
+        if overheads:
+            entry["master_overhead_seconds"] = overheads
+            entry["master_overhead_per_step_us_median"] = 1e6 * statistics.median(overheads) / steps
+            entry["final_body_v_m_s"] = finals[-1]
+        results[name] = entry
+        print(f"{name:18s} {entry['wall_seconds_median']:6.2f} s for {steps} steps "
+              f"({entry['wall_per_step_us_median']:.0f} us/step"
+              + (f", master overhead {entry['master_overhead_per_step_us_median']:.0f} us/step)" if overheads else ")"))
+    ratios = {name: results[name]["wall_seconds_median"] / results["libcosim"]["wall_seconds_median"]
+              for name in ("ours_jacobi", "ours_gauss_seidel")}
+    print("wall time / libcosim: " + ", ".join(f"{k} {v:.2f}x" for k, v in ratios.items())
+          + f" (floor {FLOOR_RATIO:.0f}x)")
+    record = run_record("make bench", {"repeats": args.repeats, "stop_time_s": args.stop_time, "step_s": args.step,
+                                       "torque_N_m": TORQUE, "fmus": 7, "cpus": os.cpu_count()})
+    write_all({args.out: json_bytes({**record, "results": results, "ratio_to_libcosim": ratios,
+                                     "floor_ratio": FLOOR_RATIO,
+                                     "floor_met": all(r <= FLOOR_RATIO for r in ratios.values()),
+                                     "note": "libcosim steps its slaves on worker threads; ours steps them one "
+                                             "after another in the Python thread"})})
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,83 @@
+"""Coupling error of the co-simulated rover (RoverBody + 6 Wheel) against the monolithic Rover.fmu,
+for Jacobi and Gauss-Seidel at communication steps of 1, 2, 5 and 10 ms (``make cosim-study``).
+
+Both plants get the same open-loop torque, sampled at the same communication step, so what is
+left is the error of cutting the rover at the hubs: the body sees the wheels' Fx one step late
+(and, under Jacobi, the wheels see the body's W and v_hub one step late as well).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .master import run
+from .system import system_from_dict
+
+STEPS = (1e-3, 2e-3, 5e-3, 10e-3)
+ALGORITHMS = ("jacobi", "gauss-seidel")
+SYSTEMS = Path(__file__).resolve().parent / "systems"
+
+
+def _system(name: str, fmu_dir: Path, **simulation: object):
+    path = SYSTEMS / f"{name}.toml"
+    data = tomllib.loads(path.read_text())
+    data["simulation"].update(simulation)
+    return system_from_dict(data, name=f"{path.name} {simulation}", base=fmu_dir, path=path)
+
+
+def coupling_errors(fmu_dir: Path, steps: tuple[float, ...] = STEPS, stop_time: float = 6.0) -> pd.DataFrame:
+    """One row per (algorithm, step): largest and RMS error of the body velocity [m/s], largest
+    error of the wheel loads [N] and of the drawbar forces [N] over the run, wall times [s]."""
+    rows = []
+    for step in steps:
+        mono_run = run(_system("rover_open_loop", fmu_dir, step=step, stop_time=stop_time))
+        mono = mono_run.data
+        for algorithm in ALGORITHMS:
+            cosim_run = run(_system("rover_cosim", fmu_dir, step=step, stop_time=stop_time, algorithm=algorithm))
+            cosim = cosim_run.data
+            dv = (cosim["body.v"] - mono["rover.v"]).to_numpy()
+            dfz = np.max([np.abs(cosim[f"wheel{i}.Fz"] - mono[f"rover.Fz[{i}]"]).max() for i in range(1, 7)])
+            dfx = np.max([np.abs(cosim[f"wheel{i}.Fx"] - mono[f"rover.Fx[{i}]"]).max() for i in range(1, 7)])
+            rows.append({
+                "algorithm": algorithm,
+                "step_s": step,
+                "max_abs_v_error_m_s": float(np.abs(dv).max()),
+                "rms_v_error_m_s": float(np.sqrt(np.mean(dv**2))),
+                "max_rel_v_error": float(np.abs(dv).max() / np.abs(mono["rover.v"]).max()),
+                "max_abs_Fz_error_N": float(dfz),
+                "max_abs_Fx_error_N": float(dfx),
+                "cosim_wall_s": cosim_run.wall_seconds,
+                "monolithic_wall_s": mono_run.wall_seconds,
+            })
+    return pd.DataFrame(rows)
+
+
+def figure_png(table: pd.DataFrame) -> bytes:
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for algorithm, marker in zip(ALGORITHMS, ("o", "s")):
+        part = table[table["algorithm"] == algorithm]
+        axes[0].loglog(part["step_s"] * 1e3, part["max_abs_v_error_m_s"], marker=marker, label=algorithm)
+        axes[1].loglog(part["step_s"] * 1e3, part["max_abs_Fz_error_N"], marker=marker, label=algorithm)
+    axes[0].set_ylabel("max |v_cosim - v_monolithic| [m/s]")
+    axes[1].set_ylabel("max |Fz_cosim - Fz_monolithic| over limbs [N]")
+    for ax in axes:
+        ax.set_xlabel("communication step [ms]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    fig.suptitle("Co-simulated rover (RoverBody + 6 Wheel) against the monolithic Rover.fmu, 6 s open loop")
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=120)
+    plt.close(fig)
+    return buffer.getvalue()
