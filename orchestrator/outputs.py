@@ -13,7 +13,7 @@ from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 
-PACKAGES = ("rover-cosim", "numpy", "scipy", "pandas", "matplotlib")
+PACKAGES = ("rover-cosim", "numpy", "scipy", "pandas", "matplotlib", "fmpy", "casadi", "rumoca")
 
 
 def write_all(files: Mapping[Path, bytes]) -> None:
