@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test fig3 fmus cosim-study bench venv clean
+.PHONY: run test fig3 fmus identify cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -26,8 +26,8 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
-## run: the whole pipeline that exists so far (now: the FMUs and the paper's Fig. 3 from the reference wheel)
-run: fmus fig3
+## run: the whole pipeline that exists so far (FMUs, Fig. 3 from the reference wheel, identification)
+run: fmus fig3 identify
 
 ## fig3: Fx against slip for loads 100..800 N -> results/fig3_fx_vs_slip.{csv,png}
 fig3: $(STAMP)
@@ -36,6 +36,10 @@ fig3: $(STAMP)
 ## fmus: FMI 2.0 FMUs (ME + CS) of the Modelica models -> fmus/*.fmu (skipped when up to date)
 fmus: $(STAMP)
 	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) $(FMU_NAMES)
+
+## identify: paper Sec. 3 (sweep on SingleWheel.fmu, LUT, Fx fits, Table 1) -> results/identification/
+identify: fmus
+	$(VENV)/bin/rover-cosim identify --out $(RESULTS)/identification --fmu fmus/SingleWheel.fmu
 
 ## cosim-study: coupling error of the co-simulated rover vs the monolithic one -> results/cosim_study/
 cosim-study: fmus

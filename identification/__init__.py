@@ -1,5 +1,9 @@
 """Identification of the torque -> slip -> Fx model from step-torque runs (paper Sec. 3).
 
-Not built yet: this package will hold the sweeps on SingleWheel.fmu, the Eq. (15) fit and the
-(W, tau) look-up tables (see ../shared/DESIGN.md, "Identified model").
+- ``testbed``: SingleWheel.fmu as an experiment (torque profile in, recorded run out);
+  ``reference_plant``: the same test bed on the numpy reference wheel.
+- ``sweep``: the (load, torque) sweep on local processes, serially or on Dask, cached per run.
+- ``fits``: first-order tau -> slip fits and their (W, tau) look-up tables, Fx(W, slip) fits,
+  Eq. (15); ``validate``: Table 1 at 275, 575, 875 N; ``figures``: Figs. 5-8;
+  ``job``: ``make identify``.
 """

@@ -61,6 +61,15 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--out", type=Path, default=Path("results/cosim_study"), help="output folder")
     study.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
 
+    ident = commands.add_parser("identify", help="paper Sec. 3: step-torque sweep on SingleWheel.fmu, LUT and "
+                                "Fx(W, slip) fits, validation at 275/575/875 N -> results/identification/")
+    ident.add_argument("--out", type=Path, default=Path("results/identification"), help="output folder")
+    ident.add_argument("--fmu", type=Path, default=Path("fmus/SingleWheel.fmu"), help="the test-bed FMU")
+    ident.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
+    ident.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
+    ident.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    ident.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+
     build = commands.add_parser("build-fmus", help="build the FMI 2.0 FMUs (ME + CS) from modelica/ into fmus/")
     build.add_argument("models", nargs="*", help="models to build (default: SingleWheel Rover RoverBody Wheel)")
     build.add_argument("--out", type=Path, default=Path("fmus"), help="output folder (default: fmus)")
@@ -141,6 +150,35 @@ def _cosim_study(args: argparse.Namespace) -> int:
     return 0
 
 
+def _identify(args: argparse.Namespace) -> int:
+    from identification.job import run_identification
+
+    from .progress import ProgressBar
+
+    if args.workers is not None and args.workers < 1:
+        print(f"rover-cosim identify: --workers {args.workers}: expected >= 1", file=sys.stderr)
+        return 2
+    if not args.fmu.is_file():
+        print(f"rover-cosim identify: FMU {args.fmu} not found (run `make fmus`)", file=sys.stderr)
+        return 2
+    bar = ProgressBar("sweep", enabled=not args.quiet)
+    try:
+        outcome = run_identification(args.fmu, args.out, workers=args.workers, scheduler=args.scheduler,
+                                     cache_dir=args.cache, progress=bar)
+    except (OSError, RuntimeError, ValueError) as error:
+        bar.close()
+        print(f"rover-cosim identify: {error} (nothing written)", file=sys.stderr)
+        return 1
+    bar.close()
+    record = outcome["record"]
+    print(f"sweep: {record['runs_computed']} runs computed, {record['runs_cached']} from the cache, "
+          f"{record['runs_failed']} failed, {record['sweep_wall_seconds']:.1f} s")
+    print(outcome["fit"].to_string(index=False, float_format=lambda v: f"{v:.1f}"))
+    for path in outcome["files"]:
+        print(f"wrote {path}")
+    return 0
+
+
 def _build_fmus(args: argparse.Namespace) -> int:
     from fmubuild.build import FMU_MODELS, build_all
     from fmubuild.expressions import UnsupportedConstruct
@@ -172,6 +210,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _run(args)
     if args.command == "cosim-study":
         return _cosim_study(args)
+    if args.command == "identify":
+        return _identify(args)
     if args.command == "fig3":
         from .fig3 import PAPER_LOADS, slip_grid, write_fig3
 

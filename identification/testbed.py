@@ -1,0 +1,102 @@
+"""The single-wheel test bed as an experiment: SingleWheel.fmu (Co-Simulation) driven by a
+piecewise-constant torque from rest, recorded at a fixed sample time (= communication step).
+
+One FMU instance per process is kept and reset between runs (:func:`shared_test_bed`), so a sweep
+pays for unpacking and loading the FMU once per worker.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import fmpy
+import numpy as np
+import pandas as pd
+from fmpy.fmi2 import FMU2Slave
+
+#: What every run records besides time and torque (SingleWheel outputs, SI units).
+RECORDED = ("slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v")
+
+
+@dataclass(frozen=True)
+class TorqueProfile:
+    """Torque levels [N·m] held from the given times [s] on (the first from t = 0)."""
+
+    times: tuple[float, ...]
+    levels: tuple[float, ...]
+
+    @staticmethod
+    def step(torque: float) -> TorqueProfile:
+        return TorqueProfile((0.0,), (float(torque),))
+
+    @staticmethod
+    def staircase(levels: tuple[float, ...], hold: float) -> TorqueProfile:
+        return TorqueProfile(tuple(i * hold for i in range(len(levels))), tuple(float(x) for x in levels))
+
+    def __call__(self, t: np.ndarray) -> np.ndarray:
+        index = np.searchsorted(np.asarray(self.times), t + 1e-12, side="right") - 1
+        return np.asarray(self.levels)[np.clip(index, 0, None)]
+
+
+class WheelTestBed:
+    """SingleWheel.fmu loaded once; :meth:`run` resets and runs it."""
+
+    def __init__(self, fmu_path: Path):
+        self.path = Path(fmu_path)
+        self._folder = tempfile.TemporaryDirectory(prefix="testbed-")
+        fmpy.extract(str(self.path), self._folder.name)
+        md = fmpy.read_model_description(str(self.path))
+        self.refs = {v.name: v.valueReference for v in md.modelVariables}
+        missing = [n for n in ("W", "tau", *RECORDED) if n not in self.refs]
+        if missing:
+            raise ValueError(f"{self.path}: not a SingleWheel FMU (no variables {missing})")
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self._folder.name,
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName="testbed")
+        self.fmu.instantiate()
+        self._fresh = True
+
+    def run(self, load: float, torque: TorqueProfile, stop_time: float, sample_time: float,
+            tolerance: float = 1e-8) -> pd.DataFrame:
+        """Columns time, tau, then :data:`RECORDED`; rows at 0, sample_time, ..., stop_time."""
+        if not load > 0:
+            raise ValueError(f"load = {load!r} N: expected > 0")
+        if not 0 < sample_time <= stop_time:
+            raise ValueError(f"sample_time = {sample_time!r} s: expected 0 < sample_time <= stop_time = {stop_time!r} s")
+        fmu = self.fmu
+        if not self._fresh:
+            fmu.reset()
+        self._fresh = False
+        n = round(stop_time / sample_time)
+        times = sample_time * np.arange(n + 1)
+        taus = torque(times)
+        fmu.setupExperiment(startTime=0.0)
+        fmu.setReal([self.refs["W"], self.refs["tau"], self.refs["solver.tolerance"]], [load, taus[0], tolerance])
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        outputs = [self.refs[name] for name in RECORDED]
+        tau_ref = [self.refs["tau"]]
+        rows = np.empty((n + 1, len(RECORDED)))
+        rows[0] = fmu.getReal(outputs)
+        for k in range(n):
+            if k and taus[k] != taus[k - 1]:
+                fmu.setReal(tau_ref, [taus[k]])
+            fmu.doStep(times[k], sample_time)
+            rows[k + 1] = fmu.getReal(outputs)
+        fmu.terminate()
+        data = pd.DataFrame(rows, columns=list(RECORDED))
+        data.insert(0, "tau", taus)
+        data.insert(0, "time", times)
+        return data
+
+
+_BEDS: dict[Path, WheelTestBed] = {}
+
+
+def shared_test_bed(fmu_path: Path) -> WheelTestBed:
+    """This process's test bed for ``fmu_path`` (created on first use)."""
+    key = Path(fmu_path).resolve()
+    if key not in _BEDS:
+        _BEDS[key] = WheelTestBed(key)
+    return _BEDS[key]

@@ -1,0 +1,74 @@
+"""Validation of the identified model at loads off the LUT grid (275, 575, 875 N, Table 1).
+
+Per load, the FMU runs a torque staircase from rest through the rover's torque range
+(5, 10, 15, 20, 30, 40 N·m, each held 0.1 s); the identified model gets the same torque. The
+Fit of Eq. (15) on Fx(t) over the whole staircase is the load's figure (one step alone barely
+varies after its first millisecond, which would make Eq. (15) measure the settled error only).
+Per torque level: the settled Fx and slip of plant and model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .fits import IdentifiedModel, fit_percent
+from .testbed import TorqueProfile, WheelTestBed
+
+VALIDATION_LOADS = (275.0, 575.0, 875.0)
+VALIDATION_TORQUES = (5.0, 10.0, 15.0, 20.0, 30.0, 40.0)
+HOLD = 0.1          # s per torque level
+SAMPLE_TIME = 1e-3  # s
+PAPER_FIT = {275.0: 82.1, 575.0: 96.8, 875.0: 96.2}  # Table 1 [%]
+
+
+@dataclass
+class Validation:
+    runs: dict[float, pd.DataFrame]   # per load: time, tau, plant columns, slip_model, Fx_model
+    fit: pd.DataFrame                 # load_N, fit_percent, ...
+    detail: pd.DataFrame              # per load and torque level
+
+
+def staircase() -> TorqueProfile:
+    return TorqueProfile.staircase(VALIDATION_TORQUES, HOLD)
+
+
+def validate(bed: WheelTestBed, models: dict[str, IdentifiedModel],
+             loads: tuple[float, ...] = VALIDATION_LOADS) -> Validation:
+    """``models`` by label (e.g. "linear", "quadratic"); the first is the one reported as
+    ``fit_percent``, each also gets its own column."""
+    profile = staircase()
+    stop = HOLD * len(VALIDATION_TORQUES) - SAMPLE_TIME
+    runs, fits, detail = {}, [], []
+    for load in loads:
+        run = bed.run(load, profile, stop, SAMPLE_TIME)
+        time, torque = run["time"].to_numpy(), run["tau"].to_numpy()
+        row: dict[str, float | str] = {"load_N": load}
+        for i, (label, model) in enumerate(models.items()):
+            slip = model.slip_response(load, time, torque)
+            fx = model.fx(load, slip)
+            run[f"slip_{label}"] = slip
+            run[f"Fx_{label}"] = fx
+            value = fit_percent(fx, run["Fx"].to_numpy())
+            if i == 0:
+                row["fit_percent"] = value
+            row[f"fit_percent_{label}"] = value
+            row[f"slip_fit_percent_{label}"] = fit_percent(slip, run["slip"].to_numpy())
+        row["paper_fit_percent"] = PAPER_FIT.get(load, float("nan"))
+        fits.append(row)
+        for level_index, level in enumerate(VALIDATION_TORQUES):
+            segment = (time >= level_index * HOLD + HOLD / 2) & (time < (level_index + 1) * HOLD)
+            entry = {"load_N": load, "torque_N_m": level, "Fx_plant_N": float(run["Fx"][segment].mean()),
+                     "slip_plant": float(run["slip"][segment].mean())}
+            for label in models:
+                entry[f"Fx_{label}_N"] = float(run[f"Fx_{label}"][segment].mean())
+                entry[f"slip_{label}"] = float(run[f"slip_{label}"][segment].mean())
+            detail.append(entry)
+        runs[load] = run
+    return Validation(runs, pd.DataFrame(fits), pd.DataFrame(detail))
+
+
+def settled_errors(detail: pd.DataFrame, label: str) -> np.ndarray:
+    return (detail[f"Fx_{label}_N"] - detail["Fx_plant_N"]).to_numpy()
