@@ -54,6 +54,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
 	$(PY) benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
 	$(PY) benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
+	$(PY) benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
 
 clean:
 	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

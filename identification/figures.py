@@ -7,14 +7,14 @@ import io
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
 
-from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, IdentifiedModel  # noqa: E402
+from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, IdentifiedModel
 
 
-def _png(fig) -> bytes:  # noqa: ANN001
+def _png(fig) -> bytes:
     buffer = io.BytesIO()
     fig.tight_layout()
     fig.savefig(buffer, format="png", dpi=110)

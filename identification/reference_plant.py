@@ -9,6 +9,8 @@ SciPy's Radau method (the start from rest is stiff: dκ/dω = r/v_eps there).
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
@@ -21,7 +23,7 @@ G_MOON = 1.62   # m/s², as the SingleWheel model's default g
 V_EPS = 1e-3    # m/s, as the SingleWheel model's default vEps
 
 
-def test_bed_run(load: float, torque: TorqueProfile, stop_time: float, sample_time: float, *,
+def run_reference_test_bed(load: float, torque: TorqueProfile, stop_time: float, sample_time: float, *,
                  wheel: Wheel | None = None, soil: Soil | None = None, g: float = G_MOON,
                  v_eps: float = V_EPS) -> pd.DataFrame:
     """Columns as :meth:`identification.testbed.WheelTestBed.run` (time, tau, RECORDED)."""
@@ -44,7 +46,7 @@ def test_bed_run(load: float, torque: TorqueProfile, stop_time: float, sample_ti
 
     states = np.zeros((n + 1, 2))
     y = np.zeros(2)
-    for start, end in zip(boundaries[:-1], boundaries[1:]):
+    for start, end in itertools.pairwise(boundaries):
         tau = float(torque(np.array([start]))[0])
         inside = (times > start + 1e-12) & (times <= end + 1e-12)
         solution = solve_ivp(rhs, (start, end), y, method="Radau", t_eval=times[inside], args=(tau,),

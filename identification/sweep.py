@@ -90,9 +90,9 @@ def compute_run(fmu_path: str | None, load: float, torque: float, stop_time: flo
     try:
         profile = TorqueProfile.step(torque)
         if fmu_path is None:
-            from .reference_plant import test_bed_run
+            from .reference_plant import run_reference_test_bed
 
-            data = test_bed_run(load, profile, stop_time, sample_time)
+            data = run_reference_test_bed(load, profile, stop_time, sample_time)
         else:
             data = shared_test_bed(Path(fmu_path)).run(load, profile, stop_time, sample_time, tolerance)
         target_path = Path(target)
@@ -147,7 +147,8 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
             progress(done / len(cases))
 
     if scheduler is not None:
-        from dask.distributed import Client, as_completed as dask_completed
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
 
         with Client(scheduler) as client:
             futures = [client.submit(compute_run, *a, pure=False) for a in arguments]

@@ -1,0 +1,161 @@
+"""Identification (paper Sec. 3): the fit metric, the first-order fit, the sweep's cache,
+failures, atomic files and Dask execution, the cross-check against the numpy reference test bed,
+and the whole `make identify` job against the paper's Table 1."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fmubuild import build
+from identification import sweep as sweep_module
+from identification.fits import (
+    IdentifiedModel,
+    first_order_fit,
+    fit_percent,
+    fx_per_load,
+    identify,
+    step_table,
+)
+from identification.job import run_identification
+from identification.sweep import SweepPlan, compute_run, run_file, run_sweep
+from identification.validate import PAPER_FIT
+
+REPO = Path(__file__).resolve().parent.parent
+FMU_DIR = REPO / "fmus"
+SMALL = SweepPlan(loads=(300.0, 600.0), torques=(10.0, 30.0), stop_time=0.02, sample_time=1e-3)
+
+
+@pytest.fixture(scope="session")
+def single_wheel() -> Path:
+    return build.build_all(("SingleWheel",), FMU_DIR, backend="builtin", jobs=1)[0].path
+
+
+def test_fit_percent_is_equation_15():
+    plant = np.array([0.0, 1.0, 2.0, 3.0])
+    assert fit_percent(plant, plant) == 100.0
+    assert fit_percent(np.full(4, plant.mean()), plant) == pytest.approx(0.0)
+    assert fit_percent(plant + 0.5, plant) == pytest.approx(100 * (1 - 1.0 / np.sqrt(5.0)))
+    with pytest.raises(ValueError, match="constant"):
+        fit_percent(plant, np.ones(4))
+
+
+def test_first_order_fit_recovers_gain_and_time_constant():
+    t = np.linspace(0.0, 0.5, 501)
+    slip = 0.004 * 30.0 * (1.0 - np.exp(-t / 0.05))
+    gain, constant = first_order_fit(t, slip, 30.0)
+    assert gain == pytest.approx(0.004, rel=1e-6) and constant == pytest.approx(0.05, rel=1e-6)
+
+
+def test_sweep_caches_runs_and_recomputes_only_what_is_missing(single_wheel, tmp_path):
+    first = run_sweep(single_wheel, SMALL, tmp_path, workers=2)
+    assert (first.computed, first.cached, first.failures) == (4, 0, {})
+    run_file(first.cache_folder, 600.0, 30.0).unlink()
+    again = run_sweep(single_wheel, SMALL, tmp_path, workers=2)
+    assert (again.computed, again.cached) == (1, 3)
+    for key, run in first.runs.items():
+        pd.testing.assert_frame_equal(run, again.runs[key])
+    run = first.runs[600.0, 30.0]
+    assert list(run.columns) == ["time", "tau", "slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v"] and len(run) == 21
+    assert not list(first.cache_folder.glob("*.part"))
+
+
+def test_a_failing_run_is_recorded_and_the_sweep_goes_on(single_wheel, tmp_path, monkeypatch):
+    real = sweep_module.shared_test_bed
+
+    class Broken:
+        def run(self, load, *args, **kwargs):
+            if load == 600.0:
+                raise RuntimeError("the carriage fell off")
+            return real(single_wheel).run(load, *args, **kwargs)
+
+    monkeypatch.setattr(sweep_module, "shared_test_bed", lambda path: Broken())
+    outcome = run_sweep(single_wheel, SMALL, tmp_path, workers=1)
+    assert set(outcome.failures) == {(600.0, 10.0), (600.0, 30.0)}
+    assert "the carriage fell off" in outcome.failures[600.0, 10.0]
+    assert set(outcome.runs) == {(300.0, 10.0), (300.0, 30.0)}
+    assert sorted(p.name for p in outcome.cache_folder.glob("*.csv")) == ["W300_tau10.csv", "W300_tau30.csv"]
+
+
+def test_an_interrupted_write_leaves_no_file(single_wheel, tmp_path, monkeypatch):
+    def interrupted(self, *args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(pd.DataFrame, "to_csv", interrupted)
+    target = tmp_path / "W300_tau10.csv"
+    _load, _torque, error, _ = compute_run(str(single_wheel), 300.0, 10.0, 0.01, 1e-3, 1e-8, str(target))
+    assert error is not None and "disk full" in error
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sweep_on_a_dask_cluster_gives_the_local_results(single_wheel, tmp_path):
+    distributed = pytest.importorskip("distributed", reason="dask.distributed not installed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+                                  processes=True) as cluster:
+        remote = run_sweep(single_wheel, SMALL, tmp_path / "dask", scheduler=cluster.scheduler_address)
+    local = run_sweep(single_wheel, SMALL, tmp_path / "local", workers=1)
+    assert remote.computed == 4 and not remote.failures
+    for key, run in local.runs.items():
+        pd.testing.assert_frame_equal(run, remote.runs[key])
+
+
+def test_reference_test_bed_and_fmu_give_the_same_a_and_b(single_wheel, tmp_path):
+    """The same identification on the numpy reference test bed and on SingleWheel.fmu: the
+    per-load a(W), b(W) of Eq. (14) and their quadratics in W agree within 1 %."""
+    plan = SweepPlan(torques=(5.0, 10.0, 15.0, 20.0, 30.0, 40.0), stop_time=0.01, sample_time=1e-3)
+    reference = run_sweep(None, plan, tmp_path, workers=2)
+    fmu = run_sweep(single_wheel, plan, tmp_path, workers=2)
+    assert not reference.failures and not fmu.failures
+    ours, theirs = fx_per_load(step_table(fmu.runs)), fx_per_load(step_table(reference.runs))
+    np.testing.assert_allclose(ours["c1"], theirs["c1"], rtol=0.01)  # a(W)
+    np.testing.assert_allclose(ours["c0"], theirs["c0"], rtol=0.01)  # b(W)
+    loads = np.array(plan.loads)
+    model_fmu, model_reference = identify(step_table(fmu.runs), 1), identify(step_table(reference.runs), 1)
+    for k in (0, 1):
+        np.testing.assert_allclose(np.polyval(model_fmu.fx_coefficients[k][::-1], loads),
+                                   np.polyval(model_reference.fx_coefficients[k][::-1], loads), rtol=0.01)
+
+
+@pytest.fixture(scope="module")
+def identified(single_wheel, tmp_path_factory) -> tuple[Path, dict]:
+    out = tmp_path_factory.mktemp("identification")
+    return out, run_identification(single_wheel, out, workers=2)
+
+
+def test_identify_writes_every_output(identified):
+    out, _outcome = identified
+    names = {p.name for p in out.iterdir()}
+    assert {"runs.csv", "steps.csv", "model.json", "fit_table.csv", "fit_models.csv", "fit_detail.csv", "failures.csv",
+            "fig5_fx_vs_slip.png", "fig6_a_of_W.png", "fig7_b_of_W.png", "fig8_validation_575N.png",
+            "identification.json"} <= names
+    runs = pd.read_csv(out / "runs.csv")
+    plan = SweepPlan()
+    assert len(runs) == len(plan.loads) * len(plan.torques) * (round(plan.stop_time / plan.sample_time) + 1)
+    assert list(runs.columns[:4]) == ["load_N", "torque_N_m", "time", "tau"]
+    table = pd.read_csv(out / "fit_table.csv")
+    assert list(table.columns) == ["load_N", "fit_percent"] and list(table["load_N"]) == [275.0, 575.0, 875.0]
+    model = json.loads((out / "model.json").read_text())
+    assert model["fmu"]["sha256"] and model["plan"]["loads"] == list(plan.loads)
+
+
+def test_identified_model_meets_table_1(identified):
+    """Fit (Eq. 15) of the recommended (quadratic) model at least the paper's Table 1 at each load;
+    the linear model of Eq. (14) is reported beside it."""
+    out, _ = identified
+    fits = pd.read_csv(out / "fit_models.csv").set_index("load_N")
+    for load, paper in PAPER_FIT.items():
+        assert fits.loc[load, "fit_percent_quadratic"] >= paper, (load, fits.loc[load].to_dict())
+    assert np.isfinite(fits["fit_percent_linear"]).all()
+
+
+def test_model_json_round_trips(identified):
+    out, _ = identified
+    model = json.loads((out / "model.json").read_text())
+    for label, data in model["models"].items():
+        restored = IdentifiedModel.from_dict(data)
+        assert restored.degree == {"linear": 1, "quadratic": 2}[label]
+        assert np.isfinite(restored.fx(575.0, 0.05)) and restored.gain_at(575.0, 20.0) > 0
