@@ -22,11 +22,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from orchestrator.outputs import json_bytes, run_record, write_all
+from orchestrator.outputs import file_sha256, json_bytes, run_record, write_all
 
 from . import figures
 from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
-from .sweep import SweepPlan, file_sha256, run_sweep
+from .sweep import SweepPlan, run_sweep
 from .testbed import shared_test_bed
 from .validate import validate
 

@@ -21,6 +21,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from orchestrator.outputs import file_sha256
+
 from .testbed import TorqueProfile, shared_test_bed
 
 #: Loads of the paper's look-up tables and Fig. 3 [N].
@@ -67,14 +69,6 @@ class SweepOutcome:
     wall_seconds: float
     cache_folder: Path
     run_seconds: dict[tuple[float, float], float] = field(default_factory=dict)
-
-
-def file_sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for chunk in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def run_file(folder: Path, load: float, torque: float) -> Path:

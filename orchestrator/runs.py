@@ -3,20 +3,11 @@ system file, SHA-256 of each FMU, package versions, wall time), both or neither.
 
 from __future__ import annotations
 
-import hashlib
 from pathlib import Path
 
 from .master import RunResult
-from .outputs import json_bytes, run_record, write_all
+from .outputs import file_sha256, json_bytes, run_record, write_all
 from .system import System
-
-
-def sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as stream:
-        for chunk in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def sidecar(system: System, result: RunResult, command: str) -> dict[str, object]:
@@ -26,8 +17,8 @@ def sidecar(system: System, result: RunResult, command: str) -> dict[str, object
     return {
         **record,
         "system_file": str(system.path) if system.path else None,
-        "system_sha256": sha256(system.path) if system.path else None,
-        "fmus": {fmu.name: {"path": str(fmu.path), "sha256": sha256(fmu.path), "guid": fmu.description.guid}
+        "system_sha256": file_sha256(system.path) if system.path else None,
+        "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid}
                  for fmu in system.fmus},
         "blocks": {block.name: block.kind for block in system.blocks},
         "steps": result.steps,
