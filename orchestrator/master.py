@@ -83,14 +83,14 @@ def _run(system: System, entries, fmus, source_of, slots, progress, started) -> 
         return slots(port)
 
     input_slots: dict[str, np.ndarray] = {}
+    connected_inputs: dict[str, list[str]] = {}
     for name, entry in entries.items():
         if isinstance(entry, FmuEntry):
             inputs = [t.variable for t in source_of if t.instance == name]
         else:
             inputs = list(entry.block.inputs)
+        connected_inputs[name] = inputs
         input_slots[name] = np.array([slot_of(source_of[Port(name, v)]) for v in inputs], dtype=int)
-        if isinstance(entry, FmuEntry):
-            fmus[name].input_names = inputs
     for entry in system.blocks:
         for output in entry.block.outputs:
             slots(Port(entry.name, output))
@@ -98,7 +98,7 @@ def _run(system: System, entries, fmus, source_of, slots, progress, started) -> 
     output_slots: dict[str, np.ndarray] = {}
     for name, entry in entries.items():
         if isinstance(entry, FmuEntry):
-            fmus[name].configure(fmus[name].input_names, reads[name])
+            fmus[name].configure(connected_inputs[name], reads[name])
             output_slots[name] = np.array([slots(Port(name, v)) for v in reads[name]], dtype=int)
         else:
             output_slots[name] = np.array([slots(Port(name, v)) for v in entry.block.outputs], dtype=int)

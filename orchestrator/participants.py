@@ -43,7 +43,6 @@ class FmuParticipant:
         self.reads: list[str] = []
         self.input_values = np.zeros(0)
         self.read_values = np.zeros(0)
-        self.step_seconds = 0.0
 
     def _log(self, env, instance, status, category, message) -> None:
         if status >= 2:  # discard, error, fatal
