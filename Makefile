@@ -9,7 +9,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test fig3 fmus identify cosim-study bench venv clean
+.PHONY: run test fig3 fmus identify simulate report cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -26,8 +26,9 @@ $(STAMP): pyproject.toml
 
 venv: $(STAMP)
 
-## run: the whole pipeline that exists so far (FMUs, Fig. 3 from the reference wheel, identification)
-run: fmus fig3 identify
+## run: the whole pipeline: FMUs -> Fig. 3 (reference wheel) -> identify -> simulate -> report
+run: fmus fig3 identify simulate
+	$(MAKE) report
 
 ## fig3: Fx against slip for loads 100..800 N -> results/fig3_fx_vs_slip.{csv,png}
 fig3: $(STAMP)
@@ -40,6 +41,14 @@ fmus: $(STAMP)
 ## identify: paper Sec. 3 (sweep on SingleWheel.fmu, LUT, Fx fits, Table 1) -> results/identification/
 identify: fmus
 	$(VENV)/bin/rover-cosim identify --out $(RESULTS)/identification --fmu fmus/SingleWheel.fmu
+
+## simulate: paper Sec. 4, closed loop on Rover.fmu and RoverBody + 6 Wheel -> results/simulation/
+simulate: identify
+	$(VENV)/bin/rover-cosim simulate --out $(RESULTS)/simulation --fmu-dir fmus --model $(RESULTS)/identification/model.json
+
+## report: results/report.html (figures and tables beside the paper's, provenance)
+report: $(STAMP)
+	$(VENV)/bin/rover-cosim report --results $(RESULTS)
 
 ## cosim-study: coupling error of the co-simulated rover vs the monolithic one -> results/cosim_study/
 cosim-study: fmus

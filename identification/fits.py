@@ -90,6 +90,20 @@ class IdentifiedModel:
     def time_constant_at(self, load: float, torque: float) -> float:
         return float(np.exp(self._t(self._point(load, torque))[0]))
 
+    def rows_at(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """K and T over the torque axis at each of ``loads`` (shape (n, torques)), by the same
+        interpolation in 1/W as gain_at, for whole rows at once."""
+        loads = np.atleast_1d(np.asarray(loads, float))
+        if np.any(~(loads > 0)):
+            raise ValueError(f"loads = {loads!r} N: expected > 0")
+        inverse = 1.0 / np.asarray(self.loads, float)  # decreasing
+        j = np.clip(np.searchsorted(-inverse, -1.0 / loads), 1, len(inverse) - 1)
+        weight = ((1.0 / loads - inverse[j - 1]) / (inverse[j] - inverse[j - 1]))[:, None]
+        gain = np.asarray(self.gain, float)
+        log_t = np.log(np.asarray(self.time_constant, float))
+        return ((1 - weight) * gain[j - 1] + weight * gain[j],
+                np.exp((1 - weight) * log_t[j - 1] + weight * log_t[j]))
+
     def fx(self, load: float | np.ndarray, slip: float | np.ndarray) -> np.ndarray:
         """Fx(W, slip) [N] (Eq. 14, or its higher-degree variant)."""
         load, slip = np.asarray(load, float), np.asarray(slip, float)

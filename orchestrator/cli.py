@@ -70,6 +70,17 @@ def build_parser() -> argparse.ArgumentParser:
     ident.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
     ident.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
+    simulate = commands.add_parser("simulate", help="paper Sec. 4: closed-loop rover, 20 s, on Rover.fmu and on "
+                                   "RoverBody + 6 Wheel -> results/simulation/")
+    simulate.add_argument("--out", type=Path, default=Path("results/simulation"), help="output folder")
+    simulate.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are")
+    simulate.add_argument("--model", type=Path, default=Path("results/identification/model.json"),
+                          help="identified model (from `rover-cosim identify`)")
+
+    report = commands.add_parser("report", help="results/report.html: figures and tables beside the paper's")
+    report.add_argument("--results", type=Path, default=Path("results"), help="the results folder")
+    report.add_argument("--out", type=Path, default=None, help="HTML file (default: <results>/report.html)")
+
     build = commands.add_parser("build-fmus", help="build the FMI 2.0 FMUs (ME + CS) from modelica/ into fmus/")
     build.add_argument("models", nargs="*", help="models to build (default: SingleWheel Rover RoverBody Wheel)")
     build.add_argument("--out", type=Path, default=Path("fmus"), help="output folder (default: fmus)")
@@ -179,6 +190,30 @@ def _identify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _simulate(args: argparse.Namespace) -> int:
+    from control.simulate import run_simulation
+
+    from .master import RunError
+    from .system import SystemFileError
+
+    if not args.model.is_file():
+        print(f"rover-cosim simulate: identified model {args.model} not found (run `make identify`)", file=sys.stderr)
+        return 2
+    try:
+        outcome = run_simulation(args.fmu_dir, args.model, args.out)
+    except (SystemFileError, RunError, ValueError) as error:
+        print(f"rover-cosim simulate: {error} (nothing written)", file=sys.stderr)
+        return 1
+    for plant, checks in outcome["record"]["checks"].items():
+        print(f"{plant}: " + ", ".join(f"{k} {v:.4g}" for k, v in checks.items() if v is not None))
+    for plant, table in outcome["rms"].items():
+        print(f"RMS(Fx - Fx_des) [N], {plant}: " + ", ".join(f"{r:.3f}" for r in table["rms_N"]))
+    print("fixed-load ablation RMS [N]: " + ", ".join(f"{r:.3f}" for r in outcome["ablation"]["rms_fixed_load_N"]))
+    for path in outcome["files"]:
+        print(f"wrote {path}")
+    return 0
+
+
 def _build_fmus(args: argparse.Namespace) -> int:
     from fmubuild.build import FMU_MODELS, build_all
     from fmubuild.expressions import UnsupportedConstruct
@@ -212,6 +247,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _cosim_study(args)
     if args.command == "identify":
         return _identify(args)
+    if args.command == "simulate":
+        return _simulate(args)
+    if args.command == "report":
+        from control.report import build_report
+
+        from .outputs import write_all
+
+        target = args.out or args.results / "report.html"
+        write_all({target: build_report(args.results).encode()})
+        print(f"wrote {target}")
+        return 0
     if args.command == "fig3":
         from .fig3 import PAPER_LOADS, slip_grid, write_fig3
 

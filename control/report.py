@@ -1,0 +1,96 @@
+"""``make report``: results/report.html, one self-contained page (figures embedded, no network)
+with our figures and tables beside the paper's values and the provenance of every run."""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from .simulate import PAPER_RMS
+
+PAPER_TABLE_1 = {275: 82.1, 575: 96.8, 875: 96.2}
+
+
+def _image(path: Path, caption: str) -> str:
+    if not path.exists():
+        return f"<p class='missing'>{html.escape(caption)}: {html.escape(str(path))} not produced.</p>"
+    data = base64.b64encode(path.read_bytes()).decode()
+    return (f"<figure><img src='data:image/png;base64,{data}' alt='{html.escape(caption)}'>"
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+
+def _table(frame: pd.DataFrame) -> str:
+    return frame.to_html(index=False, float_format=lambda v: f"{v:.3g}", border=0, classes="data")
+
+
+def _provenance(path: Path) -> str:
+    if not path.exists():
+        return f"<p class='missing'>{html.escape(str(path))} not produced.</p>"
+    record = json.loads(path.read_text())
+    keep = {k: record[k] for k in ("command", "created_utc", "git_commit", "versions", "parameters", "fmu_sha256",
+                                   "fmus", "model_sha256", "wall_seconds", "run_wall_seconds", "sweep_wall_seconds",
+                                   "runs_computed", "runs_cached", "runs_failed") if k in record}
+    return f"<details><summary>{html.escape(path.name)}</summary><pre>{html.escape(json.dumps(keep, indent=2))}</pre></details>"
+
+
+def build_report(results: Path) -> str:
+    identification = results / "identification"
+    simulation = results / "simulation"
+    sections = ["<h1>rover-cosim: reproduction of Yoshikawa et al.</h1>",
+                "<p>Every number below is read from the files under <code>results/</code> written by "
+                "<code>make run</code>; the paper's values are quoted beside ours.</p>"]
+
+    sections += ["<h2>Fig. 3: Fx against slip (numpy reference wheel)</h2>",
+                 _image(results / "fig3_fx_vs_slip.png", "Fx(slip) for loads 100-800 N")]
+
+    sections.append("<h2>Identification (Sec. 3): Table 1</h2>")
+    models = identification / "fit_models.csv"
+    if models.exists():
+        fits = pd.read_csv(models)
+        table = pd.DataFrame({"load [N]": fits["load_N"], "paper Fit [%]": fits["paper_fit_percent"],
+                              "ours, linear Eq. (14) [%]": fits["fit_percent_linear"],
+                              "ours, quadratic (recommended) [%]": fits["fit_percent_quadratic"]})
+        sections.append(_table(table))
+    else:
+        sections.append(f"<p class='missing'>{models} not produced.</p>")
+    for name, caption in (("fig5_fx_vs_slip.png", "Fig. 5: settled Fx against slip with Fx = a(W) slip + b(W)"),
+                          ("fig6_a_of_W.png", "Fig. 6: a(W)"), ("fig7_b_of_W.png", "Fig. 7: b(W)"),
+                          ("fig8_validation_575N.png", "Fig. 8: identified model against the FMU at 575 N")):
+        sections.append(_image(identification / name, caption))
+
+    sections.append("<h2>Closed loop (Sec. 4): Table 3 and Fig. 10</h2>")
+    rms_path, cosim_path = simulation / "rms.csv", simulation / "rms_cosim.csv"
+    if rms_path.exists() and cosim_path.exists():
+        ours, cosim = pd.read_csv(rms_path), pd.read_csv(cosim_path)
+        table = pd.DataFrame({"limb": ours["limb"], "paper RMS [N]": [PAPER_RMS.get(i, float("nan")) for i in ours["limb"]],
+                              "ours, Rover.fmu [N]": ours["rms_N"], "ours, RoverBody + 6 Wheel [N]": cosim["rms_N"]})
+        sections.append(_table(table))
+    ablation = simulation / "ablation_fixed_load.csv"
+    if ablation.exists():
+        sections += ["<p>Ablation: the same controller with one model at a fixed 424 N instead of the per-load "
+                     "look-up tables:</p>", _table(pd.read_csv(ablation))]
+    record_path = simulation / "simulation.json"
+    if record_path.exists():
+        checks = json.loads(record_path.read_text()).get("checks", {})
+        rows = [{"plant": plant, **values} for plant, values in checks.items()]
+        sections += ["<p>Velocity (paper: the rover reaches 1.0 m/s, Fig. 10 g):</p>", _table(pd.DataFrame(rows))]
+    sections += [_image(simulation / "fig10_closed_loop.png", "Fig. 10 (a)-(h), Rover.fmu"),
+                 _image(simulation / "fig10_closed_loop_cosim.png", "Fig. 10 (a)-(h), RoverBody + 6 Wheel")]
+
+    study = results / "cosim_study" / "coupling_error.png"
+    if study.exists():
+        sections += ["<h2>Co-simulation coupling error</h2>", _image(study, "co-simulated vs monolithic rover")]
+
+    sections.append("<h2>Provenance</h2>")
+    for path in (results / "fig3_fx_vs_slip.json", identification / "identification.json", record_path):
+        sections.append(_provenance(path))
+    style = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
+             "img{max-width:100%}table.data{border-collapse:collapse;margin:1em 0}"
+             "table.data td,table.data th{border:1px solid #bbb;padding:4px 8px;text-align:right}"
+             ".missing{color:#a00}pre{background:#f6f6f6;padding:1em;overflow:auto}")
+    return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>rover-cosim report</title>"
+            f"<style>{style}</style></head><body>" + "\n".join(sections) + "</body></html>\n")

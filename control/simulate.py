@@ -1,0 +1,134 @@
+"""``make simulate``: the closed-loop rover of the paper's Sec. 4 on two plants, 20 s at 1 ms,
+Gauss-Seidel: the monolithic Rover.fmu and the co-simulated RoverBody + 6 Wheel.
+
+results/simulation/
+  trajectories.csv         Rover.fmu: time, x, v and per limb tau_i, Tx_i, Fz_i, sinkage_i, slip_i, Fx_i, Fx_des_i
+  trajectories_cosim.csv   the same for RoverBody + 6 Wheel
+  rms.csv                  limb, rms_N = RMS(Fx_i - Fx_des_i) on Rover.fmu (Table 3); rms_cosim.csv likewise
+  ablation_fixed_load.csv  RMS per limb with one model at a fixed 424 N instead of the per-load LUT
+  fig10_closed_loop.png    Fig. 10 (a)-(h), limbs 1-3
+  simulation.json          parameters, FMU hashes, versions, wall times, checks
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from orchestrator.master import run
+from orchestrator.outputs import file_sha256, json_bytes, run_record, write_all
+from orchestrator.system import system_from_dict
+
+STOP_TIME = 20.0
+STEP = 1e-3
+LIMBS = range(1, 7)
+PAPER_RMS = {1: 0.7, 2: 0.4, 3: 0.5}  # Table 3 [N], limbs 1-3
+STATIC_LOAD = 1570.0 * 1.62 / 6       # N, the fixed load of the ablation
+
+
+def controller_block(model: Path, **options: Any) -> dict[str, Any]:
+    return {"name": "ctrl", "type": "python", "factory": "control.controller:InverseModelController",
+            "model": str(model), "step": STEP, **options}
+
+
+def monolithic_system(fmu_dir: Path, model: Path, **options: Any) -> dict[str, Any]:
+    connections = [{"from": "rover.x", "to": "ctrl.x"}, {"from": "rover.v", "to": "ctrl.v"}]
+    for i in LIMBS:
+        connections += [{"from": f"rover.Fz[{i}]", "to": f"ctrl.W[{i}]"}, {"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"}]
+    return {"simulation": {"stop_time": STOP_TIME, "step": STEP, "algorithm": "gauss-seidel"},
+            "fmu": [{"name": "rover", "path": str(fmu_dir / "Rover.fmu")}],
+            "block": [controller_block(model, **options)], "connection": connections}
+
+
+def cosim_system(fmu_dir: Path, model: Path, **options: Any) -> dict[str, Any]:
+    fmus = [{"name": "body", "path": str(fmu_dir / "RoverBody.fmu")}]
+    connections = [{"from": "body.x", "to": "ctrl.x"}, {"from": "body.v", "to": "ctrl.v"}]
+    for i in LIMBS:
+        fmus.append({"name": f"wheel{i}", "path": str(fmu_dir / "Wheel.fmu")})
+        connections += [
+            {"from": f"body.W[{i}]", "to": f"wheel{i}.W"}, {"from": f"body.v_hub[{i}]", "to": f"wheel{i}.v_hub"},
+            {"from": f"wheel{i}.Fx", "to": f"body.Fx[{i}]"}, {"from": f"body.W[{i}]", "to": f"ctrl.W[{i}]"},
+            {"from": f"ctrl.tau[{i}]", "to": f"wheel{i}.tau"}, {"from": f"ctrl.tau[{i}]", "to": f"body.tau[{i}]"}]
+    return {"simulation": {"stop_time": STOP_TIME, "step": STEP, "algorithm": "gauss-seidel"},
+            "fmu": fmus, "block": [controller_block(model, **options)], "connection": connections}
+
+
+def trajectories(data: pd.DataFrame, plant: str) -> pd.DataFrame:
+    """The recorded run in the columns of trajectories.csv."""
+    if plant == "monolithic":
+        body, wheel = "rover", lambda i, name: f"rover.{name}[{i}]"
+    else:
+        body, wheel = "body", lambda i, name: f"wheel{i}.{name}"
+    table = {"time": data["time"], "x": data[f"{body}.x"], "v": data[f"{body}.v"]}
+    for i in LIMBS:
+        table[f"tau_{i}"] = data[f"ctrl.tau[{i}]"]
+        for name in ("Tx", "Fz", "sinkage", "slip", "Fx"):
+            table[f"{name}_{i}"] = data[wheel(i, name)]
+        table[f"Fx_des_{i}"] = data[f"ctrl.Fx_des[{i}]"]
+    return pd.DataFrame(table)
+
+
+def rms(table: pd.DataFrame) -> pd.DataFrame:
+    return pd.DataFrame({"limb": list(LIMBS),
+                         "rms_N": [float(np.sqrt(np.mean((table[f"Fx_{i}"] - table[f"Fx_des_{i}"]) ** 2))) for i in LIMBS]})
+
+
+def checks(table: pd.DataFrame) -> dict[str, Any]:
+    v = table["v"].to_numpy()
+    reached = np.nonzero(v >= 0.98)[0]
+    after = v[reached[0]:] if reached.size else np.array([])
+    accelerating = table["time"] < (table["time"][reached[0]] if reached.size else 0.0)
+    fz1, fz3 = table["Fz_1"][accelerating], table["Fz_3"][accelerating]
+    return {"time_to_98_percent_s": float(table["time"][reached[0]]) if reached.size else None,
+            "max_abs_v_error_after_m_s": float(np.abs(after - 1.0).max()) if after.size else None,
+            "final_v_m_s": float(v[-1]),
+            "Fz1_min_while_accelerating_N": float(fz1.min()) if len(fz1) else None,
+            "Fz3_max_while_accelerating_N": float(fz3.max()) if len(fz3) else None,
+            "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
+
+
+def run_simulation(fmu_dir: Path, model: Path, out_dir: Path) -> dict[str, Any]:
+    from .figures import fig10
+
+    started = time.perf_counter()
+    results: dict[str, Any] = {}
+    tables: dict[str, pd.DataFrame] = {}
+    walls: dict[str, float] = {}
+    fmu_dir = Path(fmu_dir).resolve()
+    for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
+        system = system_from_dict(build(fmu_dir, model), name=f"closed loop ({plant})", base=fmu_dir)
+        outcome = run(system)
+        tables[plant] = trajectories(outcome.data, plant)
+        walls[plant] = outcome.wall_seconds
+        results[plant] = checks(tables[plant])
+    ablation_system = system_from_dict(monolithic_system(fmu_dir, model, fixed_load=STATIC_LOAD),
+                                       name="closed loop, fixed-load model", base=fmu_dir)
+    ablation = rms(trajectories(run(ablation_system).data, "monolithic"))
+    rms_mono, rms_cosim = rms(tables["monolithic"]), rms(tables["cosim"])
+    ablation_table = pd.DataFrame({"limb": list(LIMBS), "rms_lut_N": rms_mono["rms_N"],
+                                   "rms_fixed_load_N": ablation["rms_N"]})
+    record = run_record("rover-cosim simulate", {"stop_time_s": STOP_TIME, "step_s": STEP, "model": str(model),
+                                                  "algorithm": "gauss-seidel", "fixed_load_ablation_N": STATIC_LOAD})
+    record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in ("Rover", "RoverBody", "Wheel")},
+                   "model_sha256": file_sha256(model), "run_wall_seconds": walls,
+                   "wall_seconds": time.perf_counter() - started, "checks": results,
+                   "rms_N": {"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
+                             "fixed_load_ablation": ablation["rms_N"].tolist()}})
+    out = Path(out_dir)
+    files = {
+        out / "trajectories.csv": tables["monolithic"].to_csv(index=False, float_format="%.8g").encode(),
+        out / "trajectories_cosim.csv": tables["cosim"].to_csv(index=False, float_format="%.8g").encode(),
+        out / "rms.csv": rms_mono.to_csv(index=False, float_format="%.4f").encode(),
+        out / "rms_cosim.csv": rms_cosim.to_csv(index=False, float_format="%.4f").encode(),
+        out / "ablation_fixed_load.csv": ablation_table.to_csv(index=False, float_format="%.4f").encode(),
+        out / "fig10_closed_loop.png": fig10(tables["monolithic"], "Rover.fmu"),
+        out / "fig10_closed_loop_cosim.png": fig10(tables["cosim"], "RoverBody + 6 Wheel"),
+        out / "simulation.json": json_bytes(record),
+    }
+    write_all(files)
+    return {"files": sorted(files), "record": record, "tables": tables, "rms": {"monolithic": rms_mono, "cosim": rms_cosim},
+            "ablation": ablation_table}
