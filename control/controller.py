@@ -87,18 +87,15 @@ class InverseModelController:
         return np.where(safe, nearest, linear)
 
     def torques_for_slips(self, loads: np.ndarray, slips: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(torque whose settled slip K(W, tau) tau is each slip, T there): linear between the
-        table's torques and extended linearly beyond them."""
+        """(torque whose settled slip K(W, tau) tau is each slip, T there): the exact inverse of
+        the tables as the identified model reads them (settled slip linear in tau between the
+        table's torques, extended linearly beyond them)."""
         torques = self.model.torques
-        gains, constants = self.model.rows_at(loads)
+        rows, constants = self.model.rows_at(loads)
         result, time_constants = np.empty(len(loads)), np.empty(len(loads))
-        for i, (row, slip) in enumerate(zip(gains * torques, slips)):
-            if slip <= row[0]:
-                torque = torques[0] + (slip - row[0]) * (torques[1] - torques[0]) / (row[1] - row[0])
-            elif slip >= row[-1]:
-                torque = torques[-1] + (slip - row[-1]) * (torques[-1] - torques[-2]) / (row[-1] - row[-2])
-            else:
-                torque = np.interp(slip, row, torques)
+        for i, (row, slip) in enumerate(zip(rows, slips)):
+            j = int(np.clip(np.searchsorted(row, slip), 1, len(torques) - 1))
+            torque = torques[j - 1] + (slip - row[j - 1]) * (torques[j] - torques[j - 1]) / (row[j] - row[j - 1])
             result[i] = torque
             time_constants[i] = np.interp(torque, torques, constants[i])
         return result, time_constants

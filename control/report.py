@@ -41,8 +41,8 @@ def build_report(results: Path) -> str:
     identification = results / "identification"
     simulation = results / "simulation"
     sections = ["<h1>rover-cosim: reproduction of Yoshikawa et al.</h1>",
-                "<p>Every number below is read from the files under <code>results/</code> written by "
-                "<code>make run</code>; the paper's values are quoted beside ours.</p>"]
+                ("<p>Every number below is read from the files under <code>results/</code> written by "
+                 "<code>make run</code>; the paper's values are quoted beside ours.</p>")]
 
     sections += ["<h2>Fig. 3: Fx against slip (numpy reference wheel)</h2>",
                  _image(results / "fig3_fx_vs_slip.png", "Fx(slip) for loads 100-800 N")]
@@ -71,8 +71,8 @@ def build_report(results: Path) -> str:
         sections.append(_table(table))
     ablation = simulation / "ablation_fixed_load.csv"
     if ablation.exists():
-        sections += ["<p>Ablation: the same controller with one model at a fixed 424 N instead of the per-load "
-                     "look-up tables:</p>", _table(pd.read_csv(ablation))]
+        sections += [("<p>Ablation: the same controller with one model at a fixed 424 N instead of the per-load "
+                      "look-up tables:</p>"), _table(pd.read_csv(ablation))]
     record_path = simulation / "simulation.json"
     if record_path.exists():
         checks = json.loads(record_path.read_text()).get("checks", {})

@@ -14,6 +14,9 @@ from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+
 PACKAGES = ("rover-cosim", "numpy", "scipy", "pandas", "matplotlib", "fmpy", "casadi", "rumoca")
 
 
@@ -32,6 +35,7 @@ def write_all(files: Mapping[Path, bytes]) -> None:
             staged.append((Path(name), target))
             with os.fdopen(handle, "wb") as stream:
                 stream.write(payload)
+            os.chmod(name, 0o666 & ~_UMASK)  # mkstemp makes 0600; results are ordinary files
         for temporary, target in staged:
             os.replace(temporary, target)
     finally:
