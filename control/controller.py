@@ -86,14 +86,15 @@ class InverseModelController:
         nearest = np.where(np.abs(plus - linear) <= np.abs(minus - linear), plus, minus)
         return np.where(safe, nearest, linear)
 
-    def torques_for_slips(self, loads: np.ndarray, slips: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def torques_for_slips(self, loads: np.ndarray, slips: np.ndarray,
+                          rows: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(torque whose settled slip K(W, tau) tau is each slip, T there): the exact inverse of
         the tables as the identified model reads them (settled slip linear in tau between the
-        table's torques, extended linearly beyond them)."""
+        table's torques, extended linearly beyond them). ``rows``: model.rows_at(loads), if known."""
         torques = self.model.torques
-        rows, constants = self.model.rows_at(loads)
+        settled_rows, constants = rows if rows is not None else self.model.rows_at(loads)
         result, time_constants = np.empty(len(loads)), np.empty(len(loads))
-        for i, (row, slip) in enumerate(zip(rows, slips)):
+        for i, (row, slip) in enumerate(zip(settled_rows, slips)):
             j = int(np.clip(np.searchsorted(row, slip), 1, len(torques) - 1))
             torque = torques[j - 1] + (slip - row[j - 1]) * (torques[j] - torques[j - 1]) / (row[j] - row[j - 1])
             result[i] = torque
@@ -116,8 +117,9 @@ class InverseModelController:
             self.filter_state = np.column_stack([targets, np.zeros(WHEELS)])
         slip, rate = self.filter_state[:, 0], self.filter_state[:, 1]
         # The inverse of K/(T s + 1): tau = (slip + T slip') / K, with T at the torque for slip.
-        _, constants = self.torques_for_slips(loads, slip)
-        self.torque, _ = self.torques_for_slips(loads, slip + constants * rate)
+        rows = self.model.rows_at(loads)
+        _, constants = self.torques_for_slips(loads, slip, rows)
+        self.torque, _ = self.torques_for_slips(loads, slip + constants * rate, rows)
         return np.concatenate([self.torque, forces, [force_all]])
 
     # --- the block interface --------------------------------------------------------------------

@@ -76,11 +76,12 @@ class IdentifiedModel:
         # The table interpolated is the settled slip K tau, not K: K changes sign at small torques
         # under heavy loads, and K linear in tau bends the slip between the table's torques
         # (closed-loop RMS(Fx - Fx_des) 2.1 N that way, 0.2 N interpolating K tau).
-        axes = (1.0 / np.asarray(self.loads, float)[::-1], np.asarray(self.torques, float))
-        settled = np.asarray(self.gain, float) * np.asarray(self.torques, float)[None, :]
-        self._settled = RegularGridInterpolator(axes, settled[::-1], bounds_error=False, fill_value=None)
-        self._t = RegularGridInterpolator(axes, np.log(np.asarray(self.time_constant, float))[::-1],
-                                          bounds_error=False, fill_value=None)
+        self._inverse_loads = 1.0 / np.asarray(self.loads, float)  # decreasing
+        self._settled_table = np.asarray(self.gain, float) * np.asarray(self.torques, float)[None, :]
+        self._log_t_table = np.log(np.asarray(self.time_constant, float))
+        axes = (self._inverse_loads[::-1], np.asarray(self.torques, float))
+        self._settled = RegularGridInterpolator(axes, self._settled_table[::-1], bounds_error=False, fill_value=None)
+        self._t = RegularGridInterpolator(axes, self._log_t_table[::-1], bounds_error=False, fill_value=None)
 
     @staticmethod
     def _point(load: float, torque: float) -> np.ndarray:
@@ -106,11 +107,10 @@ class IdentifiedModel:
         loads = np.atleast_1d(np.asarray(loads, float))
         if np.any(~(loads > 0)):
             raise ValueError(f"loads = {loads!r} N: expected > 0")
-        inverse = 1.0 / np.asarray(self.loads, float)  # decreasing
+        inverse = self._inverse_loads
         j = np.clip(np.searchsorted(-inverse, -1.0 / loads), 1, len(inverse) - 1)
         weight = ((1.0 / loads - inverse[j - 1]) / (inverse[j] - inverse[j - 1]))[:, None]
-        settled = np.asarray(self.gain, float) * np.asarray(self.torques, float)[None, :]
-        log_t = np.log(np.asarray(self.time_constant, float))
+        settled, log_t = self._settled_table, self._log_t_table
         return ((1 - weight) * settled[j - 1] + weight * settled[j],
                 np.exp((1 - weight) * log_t[j - 1] + weight * log_t[j]))
 

@@ -9,21 +9,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import FMU_DIR
 
 from control.controller import InverseModelController
 from control.report import build_report
 from control.simulate import run_simulation
-from fmubuild import build
 from identification.job import run_identification
-
-REPO = Path(__file__).resolve().parent.parent
-FMU_DIR = REPO / "fmus"
 
 
 @pytest.fixture(scope="module")
-def results(tmp_path_factory) -> Path:
+def results(fmus, tmp_path_factory) -> Path:
     """make fmus -> identify -> simulate, into a temporary results folder."""
-    build.build_all(build.FMU_MODELS, FMU_DIR, backend="builtin")
     root = tmp_path_factory.mktemp("results")
     run_identification(FMU_DIR / "SingleWheel.fmu", root / "identification", workers=2)
     run_simulation(FMU_DIR, root / "identification" / "model.json", root / "simulation")

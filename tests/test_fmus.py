@@ -17,6 +17,7 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
+from conftest import FMU_DIR
 from fmpy.fmi2 import (
     FMU2Model,
     FMU2Slave,
@@ -30,16 +31,7 @@ from fmubuild import build, source
 from fmubuild.expressions import UnsupportedConstruct
 from terramechanics import Wheel, slip_ratio, wheel_state
 
-REPO = Path(__file__).resolve().parent.parent
-FMU_DIR = REPO / "fmus"
 STEP_LOADS = (275.0, 575.0, 875.0)
-
-
-@pytest.fixture(scope="session")
-def fmus() -> dict[str, Path]:
-    """The four FMUs, built into fmus/ as `make fmus` does (skipped when up to date)."""
-    results = build.build_all(build.FMU_MODELS, FMU_DIR, backend="builtin")
-    return {r.name: r.path for r in results}
 
 
 def variables(path: Path) -> dict[str, fmpy.model_description.ScalarVariable]:

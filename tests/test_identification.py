@@ -11,7 +11,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from fmubuild import build
 from identification import sweep as sweep_module
 from identification.fits import (
     IdentifiedModel,
@@ -25,14 +24,12 @@ from identification.job import run_identification
 from identification.sweep import SweepPlan, compute_run, run_file, run_sweep
 from identification.validate import PAPER_FIT
 
-REPO = Path(__file__).resolve().parent.parent
-FMU_DIR = REPO / "fmus"
 SMALL = SweepPlan(loads=(300.0, 600.0), torques=(10.0, 30.0), stop_time=0.02, sample_time=1e-3)
 
 
 @pytest.fixture(scope="session")
-def single_wheel() -> Path:
-    return build.build_all(("SingleWheel",), FMU_DIR, backend="builtin", jobs=1)[0].path
+def single_wheel(fmus) -> Path:
+    return fmus["SingleWheel"]
 
 
 def test_fit_percent_is_equation_15():

@@ -6,26 +6,16 @@ from __future__ import annotations
 import io
 import json
 import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import FMU_DIR
 
-from fmubuild import build
 from orchestrator.cli import EXAMPLES, main
 from orchestrator.libcosim import run_libcosim
 from orchestrator.master import RunError, run
 from orchestrator.progress import ProgressBar
 from orchestrator.system import SystemFileError, load_system, system_from_dict
-
-REPO = Path(__file__).resolve().parent.parent
-FMU_DIR = REPO / "fmus"
-
-
-@pytest.fixture(scope="session")
-def fmus() -> dict[str, Path]:
-    results = build.build_all(build.FMU_MODELS, FMU_DIR, backend="builtin")
-    return {r.name: r.path for r in results}
 
 
 def example(name: str, **simulation: object) -> dict:
