@@ -1,6 +1,7 @@
 # rover-cosim: two commands set up everything —
 #   make run    creates .venv if missing and runs the whole pipeline that exists so far
 #   make test   creates .venv if missing and runs the test suite
+#   make lint   ruff and mypy (configured in pyproject.toml); CI runs it before the tests
 # Nothing else needs installing by hand: python3 (>= 3.11), gcc and make are enough.
 
 PYTHON ?= python3
@@ -9,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test fig3 fmus identify simulate report cosim-study bench venv clean
+.PHONY: run test lint fig3 fmus identify simulate report cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -21,7 +22,7 @@ $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "rover-cosim needs Python >= 3.11, found " + sys.version.split()[0])'
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet -e '.[test,lint]'
 	@touch $@
 
 venv: $(STAMP)
@@ -54,16 +55,22 @@ report: $(STAMP)
 cosim-study: fmus
 	$(VENV)/bin/rover-cosim cosim-study --out $(RESULTS)/cosim_study --fmu-dir fmus
 
-## test: the test suite
+## test: the test suite (python -P: the checkout's folders are not importable as top-level
+## packages; everything is imported as rover_cosim.*, as from an installed wheel)
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -P -m pytest
+
+## lint: ruff (rules in pyproject.toml) and mypy over the package, tests and benchmarks
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/mypy
 
 ## bench: benchmarks (not tests) -> results/bench/*.json
 bench: $(STAMP)
-	$(PY) benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
-	$(PY) benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
-	$(PY) benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
-	$(PY) benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
+	$(PY) -P benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
+	$(PY) -P benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
+	$(PY) -P benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
+	$(PY) -P benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
 
 clean:
 	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

@@ -25,8 +25,8 @@ from pathlib import Path
 import fmpy
 from fmpy.fmi2 import FMU2Slave
 
-from fmubuild import build, source
-from orchestrator.outputs import json_bytes, run_record, write_all
+from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.fmubuild import build, source
 
 FLOOR_BUILD_SECONDS = 120.0
 RUNS = {

@@ -11,9 +11,9 @@ import os
 import tempfile
 from pathlib import Path
 
-from fmubuild import build
-from identification.sweep import SweepPlan, run_sweep
-from orchestrator.outputs import json_bytes, run_record, write_all
+from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.fmubuild import build
+from rover_cosim.identification.sweep import SweepPlan, run_sweep
 
 
 def main() -> None:
@@ -29,7 +29,8 @@ def main() -> None:
             rerun = run_sweep(fmu, plan, Path(cache), workers=workers)
         results[f"workers_{workers}"] = {"workers": workers, "runs": outcome.computed, "failed": len(outcome.failures),
                                          "wall_seconds": outcome.wall_seconds,
-                                         "mean_run_seconds": sum(outcome.run_seconds.values()) / len(outcome.run_seconds),
+                                         "mean_run_seconds":
+                                             sum(outcome.run_seconds.values()) / len(outcome.run_seconds),
                                          "cached_rerun_wall_seconds": rerun.wall_seconds}
         print(f"{workers} worker(s): {outcome.computed} runs in {outcome.wall_seconds:.2f} s "
               f"(re-run from the cache {rerun.wall_seconds:.2f} s)")

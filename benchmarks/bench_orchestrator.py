@@ -18,11 +18,11 @@ import statistics
 import tomllib
 from pathlib import Path
 
-from fmubuild import build
-from orchestrator.libcosim import run_libcosim
-from orchestrator.master import run
-from orchestrator.outputs import json_bytes, run_record, write_all
-from orchestrator.system import system_from_dict
+from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.fmubuild import build
+from rover_cosim.orchestrator.libcosim import run_libcosim
+from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.system import system_from_dict
 
 SYSTEM = Path(__file__).resolve().parent.parent / "orchestrator" / "systems" / "rover_cosim.toml"
 FLOOR_RATIO = 3.0

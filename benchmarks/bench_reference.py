@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.outputs import json_bytes, run_record, write_all
-from terramechanics import DEFAULT_NODES, contact_forces, wheel_state
+from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.terramechanics import DEFAULT_NODES, contact_forces, wheel_state
 
 FLOOR_STATES_PER_S = 100_000
 BATCH = 100_000
@@ -44,9 +44,10 @@ def pin_to_one_core() -> int | None:
         return None
 
 
-def batch(case: dict, seed: int) -> tuple[np.ndarray, np.ndarray]:
+def batch(case: dict[str, tuple[float, float]], seed: int) -> tuple[np.ndarray, np.ndarray]:
     rng = np.random.default_rng(seed)
-    return rng.uniform(*case["load_N"], BATCH), rng.uniform(*case["slip"], BATCH)
+    (w_low, w_high), (s_low, s_high) = case["load_N"], case["slip"]
+    return rng.uniform(w_low, w_high, BATCH), rng.uniform(s_low, s_high, BATCH)
 
 
 def time_case(case: dict, repeats: int) -> dict:

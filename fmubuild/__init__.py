@@ -1,4 +1,4 @@
-"""FMU build from the Modelica source in ``modelica/``.
+"""FMU build from the Modelica source in ``modelica/`` (``rover_cosim.fmubuild``).
 
 - ``fmubuild.source``: locates the Modelica package, loads classes with rumoca (the Modelica front
   end) and runs rumoca's own simulation, the reference the FMUs are checked against.
@@ -7,8 +7,9 @@
 - ``fmubuild.ode``: a flat model → explicit ODE xdot = f(t, x, u, p), y = g(t, x, u, p) by matching
   and BLT, with clear errors for what it cannot translate.
 - ``fmubuild.codegen``: the ODE → C (CasADi) and the value-reference layout;
-  ``fmubuild.description``: modelDescription.xml; ``fmubuild.units``: unit strings → SI base units.
+  ``fmubuild.description``: modelDescription.xml (units via ``rover_cosim.common.units``).
 - ``fmubuild.runtime``: the FMI 2.0 C runtime (ME + CS, Rosenbrock integrator) the FMUs link.
-- ``fmubuild.build``: compile and package, incremental and atomic; ``fmubuild.omc``: the
+- ``fmubuild.artifact``: what an FMU is made from (input digest) and its build record;
+  ``fmubuild.build``: compile and package, incremental and atomic; ``fmubuild.omc``: the
   OpenModelica backend.
 """

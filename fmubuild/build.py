@@ -8,7 +8,6 @@ package, this builder and the pinned tool versions is stored in ``documentation/
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import platform
@@ -20,29 +19,17 @@ import time
 import zipfile
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
 
 from . import codegen, description, ode, source
+from .artifact import BUILD_RECORD, CFLAGS, RUNTIME, RUNTIME_FILES, BuildResult, input_digest, stored_digest
+from .omc import build_fmu_omc
 
 #: The FMUs ``make fmus`` builds (classes of the Modelica package).
 FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel")
 
-RUNTIME = Path(__file__).parent / "runtime"
-RUNTIME_FILES = ("model.h", "ode23s.h", "ode23s.c", "fmi2_runtime.c")
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
-CFLAGS = ("-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-std=c99", "-D_POSIX_C_SOURCE=200809L")
-BUILD_RECORD = "documentation/build.json"
-
-
-@dataclass
-class BuildResult:
-    name: str
-    path: Path
-    rebuilt: bool
-    seconds: float
-    stages: dict[str, float] = field(default_factory=dict)  # translate, generate, compile, package [s]
 
 
 def platform_folder() -> str:
@@ -64,37 +51,13 @@ def shared_library_suffix() -> str:
 
 def fmi_headers() -> Path:
     """The FMI 2.0 standard headers, as shipped with FMPy (not copied into this repository)."""
-    import fmpy  # type: ignore[import-untyped]  # its c-code folder holds the FMI standard headers
+    import fmpy  # its c-code folder holds the FMI standard headers
 
     folder = Path(fmpy.__file__).parent / "c-code"
     missing = [h for h in FMI_HEADERS if not (folder / h).exists()]
     if missing:
         raise RuntimeError(f"FMI 2.0 headers {missing} not found in {folder} (is FMPy installed?)")
     return folder
-
-
-def input_digest(name: str) -> str:
-    """Digest of everything a built-in FMU of ``name`` is made from."""
-    digest = hashlib.sha256(name.encode())
-    files = sorted((source.MODELICA_ROOT / source.PACKAGE).rglob("*")) + sorted(Path(__file__).parent.glob("*.py"))
-    files += [RUNTIME / f for f in RUNTIME_FILES]
-    for path in files:
-        if path.is_file():
-            digest.update(str(path.relative_to(path.parents[1])).encode())
-            digest.update(path.read_bytes())
-    for package in ("rumoca", "casadi"):
-        digest.update(f"{package}=={metadata.version(package)}".encode())
-    digest.update(" ".join(CFLAGS).encode())
-    return digest.hexdigest()
-
-
-def stored_digest(fmu: Path) -> str | None:
-    """The input digest recorded in an FMU built by this module, or None."""
-    try:
-        with zipfile.ZipFile(fmu) as archive:
-            return json.loads(archive.read(BUILD_RECORD))["input_sha256"]
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
-        return None
 
 
 def _class_description(name: str) -> str:
@@ -148,7 +111,8 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
         binaries = root / "binaries" / platform_folder()
         binaries.mkdir(parents=True)
         library = binaries / f"{name}{shared_library_suffix()}"
-        command = [compiler(), *CFLAGS, "-I", str(sources), *(str(sources / f) for f in source_files if f.endswith(".c")),
+        c_files = [str(sources / f) for f in source_files if f.endswith(".c")]
+        command = [compiler(), *CFLAGS, "-I", str(sources), *c_files,
                    "-o", str(library), "-lm"]
         result = subprocess.run(command, capture_output=True, text=True, check=False)
         if result.returncode != 0:
@@ -178,7 +142,6 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
 def _build_one(args: tuple[str, Path, bool, str]) -> BuildResult:
     name, out_dir, force, backend = args
     if backend == "omc":
-        from .omc import build_fmu_omc
         return build_fmu_omc(name, out_dir, force=force)
     return build_fmu(name, out_dir, force=force)
 

@@ -84,16 +84,26 @@ def _functions(model: OdeModel) -> list[ca.Function]:
     ]
 
 
-def layout(model: OdeModel) -> ModelLayout:
-    """Value references, causality/variability/initial, start values and dependencies."""
+def _state_starts(model: OdeModel) -> tuple[list[float], list[bool]]:
+    """Start value of each state at the default parameters, and whether it is calculated from them."""
+    if not model.states:
+        return [], []
+    x0 = ca.Function("x0", [model.p], [model.x0])
+    default_p = [model.parameter_values[n] for n in model.parameters]
+    starts = [float(value) for value in ca.DM(x0(default_p)).full().ravel()]
+    calculated = [bool(ca.depends_on(model.x0[i], model.p)) if model.p.numel() else False
+                  for i in range(len(model.states))]
+    return starts, calculated
+
+
+def _variables(model: OdeModel, starts: list[float], calculated: list[bool]) -> list[FmuVariable]:
+    """Every FMU variable with its value reference, in the layout of model.h; ``starts`` and
+    ``calculated`` as from :func:`_state_starts`."""
     variables: list[FmuVariable] = []
-    vr = 0
 
     def add(**kwargs: object) -> FmuVariable:
-        nonlocal vr
-        variable = FmuVariable(value_reference=vr, **kwargs)  # type: ignore[arg-type]
+        variable = FmuVariable(value_reference=len(variables), **kwargs)  # type: ignore[arg-type]
         variables.append(variable)
-        vr += 1
         return variable
 
     info = model.variables
@@ -101,21 +111,15 @@ def layout(model: OdeModel) -> ModelLayout:
         v = info[name]
         add(name=name, kind="parameter", causality="parameter", variability="fixed", initial="exact",
             start=model.parameter_values[name], unit=v.unit, description=v.description)
-    x0 = ca.Function("x0", [model.p], [model.x0])
-    default_p = [model.parameter_values[n] for n in model.parameters]
-    x_start = [float(value) for value in ca.DM(x0(default_p)).full().ravel()] if model.states else []
-    state_refs = []
-    for i, name in enumerate(model.states):
-        v = info[name]
-        calculated = bool(ca.depends_on(model.x0[i], model.p)) if model.p.numel() else False
-        state_refs.append(add(name=name, kind="state", causality="output" if v.is_output else "local",
-                              variability="continuous", initial="calculated" if calculated else "exact",
-                              start=None if calculated else x_start[i], unit=v.unit, description=v.description))
+    state_refs = [add(name=name, kind="state", causality="output" if info[name].is_output else "local",
+                      variability="continuous", initial="calculated" if calculated[i] else "exact",
+                      start=None if calculated[i] else starts[i], unit=info[name].unit,
+                      description=info[name].description)
+                  for i, name in enumerate(model.states)]
     for state, name in zip(state_refs, model.states):
-        v = info[name]
-        unit = _derivative_unit(v.unit)
         add(name=f"der({name})", kind="derivative", causality="local", variability="continuous", initial="calculated",
-            start=None, unit=unit, description=f"time derivative of {name}", derivative_of=state.value_reference)
+            start=None, unit=_derivative_unit(info[name].unit), description=f"time derivative of {name}",
+            derivative_of=state.value_reference)
     for name in model.inputs:
         v = info[name]
         add(name=name, kind="input", causality="input", variability="continuous", initial=None,
@@ -127,7 +131,13 @@ def layout(model: OdeModel) -> ModelLayout:
     for name, value, unit, description in SOLVER_PARAMETERS:
         add(name=name, kind="solver", causality="parameter", variability="tunable", initial="exact", start=value,
             unit=unit, description=description)
+    return variables
 
+
+def layout(model: OdeModel) -> ModelLayout:
+    """Value references, causality/variability/initial, start values and dependencies."""
+    x_start, calculated = _state_starts(model)
+    variables = _variables(model, x_start, calculated)
     # Structural dependencies of derivatives and observed variables on states and inputs.
     knowns = ca.vertcat(model.x, model.u)
     known_refs = [v.value_reference for v in variables if v.kind in ("state", "input")]
@@ -177,8 +187,8 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path) -
         generator.add(function)
     code = generator.dump()
     digest = hashlib.sha256(code.encode())
-    digest.update(json.dumps([model.name, [(v.name, v.kind, v.causality, v.start, v.unit) for v in model_layout.variables],
-                              sorted(model_layout.dependencies.items())]).encode())
+    variables = [(v.name, v.kind, v.causality, v.start, v.unit) for v in model_layout.variables]
+    digest.update(json.dumps([model.name, variables, sorted(model_layout.dependencies.items())]).encode())
     h = digest.hexdigest()
     guid = "{" + f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:32]}" + "}"
     (directory / "model_casadi.c").write_text(

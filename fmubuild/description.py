@@ -8,8 +8,9 @@ from __future__ import annotations
 import datetime
 import xml.etree.ElementTree as ET
 
+from rover_cosim.common.units import base_units
+
 from .codegen import FmuVariable, ModelLayout
-from .units import base_units
 
 GENERATOR = "rover-cosim fmubuild (rumoca + CasADi + own FMI 2.0 runtime)"
 
@@ -18,18 +19,8 @@ def _number(value: float) -> str:
     return repr(float(value))
 
 
-def model_description(model_layout: ModelLayout, guid: str, sources: list[str], description: str,
-                      version: str) -> str:
-    root = ET.Element("fmiModelDescription", {
-        "fmiVersion": "2.0",
-        "modelName": model_layout.name,
-        "guid": guid,
-        "description": description,
-        "generationTool": f"{GENERATOR} {version}",
-        "generationDateAndTime": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "variableNamingConvention": "structured",
-        "numberOfEventIndicators": "0",
-    })
+def _interfaces(root: ET.Element, model_layout: ModelLayout, sources: list[str]) -> None:
+    """<ModelExchange> and <CoSimulation>, with their capability flags and C source files."""
     common = {"modelIdentifier": model_layout.name, "providesDirectionalDerivative": "true",
               "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true",
               "canNotUseMemoryManagementFunctions": "false"}
@@ -43,66 +34,91 @@ def model_description(model_layout: ModelLayout, guid: str, sources: list[str], 
             if name.endswith(".c"):
                 ET.SubElement(files, "File", {"name": name})
 
+
+def _unit_definitions(root: ET.Element, model_layout: ModelLayout) -> None:
+    """<UnitDefinitions>: every unit used, in SI base units."""
     units = sorted({v.unit for v in model_layout.variables if v.unit is not None})
-    if units:
-        definitions = ET.SubElement(root, "UnitDefinitions")
-        for unit in units:
-            exponents, factor = base_units(unit)
-            node = ET.SubElement(definitions, "Unit", {"name": unit})
-            attributes = {k: str(e) for k, e in exponents.items()}
-            if factor != 1.0:
-                attributes["factor"] = _number(factor)
-            ET.SubElement(node, "BaseUnit", attributes)
+    if not units:
+        return
+    definitions = ET.SubElement(root, "UnitDefinitions")
+    for unit in units:
+        exponents, factor = base_units(unit)
+        node = ET.SubElement(definitions, "Unit", {"name": unit})
+        attributes = {k: str(e) for k, e in exponents.items()}
+        if factor != 1.0:
+            attributes["factor"] = _number(factor)
+        ET.SubElement(node, "BaseUnit", attributes)
 
-    categories = ET.SubElement(root, "LogCategories")
-    ET.SubElement(categories, "Category", {"name": "logStatusError", "description": "errors, always reported"})
-    ET.SubElement(categories, "Category", {"name": "logStatistics",
-                                           "description": "Co-Simulation integrator counts, at fmi2Terminate"})
 
-    ET.SubElement(root, "DefaultExperiment", {"startTime": "0.0", "tolerance": "1e-06"})
+def _scalar_variable(parent: ET.Element, v: FmuVariable, index: dict[int, int]) -> None:
+    attributes = {"name": v.name, "valueReference": str(v.value_reference), "causality": v.causality,
+                  "variability": v.variability}
+    if v.description:
+        attributes["description"] = v.description
+    if v.initial is not None:
+        attributes["initial"] = v.initial
+    node = ET.SubElement(parent, "ScalarVariable", attributes)
+    real: dict[str, str] = {}
+    if v.unit is not None:
+        real["unit"] = v.unit
+    if v.start is not None:
+        real["start"] = _number(v.start)
+    if v.derivative_of is not None:
+        real["derivative"] = str(index[v.derivative_of])
+    ET.SubElement(node, "Real", real)
 
+
+def _model_variables(root: ET.Element, model_layout: ModelLayout) -> dict[int, int]:
+    """<ModelVariables>; returns the 1-based index of each value reference."""
     variables = ET.SubElement(root, "ModelVariables")
     index: dict[int, int] = {}
     for position, v in enumerate(model_layout.variables, start=1):
         index[v.value_reference] = position
-        attributes = {"name": v.name, "valueReference": str(v.value_reference), "causality": v.causality,
-                      "variability": v.variability}
-        if v.description:
-            attributes["description"] = v.description
-        if v.initial is not None:
-            attributes["initial"] = v.initial
-        node = ET.SubElement(variables, "ScalarVariable", attributes)
-        real: dict[str, str] = {}
-        if v.unit is not None:
-            real["unit"] = v.unit
-        if v.start is not None:
-            real["start"] = _number(v.start)
-        if v.derivative_of is not None:
-            real["derivative"] = str(index[v.derivative_of])
-        ET.SubElement(node, "Real", real)
+        _scalar_variable(variables, v, index)
+    return index
 
+
+def _model_structure(root: ET.Element, model_layout: ModelLayout, index: dict[int, int]) -> None:
+    """<ModelStructure>: outputs and derivatives with their dependencies, the initial unknowns."""
     structure = ET.SubElement(root, "ModelStructure")
-    outputs = [v for v in model_layout.variables if v.causality == "output"]
-    derivatives = [v for v in model_layout.variables if v.kind == "derivative"]
-    if outputs:
-        node = ET.SubElement(structure, "Outputs")
-        for v in outputs:
-            ET.SubElement(node, "Unknown", {"index": str(index[v.value_reference]),
-                                            "dependencies": _dependencies(v, model_layout, index)})
-    if derivatives:
-        node = ET.SubElement(structure, "Derivatives")
-        for v in derivatives:
-            ET.SubElement(node, "Unknown", {"index": str(index[v.value_reference]),
-                                            "dependencies": _dependencies(v, model_layout, index)})
-    initial = [v for v in model_layout.variables
-               if (v.causality == "output" and v.initial in ("approx", "calculated"))
-               or (v.kind in ("state", "derivative") and v.initial in ("approx", "calculated"))]
+    for element, selected in (("Outputs", [v for v in model_layout.variables if v.causality == "output"]),
+                              ("Derivatives", [v for v in model_layout.variables if v.kind == "derivative"])):
+        if selected:
+            node = ET.SubElement(structure, element)
+            for v in selected:
+                ET.SubElement(node, "Unknown", {"index": str(index[v.value_reference]),
+                                                "dependencies": _dependencies(v, model_layout, index)})
+    initial = [v for v in model_layout.variables if (v.causality == "output" or v.kind in ("state", "derivative"))
+               and v.initial in ("approx", "calculated")]
     if initial:
         node = ET.SubElement(structure, "InitialUnknowns")
         for v in sorted(initial, key=lambda v: index[v.value_reference]):
             # No dependencies attribute: may depend on every known (parameters, inputs, exact states).
             ET.SubElement(node, "Unknown", {"index": str(index[v.value_reference])})
 
+
+def model_description(model_layout: ModelLayout, guid: str, sources: list[str], description: str,
+                      version: str) -> str:
+    """The modelDescription.xml text of an FMU of ``model_layout``."""
+    root = ET.Element("fmiModelDescription", {
+        "fmiVersion": "2.0",
+        "modelName": model_layout.name,
+        "guid": guid,
+        "description": description,
+        "generationTool": f"{GENERATOR} {version}",
+        "generationDateAndTime": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "variableNamingConvention": "structured",
+        "numberOfEventIndicators": "0",
+    })
+    _interfaces(root, model_layout, sources)
+    _unit_definitions(root, model_layout)
+    categories = ET.SubElement(root, "LogCategories")
+    ET.SubElement(categories, "Category", {"name": "logStatusError", "description": "errors, always reported"})
+    ET.SubElement(categories, "Category", {"name": "logStatistics",
+                                           "description": "Co-Simulation integrator counts, at fmi2Terminate"})
+    ET.SubElement(root, "DefaultExperiment", {"startTime": "0.0", "tolerance": "1e-06"})
+    index = _model_variables(root, model_layout)
+    _model_structure(root, model_layout, index)
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 

@@ -84,13 +84,19 @@ class FunctionLibrary:
             result = list(result.values())
         return tuple(result)
 
-    def _translate(self, definition: Mapping[str, Any], structural: tuple[Any, ...]) -> ca.Function:
+    @staticmethod
+    def _check_supported(definition: Mapping[str, Any]) -> None:
         name = definition["name"]
         for declared in list(definition["inputs"]) + list(definition["outputs"]) + list(definition["locals"]):
             if declared["shape_expr"]:
                 raise UnsupportedConstruct(f"array variable {declared['name']} in function {name}", name)
         if definition.get("external"):
             raise UnsupportedConstruct(f"external function {name}", name)
+
+    def _environment(self, definition: Mapping[str, Any], structural: tuple[Any, ...]) -> tuple[list[ca.MX],
+                                                                                                 dict[str, Value]]:
+        """Symbols of the run-time inputs, and the start environment: structural inputs fixed,
+        outputs and locals at their defaults."""
         symbols = []
         env: dict[str, Value] = {}
         for declared, fixed in zip(definition["inputs"], structural):
@@ -102,14 +108,26 @@ class FunctionLibrary:
                 env[declared["name"]] = fixed
         for declared in list(definition["outputs"]) + list(definition["locals"]):
             if declared["default"] is not None:
-                env[declared["name"]] = Evaluator(env.__getitem__, self.call, name)(declared["default"])
-        self._execute(definition["body"], env, name)
+                env[declared["name"]] = Evaluator(env.__getitem__, self.call, definition["name"])(declared["default"])
+        return symbols, env
+
+    @staticmethod
+    def _outputs(definition: Mapping[str, Any], env: dict[str, Value]) -> list[ca.MX]:
         outputs = []
         for declared in definition["outputs"]:
             if declared["name"] not in env:
-                raise UnsupportedConstruct(f"output {declared['name']} of {name} is never assigned", name)
+                raise UnsupportedConstruct(f"output {declared['name']} of {definition['name']} is never assigned",
+                                           definition["name"])
             value = env[declared["name"]]
             outputs.append(value if is_symbolic(value) else ca.MX(float(value)))
+        return outputs
+
+    def _translate(self, definition: Mapping[str, Any], structural: tuple[Any, ...]) -> ca.Function:
+        name = definition["name"]
+        self._check_supported(definition)
+        symbols, env = self._environment(definition, structural)
+        self._execute(definition["body"], env, name)
+        outputs = self._outputs(definition, env)
         suffix = "_".join(str(int(s)) for s in structural if s is not None)
         function = ca.Function(_safe(name) + (f"_{suffix}" if suffix else ""), symbols, outputs,
                                [s.name() for s in symbols], [d["name"] for d in definition["outputs"]])

@@ -13,7 +13,7 @@ names the equation and its source line and suggests the omc backend.
 from __future__ import annotations
 
 import sys
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import partial
 from typing import Any
@@ -102,77 +102,78 @@ class _Locator:
         return f"{path}:{line}: '{snippet}'"
 
 
-def translate(model: Any, name: str) -> OdeModel:
-    """Translate a loaded rumoca model (``fmubuild.source.load``) to an :class:`OdeModel`."""
-    flat = model.to_dict("flat")
-    locate = _Locator(model.to_dict("dae"))
-    for key, what in (("when_chains", "when-clause (events)"), ("algorithms", "algorithm section in a model"),
-                      ("initial_equations", "initial equation"), ("initial_algorithms", "initial algorithm")):
+UNSUPPORTED_SECTIONS = (("when_chains", "when-clause (events)"), ("algorithms", "algorithm section in a model"),
+                        ("initial_equations", "initial equation"), ("initial_algorithms", "initial algorithm"))
+
+Info = tuple[Mapping[str, Any], list[int], str]  # (flat variable info, indices of the scalar, flat name)
+Equation = tuple[Any, list[str] | None, str]     # (residual, tuple targets or None, where)
+
+
+def _reject_unsupported_sections(flat: Mapping[str, Any], locate: _Locator, name: str) -> None:
+    for key, what in UNSUPPORTED_SECTIONS:
         if flat.get(key):
             first = flat[key][0]
-            raise UnsupportedConstruct(what, f"{name}: {locate(first.get('span') if isinstance(first, dict) else None)}")
-    library = FunctionLibrary(flat["functions"])
-    types = flat["variable_type_names"]
+            span = first.get("span") if isinstance(first, dict) else None
+            raise UnsupportedConstruct(what, f"{name}: {locate(span)}")
 
-    # --- variables -----------------------------------------------------------------------
-    infos: dict[str, tuple[Mapping[str, Any], list[int], str]] = {}
-    for flat_name, info in flat["variables"].items():
-        for scalar, indices in _scalar_names(flat_name, info["dims"]):
-            infos[scalar] = (info, indices, flat_name)
-    state_names = _states(flat["equations"])
-    parameters: dict[str, Value] = {}  # scalar name -> number or MX expression of p
-    free: list[str] = []
-    free_symbols: list[ca.MX] = []
-    values: dict[str, float] = {}
-    calculated: dict[str, ca.MX] = {}
 
-    def parameter(scalar: str) -> Value:
-        if scalar in parameters:
-            return parameters[scalar]
-        info, indices, flat_name = infos[scalar]
+class _Parameters:
+    """Parameters and constants as CasADi values: a literal binding is a free (tunable) parameter,
+    an entry of p; a binding that is an expression of other parameters is calculated from them."""
+
+    def __init__(self, infos: dict[str, Info], types: Mapping[str, str], library: FunctionLibrary, name: str):
+        self.infos, self.types, self.library, self.name = infos, types, library, name
+        self.values: dict[str, Value] = {}       # scalar name -> number or MX expression of p
+        self.free: list[str] = []
+        self.symbols: list[ca.MX] = []
+        self.defaults: dict[str, float] = {}     # free parameter -> its value
+        self.calculated: dict[str, ca.MX] = {}   # dependent parameters, expressions of p
+
+    def __call__(self, scalar: str) -> Value:
+        if scalar not in self.values:
+            self.values[scalar] = self._evaluate(scalar)
+        return self.values[scalar]
+
+    def _evaluate(self, scalar: str) -> Value:
+        info, indices, flat_name = self.infos[scalar]
         binding = info["binding"] if info["binding"] is not None else info["start"]
-        where = f"{name}: parameter {scalar}"
+        where = f"{self.name}: parameter {scalar}"
         if binding is None:
             raise UnsupportedConstruct(f"parameter {scalar} without a value", where)
         binding = _element(binding, indices, where)
-        evaluator = Evaluator(parameter, library.call, where)
-        value = evaluator(binding)
-        if types.get(flat_name) in ("Integer", "Boolean"):
+        value = Evaluator(self, self.library.call, where)(binding)
+        if self.types.get(flat_name) in ("Integer", "Boolean"):
             if is_symbolic(value):
                 raise UnsupportedConstruct(f"Integer/Boolean parameter {scalar} bound to a run-time value", where)
-            parameters[scalar] = value
             return value
         if "Literal" in binding or (not is_symbolic(value) and "Unary" in binding):
             symbol = ca.MX.sym(scalar)
-            free.append(scalar)
-            free_symbols.append(symbol)
-            values[scalar] = float(value)
-            parameters[scalar] = symbol
+            self.free.append(scalar)
+            self.symbols.append(symbol)
+            self.defaults[scalar] = float(value)
             return symbol
-        parameters[scalar] = value
-        calculated[scalar] = value if is_symbolic(value) else ca.MX(float(value))
+        self.calculated[scalar] = value if is_symbolic(value) else ca.MX(float(value))
         return value
 
-    for scalar, (info, _, _) in infos.items():
-        if _role_names(info)[0] in ("Parameter", "Constant"):
-            parameter(scalar)
+    def vector(self) -> ca.MX:
+        return ca.vertcat(*self.symbols) if self.symbols else ca.MX.sym("p", 0)
 
-    inputs = [s for s, (info, _, flat_name) in infos.items()
-              if _role_names(info)[1] == "Input" and "." not in flat_name]
-    states = [s for s in infos if s in state_names]
-    t = ca.MX.sym("time")
-    x = ca.MX.sym("x", len(states))
-    u = ca.MX.sym("u", len(inputs))
-    p = ca.vertcat(*free_symbols) if free_symbols else ca.MX.sym("p", 0)
-    known: dict[str, Value] = {"time": t}
-    known.update({s: x[i] for i, s in enumerate(states)})
-    known.update({s: u[i] for i, s in enumerate(inputs)})
-    known.update(parameters)
-    unknowns = [f"der({s})" for s in states] + [
-        s for s in infos if s not in known and _role_names(infos[s][0])[0] not in ("Parameter", "Constant")]
 
-    # --- equations, matching, BLT ----------------------------------------------------------
-    equations: list[tuple[Any, list[str] | None, str]] = []  # (residual, tuple targets or None, where)
+def _scalar_infos(flat: Mapping[str, Any]) -> dict[str, Info]:
+    infos: dict[str, Info] = {}
+    for flat_name, info in flat["variables"].items():
+        for scalar, indices in _scalar_names(flat_name, info["dims"]):
+            infos[scalar] = (info, indices, flat_name)
+    return infos
+
+
+def _is_parameter(info: Mapping[str, Any]) -> bool:
+    return _role_names(info)[0] in ("Parameter", "Constant")
+
+
+def _equations(flat: Mapping[str, Any], locate: _Locator, name: str) -> list[Equation]:
+    """The flat equations; a tuple equated to a multi-output call keeps its targets."""
+    equations: list[Equation] = []
     for equation in flat["equations"]:
         where = f"{name}: equation at {locate(equation.get('span'))}"
         residual = equation["residual"]
@@ -181,63 +182,106 @@ def translate(model: Any, name: str) -> OdeModel:
             equations.append((body["rhs"], [_ref_name(e, where) for e in body["lhs"]["Tuple"]["elements"]], where))
         else:
             equations.append((residual, None, where))
-    slots: list[tuple[int, set[str]]] = []  # (equation, unknowns it can be solved for)
-    depends: list[set[str]] = []  # unknowns each slot's equation reads
+    return equations
+
+
+def _slots(equations: list[Equation], unknowns: list[str]) -> tuple[list[tuple[int, set[str]]], list[set[str]]]:
+    """One slot per scalar equation (a tuple equation has one per target): (equation, unknowns it
+    can be solved for), and the unknowns each slot's equation reads."""
+    slots: list[tuple[int, set[str]]] = []
+    depends: list[set[str]] = []
     for index, (residual, tuple_targets, _) in enumerate(equations):
         incidence = _incidence(residual, unknowns)
-        if tuple_targets is not None:
-            for target in tuple_targets:
-                slots.append((index, {target}))
-                depends.append(incidence)
-        else:
-            slots.append((index, incidence))
+        for targets in ([{t} for t in tuple_targets] if tuple_targets is not None else [incidence]):
+            slots.append((index, targets))
             depends.append(incidence)
+    return slots, depends
+
+
+def _solve(equations: list[Equation], unknowns: list[str], known: dict[str, Value], library: FunctionLibrary,
+           name: str) -> dict[str, Value]:
+    """Match, sort into BLT blocks and solve them in order: every unknown as an expression."""
+    slots, depends = _slots(equations, unknowns)
     if len(slots) != len(unknowns):
         raise UnsupportedConstruct(f"{len(slots)} scalar equations for {len(unknowns)} unknowns (not balanced)", name)
     assignment = _match(slots, unknowns, name, equations)
-    blocks = _blt(slots, depends, assignment)
-
     env: dict[str, Value] = dict(known)
-    for block in blocks:
+    for block in _blt(slots, depends, assignment):
         eq_indices = sorted({slots[s][0] for s in block})
-        block_unknowns = [assignment[s] for s in block]
-        _solve_block(eq_indices, block_unknowns, equations, env, library, name)
+        _solve_block(eq_indices, [assignment[s] for s in block], equations, env, library, name)
+    return env
+
+
+def _start_values(states: list[str], infos: dict[str, Info], parameters: _Parameters, name: str) -> ca.MX:
+    """x0 as an expression of p (0 for a state without a start)."""
+    x0: list[ca.MX] = []
+    for s in states:
+        info, indices, _ = infos[s]
+        start = info["start"]
+        evaluator = Evaluator(lambda n: parameters.values[n], parameters.library.call, f"{name}: start of {s}")
+        x0.append(_mx(evaluator(_element(start, indices, s)) if start is not None else 0.0))
+    return ca.vertcat(*x0) if x0 else ca.MX(0, 1)
+
+
+def _role(scalar: str, info: Mapping[str, Any], flat_name: str, parameters: _Parameters, inputs: list[str],
+          states: list[str]) -> str:
+    variability, causality = _role_names(info)
+    if scalar in parameters.free:
+        return "parameter"
+    if scalar in parameters.calculated:
+        return "calculated"
+    if variability in ("Parameter", "Constant"):
+        return "constant"
+    if scalar in inputs:
+        return "input"
+    if scalar in states:
+        return "state"
+    return "output" if causality == "Output" and "." not in flat_name else "local"
+
+
+def _variables(infos: dict[str, Info], types: Mapping[str, str], parameters: _Parameters, inputs: list[str],
+               states: list[str]) -> dict[str, Variable]:
+    variables = {}
+    for s, (info, _, flat_name) in infos.items():
+        start = parameters.defaults.get(s)
+        if start is None and isinstance(parameters.values.get(s), (int, float)):
+            start = float(parameters.values[s])
+        is_output = _role_names(info)[1] == "Output" and "." not in flat_name
+        variables[s] = Variable(s, _role(s, info, flat_name, parameters, inputs, states), types.get(flat_name, "Real"),
+                                info["unit"], info["description"], start, is_output)
+    return variables
+
+
+def translate(model: Any, name: str) -> OdeModel:
+    """Translate a loaded rumoca model (``fmubuild.source.load``) to an :class:`OdeModel`."""
+    flat = model.to_dict("flat")
+    locate = _Locator(model.to_dict("dae"))
+    _reject_unsupported_sections(flat, locate, name)
+    library = FunctionLibrary(flat["functions"])
+    types = flat["variable_type_names"]
+    infos = _scalar_infos(flat)
+    parameters = _Parameters(infos, types, library, name)
+    for scalar, (info, _, _) in infos.items():
+        if _is_parameter(info):
+            parameters(scalar)
+
+    state_names = _states(flat["equations"])
+    inputs = [s for s, (info, _, flat_name) in infos.items()
+              if _role_names(info)[1] == "Input" and "." not in flat_name]
+    states = [s for s in infos if s in state_names]
+    t, x, u, p = ca.MX.sym("time"), ca.MX.sym("x", len(states)), ca.MX.sym("u", len(inputs)), parameters.vector()
+    known: dict[str, Value] = {"time": t, **{s: x[i] for i, s in enumerate(states)},
+                               **{s: u[i] for i, s in enumerate(inputs)}, **parameters.values}
+    unknowns = [f"der({s})" for s in states] + [s for s in infos if s not in known and not _is_parameter(infos[s][0])]
+    env = _solve(_equations(flat, locate, name), unknowns, known, library, name)
 
     xdot = ca.vertcat(*[_mx(env[f"der({s})"]) for s in states]) if states else ca.MX(0, 1)
     observed = [s for s in unknowns if not s.startswith("der(")]
     y = ca.vertcat(*[_mx(env[s]) for s in observed]) if observed else ca.MX(0, 1)
-    x0_list = []
-    for s in states:
-        info, indices, _ = infos[s]
-        start = info["start"]
-        value = Evaluator(lambda n: parameters[n], library.call, f"{name}: start of {s}")(
-            _element(start, indices, s)) if start is not None else 0.0
-        x0_list.append(_mx(value))
-    x0 = ca.vertcat(*x0_list) if x0_list else ca.MX(0, 1)
-
-    variables = {}
-    for s, (info, _, flat_name) in infos.items():
-        variability, causality = _role_names(info)
-        if s in free:
-            role = "parameter"
-        elif s in calculated:
-            role = "calculated"
-        elif variability in ("Parameter", "Constant"):
-            role = "constant"
-        elif s in inputs:
-            role = "input"
-        elif s in states:
-            role = "state"
-        elif causality == "Output" and "." not in flat_name:
-            role = "output"
-        else:
-            role = "local"
-        start = values.get(s)
-        if start is None and isinstance(parameters.get(s), (int, float)):
-            start = float(parameters[s])
-        variables[s] = Variable(s, role, types.get(flat_name, "Real"), info["unit"], info["description"], start,
-                                causality == "Output" and "." not in flat_name)
-    return OdeModel(name, variables, states, inputs, free, observed, t, x, u, p, xdot, y, x0, values, calculated)
+    x0 = _start_values(states, infos, parameters, name)
+    variables = _variables(infos, types, parameters, inputs, states)
+    return OdeModel(name, variables, states, inputs, parameters.free, observed, t, x, u, p, xdot, y, x0,
+                    parameters.defaults, parameters.calculated)
 
 
 def _mx(value: Value) -> ca.MX:
@@ -334,9 +378,9 @@ def _augment(slot: int, slots: list[tuple[int, set[str]]], owner: dict[str, int]
     return False
 
 
-def _blt(slots: list[tuple[int, set[str]]], depends: list[set[str]], assignment: list[str]) -> list[list[int]]:
-    """Strongly connected components of the slot dependency graph in evaluation order
-    (Tarjan's algorithm, iterative). Slots of one tuple equation are one block."""
+def _edges(slots: list[tuple[int, set[str]]], depends: list[set[str]], assignment: list[str]) -> list[set[int]]:
+    """Per slot, the slots it needs first: those solving the unknowns it reads, and the other
+    slots of its tuple equation (a multi-output call is one block)."""
     solved_by = {variable: slot for slot, variable in enumerate(assignment)}
     groups: dict[int, list[int]] = {}
     for slot, (equation, _) in enumerate(slots):
@@ -346,83 +390,106 @@ def _blt(slots: list[tuple[int, set[str]]], depends: list[set[str]], assignment:
         deps = {solved_by[v] for v in depends[slot] if v in solved_by and solved_by[v] != slot}
         deps |= {other for other in groups[equation] if other != slot}
         edges.append(deps)
-    index_of: dict[int, int] = {}
-    low: dict[int, int] = {}
-    on_stack: set[int] = set()
-    stack: list[int] = []
-    order: list[list[int]] = []
-    counter = 0
-    for root in range(len(slots)):
-        if root in index_of:
-            continue
-        work = [(root, iter(sorted(edges[root])))]
-        index_of[root] = low[root] = counter
-        counter += 1
-        stack.append(root)
-        on_stack.add(root)
+    return edges
+
+
+class _Tarjan:
+    """Strongly connected components of a graph, iteratively, each emitted after the components
+    it depends on (Tarjan's algorithm)."""
+
+    def __init__(self, edges: list[set[int]]):
+        self.edges = edges
+        self.index_of: dict[int, int] = {}
+        self.low: dict[int, int] = {}
+        self.stack: list[int] = []
+        self.on_stack: set[int] = set()
+        self.components: list[list[int]] = []
+
+    def _open(self, node: int, work: list[tuple[int, Iterator[int]]]) -> None:
+        self.index_of[node] = self.low[node] = len(self.index_of)
+        self.stack.append(node)
+        self.on_stack.add(node)
+        work.append((node, iter(sorted(self.edges[node]))))
+
+    def _close(self, node: int) -> None:
+        if self.low[node] != self.index_of[node]:
+            return
+        component = []
+        while True:
+            member = self.stack.pop()
+            self.on_stack.discard(member)
+            component.append(member)
+            if member == node:
+                break
+        self.components.append(component)
+
+    def _visit(self, root: int) -> None:
+        work: list[tuple[int, Iterator[int]]] = []
+        self._open(root, work)
         while work:
             node, children = work[-1]
-            advanced = False
-            for child in children:
-                if child not in index_of:
-                    index_of[child] = low[child] = counter
-                    counter += 1
-                    stack.append(child)
-                    on_stack.add(child)
-                    work.append((child, iter(sorted(edges[child]))))
-                    advanced = True
-                    break
-                if child in on_stack:
-                    low[node] = min(low[node], index_of[child])
-            if advanced:
+            child = next((c for c in children if c not in self.index_of or c in self.on_stack), None)
+            if child is not None and child not in self.index_of:
+                self._open(child, work)
+                continue
+            if child is not None:  # on the stack: a back edge
+                self.low[node] = min(self.low[node], self.index_of[child])
                 continue
             work.pop()
             if work:
-                low[work[-1][0]] = min(low[work[-1][0]], low[node])
-            if low[node] == index_of[node]:
-                component = []
-                while True:
-                    member = stack.pop()
-                    on_stack.discard(member)
-                    component.append(member)
-                    if member == node:
-                        break
-                order.append(component)
-    return order  # Tarjan emits components after their dependencies
+                self.low[work[-1][0]] = min(self.low[work[-1][0]], self.low[node])
+            self._close(node)
+
+    def components_in_order(self) -> list[list[int]]:
+        for root in range(len(self.edges)):
+            if root not in self.index_of:
+                self._visit(root)
+        return self.components
 
 
-def _solve_block(eq_indices: list[int], block_unknowns: list[str], equations: list[Any], env: dict[str, Value],
-                 library: FunctionLibrary, name: str) -> None:
+def _blt(slots: list[tuple[int, set[str]]], depends: list[set[str]], assignment: list[str]) -> list[list[int]]:
+    """Strongly connected components of the slot dependency graph in evaluation order. Slots of
+    one tuple equation are one block."""
+    return _Tarjan(_edges(slots, depends, assignment)).components_in_order()
+
+
+def _evaluator(env: Mapping[str, Value], library: FunctionLibrary, where: str) -> Evaluator:
+    return Evaluator(partial(_lookup, env, where=where), library.call, where, allow_events=False)
+
+
+def _solve_tuple(eq_indices: list[int], equations: list[Equation], env: dict[str, Value],
+                 library: FunctionLibrary) -> None:
+    """A tuple equated to a multi-output call: one call gives every target."""
     tuple_equations = [i for i in eq_indices if equations[i][1] is not None]
-    if tuple_equations:
-        if len(eq_indices) != 1:
-            raise UnsupportedConstruct("a multi-output function call inside an algebraic loop",
-                                       equations[tuple_equations[0]][2])
-        residual, targets, where = equations[eq_indices[0]]
-        assert targets is not None  # a tuple equation
-        if all(target in env for target in targets):
-            return  # solved with its first target: one call for all outputs
-        evaluator = Evaluator(partial(_lookup, env, where=where), library.call, where, allow_events=False)
-        outputs = evaluator.call_outputs(residual)
-        for target, value in zip(targets, outputs):
-            env[target] = value
-        return
-    if len(eq_indices) == 1 and len(block_unknowns) == 1:
-        residual, _, where = equations[eq_indices[0]]
-        explicit = _explicit_side(residual, block_unknowns[0])
-        if explicit is not None:
-            # unknown = expression (the common case): evaluated as it stands, keeping shared nodes
-            evaluator = Evaluator(partial(_lookup, env, where=where), library.call, where, allow_events=False)
-            env[block_unknowns[0]] = evaluator(explicit)
-            return
+    if len(eq_indices) != 1:
+        raise UnsupportedConstruct("a multi-output function call inside an algebraic loop",
+                                   equations[tuple_equations[0]][2])
+    residual, targets, where = equations[eq_indices[0]]
+    assert targets is not None  # a tuple equation
+    if all(target in env for target in targets):
+        return  # solved with its first target: one call for all outputs
+    for target, value in zip(targets, _evaluator(env, library, where).call_outputs(residual)):
+        env[target] = value
+
+
+def _solve_explicit(equation: Equation, unknown: str, env: dict[str, Value], library: FunctionLibrary) -> bool:
+    """``unknown = expression`` (the common case), evaluated as it stands, keeping shared nodes;
+    False when the equation is not of that form."""
+    residual, _, where = equation
+    explicit = _explicit_side(residual, unknown)
+    if explicit is None:
+        return False
+    env[unknown] = _evaluator(env, library, where)(explicit)
+    return True
+
+
+def _solve_linear(eq_indices: list[int], block_unknowns: list[str], equations: list[Equation],
+                  env: dict[str, Value], library: FunctionLibrary) -> None:
+    """A block linear in its unknowns, solved symbolically; a nonlinear one is rejected."""
     symbols = [ca.MX.sym(f"unknown_{i}") for i in range(len(block_unknowns))]
     trial = dict(env)
     trial.update(zip(block_unknowns, symbols))
-    residuals = []
-    for i in eq_indices:
-        residual, _, where = equations[i]
-        evaluator = Evaluator(partial(_lookup, trial, where=where), library.call, where, allow_events=False)
-        residuals.append(_mx(evaluator(residual)))
+    residuals = [_mx(_evaluator(trial, library, equations[i][2])(equations[i][0])) for i in eq_indices]
     unknown_vector = ca.vertcat(*symbols)
     residual_vector = ca.vertcat(*residuals)
     jacobian = ca.jacobian(residual_vector, unknown_vector)
@@ -433,11 +500,23 @@ def _solve_block(eq_indices: list[int], block_unknowns: list[str], equations: li
     # graph_substitute keeps the nodes that do not depend on the unknowns (function calls stay shared)
     offset = ca.graph_substitute(residual_vector, [unknown_vector], [ca.MX.zeros(len(symbols))])
     if len(symbols) == 1:
-        solution = -offset / jacobian
-    else:
-        solution = -ca.solve(jacobian, offset)
+        env[block_unknowns[0]] = ca.simplify((-offset / jacobian)[0])
+        return
+    solution = -ca.solve(jacobian, offset)
     for i, variable in enumerate(block_unknowns):
-        env[variable] = ca.simplify(solution[i]) if len(symbols) == 1 else solution[i]
+        env[variable] = solution[i]
+
+
+def _solve_block(eq_indices: list[int], block_unknowns: list[str], equations: list[Equation], env: dict[str, Value],
+                 library: FunctionLibrary, name: str) -> None:
+    """Solve one BLT block for its unknowns into ``env``."""
+    if any(equations[i][1] is not None for i in eq_indices):
+        _solve_tuple(eq_indices, equations, env, library)
+        return
+    if len(eq_indices) == 1 and len(block_unknowns) == 1 and _solve_explicit(
+            equations[eq_indices[0]], block_unknowns[0], env, library):
+        return
+    _solve_linear(eq_indices, block_unknowns, equations, env, library)
 
 
 def _explicit_side(residual: Mapping[str, Any], unknown: str) -> Mapping[str, Any] | None:

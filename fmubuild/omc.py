@@ -18,7 +18,7 @@ import zipfile
 from pathlib import Path
 
 from . import source
-from .build import BUILD_RECORD, BuildResult, input_digest, stored_digest
+from .artifact import BUILD_RECORD, BuildResult, input_digest, stored_digest
 
 #: Simulation flags compiled into the FMU: CVODE for Co-Simulation.
 FMI_FLAGS = "s:cvode"

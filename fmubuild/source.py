@@ -14,8 +14,9 @@ from pathlib import Path
 
 import pandas as pd
 
-#: The folder that holds the top-level Modelica package (a rumoca source root).
-MODELICA_ROOT = Path(__file__).resolve().parent.parent / "modelica"
+#: The folder that holds the top-level Modelica package (a rumoca source root): ``modelica/`` of
+#: the repository, installed as package data ``rover_cosim/modelica``.
+MODELICA_ROOT = Path(__file__).parent.parent / "modelica"
 #: Name of the top-level Modelica package.
 PACKAGE = "RoverTerramechanics"
 

@@ -5,5 +5,5 @@
 - ``sweep``: the (load, torque) sweep on local processes, serially or on Dask, cached per run.
 - ``fits``: first-order tau -> slip fits and their (W, tau) look-up tables, Fx(W, slip) fits,
   Eq. (15); ``validate``: Table 1 at 275, 575, 875 N; ``figures``: Figs. 5-8;
-  ``job``: ``make identify``.
+  ``make identify`` is the job ``rover_cosim.jobs.identify``.
 """

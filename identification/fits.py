@@ -2,8 +2,9 @@
 
 - tau -> slip: per (W, tau), a first-order step response slip(t) = K tau (1 - exp(-t/T)) fitted
   to the recorded slip; K and T form look-up tables over (W, tau); the settled slip K tau and
-  log T are interpolated linearly in 1/W and tau (and extended linearly beyond the table). At a fixed torque the slip falls roughly like
-  1/W, so 1/W interpolates it far better than W (slip Fit at 275 N: 86 % with W, 95 % with 1/W).
+  log T are interpolated linearly in 1/W and tau (and extended linearly beyond the table). At a
+  fixed torque the slip falls roughly like 1/W, so 1/W interpolates it far better than W (slip
+  Fit at 275 N: 86 % with W, 95 % with 1/W).
 - slip -> Fx: per load, Fx = a(W) slip + b(W) (Eq. 14) fitted to the settled (slip, Fx) points;
   a and b are then quadratic in W (Figs. 6, 7). ``degree`` > 1 gives the higher-degree variant the
   paper suggests: Fx = sum_k c_k(W) slip^k, each c_k quadratic in W.
@@ -135,7 +136,8 @@ class IdentifiedModel:
 
     def to_dict(self) -> dict[str, object]:
         return {"loads_N": list(map(float, self.loads)), "torques_N_m": list(map(float, self.torques)),
-                "gain_K_per_N_m": np.asarray(self.gain).tolist(), "time_constant_T_s": np.asarray(self.time_constant).tolist(),
+                "gain_K_per_N_m": np.asarray(self.gain).tolist(),
+                "time_constant_T_s": np.asarray(self.time_constant).tolist(),
                 "fx_degree_in_slip": self.degree,
                 "fx_coefficients_N": np.asarray(self.fx_coefficients).tolist(),
                 "fx_coefficients_meaning": "Fx = sum_k (c[k][0] + c[k][1] W + c[k][2] W^2) slip^k"}

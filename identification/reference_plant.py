@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
-from terramechanics import Soil, Wheel, slip_ratio, wheel_state
+from rover_cosim.terramechanics import Soil, Wheel, slip_ratio, wheel_state
 
 from .testbed import RECORDED, TorqueProfile
 

@@ -14,19 +14,19 @@ import json
 import os
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import pandas as pd
 
-from orchestrator.outputs import file_sha256
+from rover_cosim import terramechanics
+from rover_cosim.common.outputs import file_sha256
+from rover_cosim.common.paper import LOADS as PAPER_LOADS
 
 from .testbed import TorqueProfile, shared_test_bed
 
-#: Loads of the paper's look-up tables and Fig. 3 [N].
-PAPER_LOADS = tuple(float(w) for w in range(100, 801, 100))
 #: Torque levels [N·m]: 5-80 N·m covers what the rover's wheels get (the open-loop run uses
 #: 9-40 N·m at 290-560 N per wheel; the closed loop asks ~5-30 N of drawbar pull per wheel on
 #: top of the rolling resistance), i.e. slips from ~0.01 to ~0.35 at 300-800 N. At 100-200 N the
@@ -102,6 +102,42 @@ def compute_run(fmu_path: str | None, load: float, torque: float, stop_time: flo
         return load, torque, f"{type(error).__name__}: {error}", time.perf_counter() - started
 
 
+def _plant_key(fmu_path: Path | None) -> str:
+    """The cache key of the plant: the FMU's SHA-256, or a digest of the numpy reference wheel's
+    source and of the reference test bed when ``fmu_path`` is None."""
+    if fmu_path is not None:
+        return file_sha256(fmu_path)[:16]
+    sources = sorted(Path(terramechanics.__file__).parent.glob("*.py"))
+    sources.append(Path(__file__).with_name("reference_plant.py"))
+    return "reference-" + hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:12]
+
+
+Arguments = tuple[str | None, float, float, float, float, float, str]
+Result = tuple[float, float, str | None, float]
+
+
+def _results(arguments: list[Arguments], workers: int | None, scheduler: str | None) -> Iterator[Result]:
+    """compute_run for every argument tuple, on a Dask cluster, local processes or serially;
+    results in the order they complete."""
+    if scheduler is not None:
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
+
+        with Client(scheduler) as client:
+            for future in dask_completed([client.submit(compute_run, *a, pure=False) for a in arguments]):
+                yield future.result()
+        return
+    workers = workers or os.cpu_count() or 1
+    if workers < 1:
+        raise ValueError(f"workers = {workers!r}: expected >= 1")
+    if workers == 1 or len(arguments) <= 1:
+        yield from (compute_run(*a) for a in arguments)
+        return
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        for future in as_completed([pool.submit(compute_run, *a) for a in arguments]):
+            yield future.result()
+
+
 def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, workers: int | None = None,
               scheduler: str | None = None, progress: Callable[[float], None] | None = None) -> SweepOutcome:
     """Run (or take from the cache) every case of ``plan`` on the FMU, or on the numpy reference
@@ -111,12 +147,7 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
         fmu_path = Path(fmu_path).resolve()
         if not fmu_path.is_file():
             raise FileNotFoundError(f"FMU {fmu_path} not found (run `make fmus`)")
-        plant = file_sha256(fmu_path)[:16]
-    else:
-        plant = "reference-" + hashlib.sha256(
-            "".join(p.read_text() for p in sorted((Path(__file__).parent.parent / "terramechanics").glob("*.py"))).encode()
-            + Path(__file__).with_name("reference_plant.py").read_bytes()).hexdigest()[:12]
-    folder = Path(cache_dir) / plant / plan.digest()
+    folder = Path(cache_dir) / _plant_key(fmu_path) / plan.digest()
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "plan.json").write_text(json.dumps({**asdict(plan), "plant": str(fmu_path or "numpy reference")},
                                                  indent=2) + "\n")
@@ -129,37 +160,13 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
         progress(done / len(cases))
     arguments = [(str(fmu_path) if fmu_path else None, w, tau, plan.stop_time, plan.sample_time, plan.tolerance,
                   str(run_file(folder, w, tau))) for w, tau in missing]
-
-    def collect(result: tuple[float, float, str | None, float]) -> None:
-        nonlocal done
-        load, torque, error, seconds = result
+    for load, torque, error, seconds in _results(arguments, workers, scheduler):
         run_seconds[load, torque] = seconds
         if error is not None:
             failures[load, torque] = error
         done += 1
         if progress:
             progress(done / len(cases))
-
-    if scheduler is not None:
-        from dask.distributed import Client
-        from dask.distributed import as_completed as dask_completed
-
-        with Client(scheduler) as client:
-            futures = [client.submit(compute_run, *a, pure=False) for a in arguments]
-            for future in dask_completed(futures):
-                collect(future.result())
-    else:
-        workers = workers or os.cpu_count() or 1
-        if workers < 1:
-            raise ValueError(f"workers = {workers!r}: expected >= 1")
-        if workers == 1 or len(arguments) <= 1:
-            for a in arguments:
-                collect(compute_run(*a))
-        else:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                futures = [pool.submit(compute_run, *a) for a in arguments]
-                for future in as_completed(futures):
-                    collect(future.result())
     runs = {(w, tau): pd.read_csv(run_file(folder, w, tau)) for w, tau in cases if (w, tau) not in failures}
     return SweepOutcome(runs, failures, len(missing), len(cases) - len(missing), time.perf_counter() - started,
                         folder, run_seconds)

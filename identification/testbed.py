@@ -63,7 +63,8 @@ class WheelTestBed:
         if not load > 0:
             raise ValueError(f"load = {load!r} N: expected > 0")
         if not 0 < sample_time <= stop_time:
-            raise ValueError(f"sample_time = {sample_time!r} s: expected 0 < sample_time <= stop_time = {stop_time!r} s")
+            raise ValueError(f"sample_time = {sample_time!r} s: "
+                             f"expected 0 < sample_time <= stop_time = {stop_time!r} s")
         fmu = self.fmu
         if not self._fresh:
             fmu.reset()

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.paper import TABLE_1_FIT
+
 from .fits import IdentifiedModel, fit_percent
 from .testbed import TorqueProfile, WheelTestBed
 
@@ -21,7 +23,7 @@ VALIDATION_LOADS = (275.0, 575.0, 875.0)
 VALIDATION_TORQUES = (5.0, 10.0, 15.0, 20.0, 30.0, 40.0)
 HOLD = 0.1          # s per torque level
 SAMPLE_TIME = 1e-3  # s
-PAPER_FIT = {275.0: 82.1, 575.0: 96.8, 875.0: 96.2}  # Table 1 [%]
+PAPER_FIT = TABLE_1_FIT  # Table 1 [%]
 
 
 @dataclass

@@ -25,82 +25,97 @@ class LibcosimResult:
     wall_seconds: float
 
 
+class _Execution:
+    """A libcosim execution of ``system``: slaves, initial values, FMU-to-FMU connections, and the
+    FMU inputs driven by Python source blocks (set through an override manipulator)."""
+
+    def __init__(self, system: System):
+        from libcosimpy.CosimExecution import CosimExecution
+        from libcosimpy.CosimObserver import CosimObserver
+        from libcosimpy.CosimSlave import CosimLocalSlave
+
+        self.system = system
+        self.execution = CosimExecution.from_step_size(round(system.step * 1e9))
+        self.index: dict[str, int] = {}
+        self.refs: dict[str, dict[str, int]] = {}
+        for fmu in system.fmus:
+            self.index[fmu.name] = self.execution.add_local_slave(
+                CosimLocalSlave(fmu_path=str(fmu.path), instance_name=fmu.name))
+            self.refs[fmu.name] = {v.name: v.valueReference for v in fmu.description.modelVariables}
+            for variable, value in {**fmu.parameters, **fmu.start}.items():
+                self.execution.real_initial_value(self.index[fmu.name], self.refs[fmu.name][variable], value)
+        self.driven = self._connect()
+        self.blocks = {b.name: b.block for b in system.blocks}
+        t0 = self.block_values(system.start_time)
+        for source, target in self.driven:
+            self.execution.real_initial_value(self.index[target.instance], self.ref(target), t0[source])
+        self.observer = CosimObserver.create_last_value()
+        self.execution.add_observer(self.observer)
+
+    def ref(self, port: Port) -> int:
+        return self.refs[port.instance][port.variable]
+
+    def _connect(self) -> list[tuple[Port, Port]]:
+        """Connect FMU outputs to FMU inputs; returns the (block output, FMU input) pairs."""
+        driven: list[tuple[Port, Port]] = []
+        for connection in self.system.connections:
+            source, target = connection.source, connection.target
+            if source.instance in self.index and target.instance in self.index:
+                self.execution.connect_real_variables(self.index[source.instance], self.ref(source),
+                                                      self.index[target.instance], self.ref(target))
+            elif target.instance in self.index:
+                driven.append((source, target))
+        return driven
+
+    def block_values(self, t: float) -> dict[Port, float]:
+        outputs: dict[Port, float] = {}
+        for name, block in self.blocks.items():
+            values = block.start(t, np.zeros(0))
+            outputs.update({Port(name, o): float(v) for o, v in zip(block.outputs, values)})
+        return outputs
+
+    def sample(self) -> list[float]:
+        """The recorded values now (NaN for block outputs, which libcosim does not see)."""
+        return [self.observer.last_real_values(self.index[port.instance], [self.ref(port)])[0]
+                if port.instance in self.index else float("nan") for port in self.system.record]
+
+    def run(self, record: bool) -> list[list[float]]:
+        from libcosimpy.CosimManipulator import CosimManipulator
+
+        system = self.system
+        n_steps = round((system.stop_time - system.start_time) / system.step)
+        if not self.driven and not record:
+            self.execution.simulate_until(round(system.stop_time * 1e9))
+            return []
+        manipulator = None
+        if self.driven:
+            manipulator = CosimManipulator.create_override()
+            self.execution.add_manipulator(manipulator)
+        rows: list[list[float]] = []
+        for k in range(n_steps):
+            if manipulator is not None:
+                values = self.block_values(system.start_time + k * system.step)
+                for source, target in self.driven:
+                    manipulator.slave_real_values(self.index[target.instance], [self.ref(target)], [values[source]])
+            self.execution.step(1)
+            if record:
+                rows.append(self.sample())
+        return rows
+
+
 def run_libcosim(system: System, *, record: bool = True) -> LibcosimResult:
-    from libcosimpy.CosimExecution import CosimExecution
+    """Run ``system`` with libcosim; source blocks only (no blocks with inputs)."""
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimManipulator import CosimManipulator
-    from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy.CosimSlave import CosimLocalSlave
 
     if any(b.block.inputs for b in system.blocks):
         raise ValueError("libcosim runs support source blocks only (no blocks with inputs)")
     log_output_level(CosimLogLevel.ERROR)
     started = time.perf_counter()
-    nanoseconds = round(system.step * 1e9)
-    execution = CosimExecution.from_step_size(nanoseconds)
-    index: dict[str, int] = {}
-    refs: dict[str, dict[str, int]] = {}
-    for fmu in system.fmus:
-        index[fmu.name] = execution.add_local_slave(CosimLocalSlave(fmu_path=str(fmu.path), instance_name=fmu.name))
-        refs[fmu.name] = {v.name: v.valueReference for v in fmu.description.modelVariables}
-        for variable, value in {**fmu.parameters, **fmu.start}.items():
-            execution.real_initial_value(index[fmu.name], refs[fmu.name][variable], value)
-    driven: list[tuple[Port, Port]] = []  # (block output, FMU input)
-    for connection in system.connections:
-        source, target = connection.source, connection.target
-        if source.instance in index and target.instance in index:
-            execution.connect_real_variables(index[source.instance], refs[source.instance][source.variable],
-                                             index[target.instance], refs[target.instance][target.variable])
-        elif target.instance in index:
-            driven.append((source, target))
-    blocks = {b.name: b.block for b in system.blocks}
-
-    def block_values(t: float) -> dict[Port, float]:
-        outputs: dict[Port, float] = {}
-        for name, block in blocks.items():
-            values = block.start(t, np.zeros(0))
-            outputs.update({Port(name, o): float(v) for o, v in zip(block.outputs, values)})
-        return outputs
-
-    t0 = block_values(system.start_time)
-    for source, target in driven:
-        execution.real_initial_value(index[target.instance], refs[target.instance][target.variable], t0[source])
-
-    observer = CosimObserver.create_last_value()
-    execution.add_observer(observer)
-    n_steps = round((system.stop_time - system.start_time) / system.step)
-    rows: list[list[float]] = []
-
-    def sample() -> None:
-        row = []
-        for port in system.record:
-            if port.instance in index:
-                row.append(observer.last_real_values(index[port.instance], [refs[port.instance][port.variable]])[0])
-            else:
-                row.append(float("nan"))
-        rows.append(row)
-
-    if not driven and not record:
-        execution.simulate_until(round(system.stop_time * 1e9))
-    elif not driven:
-        for _ in range(n_steps):
-            execution.step(1)
-            sample()
-    else:
-        manipulator = CosimManipulator.create_override()
-        execution.add_manipulator(manipulator)
-        for k in range(n_steps):
-            t = system.start_time + k * system.step
-            values = block_values(t)
-            for source, target in driven:
-                manipulator.slave_real_values(index[target.instance], [refs[target.instance][target.variable]],
-                                              [values[source]])
-            execution.step(1)
-            if record:
-                sample()
+    rows = _Execution(system).run(record)
     wall = time.perf_counter() - started
     if not record:
         return LibcosimResult(None, wall)
+    n_steps = len(rows)
     data = pd.DataFrame(rows, columns=[str(p) for p in system.record])
     data.insert(0, "time", system.start_time + system.step * np.arange(1, n_steps + 1))
     return LibcosimResult(data, wall)

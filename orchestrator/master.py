@@ -1,25 +1,33 @@
-"""Master algorithms at a fixed communication step: Jacobi and Gauss-Seidel.
+"""Master algorithms at a fixed communication step, and :func:`run`.
 
-Every value exchanged or recorded has a slot in one vector ``values``; each participant reads its
-inputs from the slots of their sources (one gather and one batched set per step) and writes its
-outputs into its own slots (one batched get). Jacobi steps all participants from the values at
-``t`` and then exchanges; Gauss-Seidel steps them in order, each seeing the outputs at ``t + h``
-of those before it. Recorded values go into a preallocated array.
+Every value exchanged or recorded has a slot in one vector ``values`` (``wiring``); each
+participant reads its inputs from the slots of their sources and writes its outputs into its own
+slots. :class:`JacobiMaster` steps all participants from the values at ``t`` and then exchanges;
+:class:`GaussSeidelMaster` steps them in order, each seeing the outputs at ``t + h`` of those
+before it. Recorded values go into a preallocated array (``recorder``).
 """
 
 from __future__ import annotations
 
 import tempfile
 import time
-from collections.abc import Callable
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .participants import FmuParticipant, RunError
-from .system import BlockEntry, FmuEntry, Port, System
+from .participants import BlockParticipant, FmuParticipant, Participant, RunError
+from .recorder import Recorder
+from .system import System
+from .wiring import Wiring, wire
+
+#: Passes of the initial-output exchange among participants with an iterative start (FMUs in
+#: Initialization Mode), so that a chain of direct feedthrough two deep settles.
+INITIAL_PASSES = 2
 
 
 @dataclass
@@ -34,148 +42,115 @@ class RunResult:
         return self.wall_seconds - sum(self.step_seconds.values())
 
 
-class _Slots:
-    def __init__(self) -> None:
-        self.index: dict[Port, int] = {}
+class Master(ABC):
+    """Steps the participants (in the system's order) over one communication step, in place on
+    the value vector, and keeps the time spent inside each participant."""
 
-    def __call__(self, port: Port) -> int:
-        if port not in self.index:
-            self.index[port] = len(self.index)
-        return self.index[port]
+    def __init__(self, participants: list[Participant], wiring: Wiring):
+        self.participants = participants
+        self.inputs = [wiring.participants[p.name].input_slots for p in participants]
+        self.outputs = [wiring.participants[p.name].output_slots for p in participants]
+        self.step_seconds = {p.name: 0.0 for p in participants}
+
+    @abstractmethod
+    def step(self, values: np.ndarray, t: float, h: float) -> None:
+        """Advance every participant from ``t`` to ``t + h``; ``values`` then holds the outputs at ``t + h``."""
+
+
+class GaussSeidelMaster(Master):
+    """Participant after participant, each with the newest values of those before it."""
+
+    def step(self, values: np.ndarray, t: float, h: float) -> None:
+        clock = time.perf_counter
+        for participant, inputs, outputs in zip(self.participants, self.inputs, self.outputs):
+            begin = clock()
+            participant.do_step(t, h, values[inputs])
+            values[outputs] = participant.get_outputs(t + h)
+            self.step_seconds[participant.name] += clock() - begin
+
+
+class JacobiMaster(Master):
+    """Every participant from the values at ``t``; outputs exchanged after all have stepped."""
+
+    def step(self, values: np.ndarray, t: float, h: float) -> None:
+        clock = time.perf_counter
+        gathered = [values[inputs] for inputs in self.inputs]
+        for participant, u in zip(self.participants, gathered):
+            begin = clock()
+            participant.do_step(t, h, u)
+            self.step_seconds[participant.name] += clock() - begin
+        for participant, outputs in zip(self.participants, self.outputs):
+            begin = clock()
+            values[outputs] = participant.get_outputs(t + h)
+            self.step_seconds[participant.name] += clock() - begin
+
+
+MASTERS: dict[str, type[Master]] = {"jacobi": JacobiMaster, "gauss-seidel": GaussSeidelMaster}
+
+
+def initialize(participants: list[Participant], wiring: Wiring, values: np.ndarray, t0: float,
+               stop_time: float) -> None:
+    """FMI 2.0 initialization of every participant; ``values`` then holds the outputs at ``t0``."""
+    slots = {p.name: wiring.participants[p.name] for p in participants}
+
+    def initial(participant: Participant) -> None:
+        ports = slots[participant.name]
+        values[ports.output_slots] = participant.initial_outputs(t0, values[ports.input_slots])
+
+    for participant in participants:
+        participant.enter_initialization(t0, stop_time)
+    direct = [p for p in participants if not p.iterative_start]
+    iterative = [p for p in participants if p.iterative_start]
+    for participant in direct:  # sources first: their outputs do not depend on anyone
+        if not participant.inputs:
+            initial(participant)
+    for _ in range(INITIAL_PASSES):
+        for participant in iterative:
+            initial(participant)
+    for participant in direct:
+        if participant.inputs:
+            initial(participant)
+    for participant in participants:
+        ports = slots[participant.name]
+        values[ports.output_slots] = participant.exit_initialization(t0, values[ports.input_slots])
+
+
+@contextmanager
+def participants_of(system: System, wiring: Wiring) -> Iterator[list[Participant]]:
+    """The participants of ``system`` in its order, FMUs extracted into a temporary folder;
+    every FMU is terminated and freed on leaving, whatever happened."""
+    with ExitStack() as stack:
+        unzip_root = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="rover-cosim-run-")))
+        by_name: dict[str, Participant] = {}
+        for entry in system.fmus:
+            fmu = FmuParticipant(entry, unzip_root)
+            stack.callback(fmu.close)
+            ports = wiring.participants[entry.name]
+            fmu.configure(ports.inputs, ports.outputs)
+            by_name[entry.name] = fmu
+        for block in system.blocks:
+            by_name[block.name] = BlockParticipant(block.name, block.block)
+        yield [by_name[name] for name in system.order]
 
 
 def run(system: System, *, progress: Callable[[float], None] | None = None) -> RunResult:
     """Run ``system``; raises :class:`RunError` naming the participant, call and time on failure."""
     started = time.perf_counter()
-    source_of = {c.target: c.source for c in system.connections}
-    slots = _Slots()
-    entries: dict[str, FmuEntry | BlockEntry] = {e.name: e for e in [*system.fmus, *system.blocks]}
-
-    with tempfile.TemporaryDirectory(prefix="rover-cosim-run-") as unzip_root:
-        fmus: dict[str, FmuParticipant] = {}
-        try:
-            for entry in system.fmus:
-                fmus[entry.name] = FmuParticipant(entry, Path(unzip_root))
-            return _run(system, entries, fmus, source_of, slots, progress, started)
-        finally:
-            for participant in fmus.values():
-                participant.close()
-
-
-def _run(system: System, entries, fmus, source_of, slots, progress, started) -> RunResult:
-    # --- what each participant reads and where its inputs come from ------------------------------
-    reads: dict[str, list[str]] = {name: [] for name in entries}
-    constants: dict[int, float] = {}
-
-    def slot_of(port: Port) -> int:
-        """The slot holding the value of ``port`` (an input resolves to its source)."""
-        if port in source_of:
-            return slot_of(source_of[port])
-        entry = entries[port.instance]
-        if isinstance(entry, FmuEntry):
-            variable = entry.variables()[port.variable]
-            if variable.causality == "input":  # not connected: a start value, constant in time
-                slot = slots(port)
-                constants[slot] = entry.start.get(port.variable, float(variable.start or 0.0))
-                return slot
-            if port.variable not in reads[port.instance]:
-                reads[port.instance].append(port.variable)
-        return slots(port)
-
-    input_slots: dict[str, np.ndarray] = {}
-    connected_inputs: dict[str, list[str]] = {}
-    for name, entry in entries.items():
-        if isinstance(entry, FmuEntry):
-            inputs = [t.variable for t in source_of if t.instance == name]
-        else:
-            inputs = list(entry.block.inputs)
-        connected_inputs[name] = inputs
-        input_slots[name] = np.array([slot_of(source_of[Port(name, v)]) for v in inputs], dtype=int)
-    for entry in system.blocks:
-        for output in entry.block.outputs:
-            slots(Port(entry.name, output))
-    record_slots = np.array([slot_of(port) for port in system.record], dtype=int)
-    output_slots: dict[str, np.ndarray] = {}
-    for name, entry in entries.items():
-        if isinstance(entry, FmuEntry):
-            fmus[name].configure(connected_inputs[name], reads[name])
-            output_slots[name] = np.array([slots(Port(name, v)) for v in reads[name]], dtype=int)
-        else:
-            output_slots[name] = np.array([slots(Port(name, v)) for v in entry.block.outputs], dtype=int)
-
-    values = np.zeros(len(slots.index))
-    for slot, value in constants.items():
-        values[slot] = value
-
-    # --- initialization ---------------------------------------------------------------------------
+    wiring = wire(system)
     t0, h = system.start_time, system.step
     n_steps = round((system.stop_time - t0) / h)
-    order = system.order
-    blocks = {e.name: e.block for e in system.blocks}
-    for name in order:
-        if name in blocks and not blocks[name].inputs:
-            values[output_slots[name]] = blocks[name].start(t0, np.zeros(0))
-    for name in order:
-        if name in fmus:
-            fmus[name].setup(t0, system.stop_time)
-    for _ in range(2):  # outputs in Initialization Mode, exchanged twice so chains settle
-        for name in order:
-            if name in fmus:
-                fmus[name].set_inputs(values[input_slots[name]], t0)
-                values[output_slots[name]] = fmus[name].get_values(t0)
-    for name in order:
-        if name in blocks and blocks[name].inputs:
-            values[output_slots[name]] = blocks[name].start(t0, values[input_slots[name]])
-    for name in order:
-        if name in fmus:
-            fmus[name].set_inputs(values[input_slots[name]], t0)
-            fmus[name].finish_initialization()
-            values[output_slots[name]] = fmus[name].get_values(t0)
-
-    record = np.empty((n_steps + 1, record_slots.size))
-    times = t0 + h * np.arange(n_steps + 1)
-    record[0] = values[record_slots]
-    step_seconds = dict.fromkeys(order, 0.0)
-    gauss_seidel = system.algorithm == "gauss-seidel"
-    clock = time.perf_counter
-
-    # --- stepping ---------------------------------------------------------------------------------
-    for k in range(n_steps):
-        t = float(times[k])
-        if gauss_seidel:
-            for name in order:
-                begin = clock()
-                if name in fmus:
-                    fmu = fmus[name]
-                    fmu.set_inputs(values[input_slots[name]], t)
-                    fmu.do_step(t, h)
-                    values[output_slots[name]] = fmu.get_values(t + h)
-                else:
-                    values[output_slots[name]] = blocks[name].step(t, h, values[input_slots[name]])
-                step_seconds[name] += clock() - begin
-        else:
-            gathered = {name: values[input_slots[name]] for name in order}
-            for name in order:
-                begin = clock()
-                if name in fmus:
-                    fmus[name].set_inputs(gathered[name], t)
-                    fmus[name].do_step(t, h)
-                else:
-                    values[output_slots[name]] = blocks[name].step(t, h, gathered[name])
-                step_seconds[name] += clock() - begin
-            for name in fmus:
-                begin = clock()
-                values[output_slots[name]] = fmus[name].get_values(t + h)
-                step_seconds[name] += clock() - begin
-        record[k + 1] = values[record_slots]
-        if progress is not None:
-            progress((k + 1) / n_steps)
-
-    wall = time.perf_counter() - started
-    columns = [str(port) for port in system.record]
-    data = pd.DataFrame(record, columns=columns)
-    data.insert(0, "time", times)
-    return RunResult(data, wall, n_steps, step_seconds)
+    with participants_of(system, wiring) as participants:
+        values = wiring.initial_values()
+        initialize(participants, wiring, values, t0, system.stop_time)
+        master = MASTERS[system.algorithm](participants, wiring)
+        recorder = Recorder(system.record, wiring.record_slots, t0, h, n_steps)
+        recorder.sample(0, values)
+        for k in range(n_steps):
+            master.step(values, float(recorder.times[k]), h)
+            recorder.sample(k + 1, values)
+            if progress is not None:
+                progress((k + 1) / n_steps)
+        return RunResult(recorder.frame(), time.perf_counter() - started, n_steps, master.step_seconds)
 
 
-__all__ = ["RunError", "RunResult", "run"]
+__all__ = ["GaussSeidelMaster", "JacobiMaster", "Master", "RunError", "RunResult", "initialize", "run"]

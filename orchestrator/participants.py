@@ -1,11 +1,23 @@
-"""An FMU instance in a co-simulation: FMPy's FMI 2.0 slave with batched, preallocated value
-exchange (one fmi2SetReal of all connected inputs and one fmi2GetReal of all needed variables
-per step), and errors turned into :class:`RunError` with the FMU's own message."""
+"""Participants of a co-simulation: the protocol the masters step, and its two kinds.
+
+- :class:`FmuParticipant`: an FMU instance, FMPy's FMI 2.0 slave with batched, preallocated value
+  exchange (one fmi2SetReal of all connected inputs and one fmi2GetReal of all needed variables
+  per step), errors turned into :class:`RunError` with the FMU's own message;
+- :class:`BlockParticipant`: a Python block (``blocks.Block``), its exceptions turned into
+  :class:`RunError` naming the block.
+
+Initialization follows FMI 2.0: every participant enters initialization, participants with
+``iterative_start`` (FMUs, in Initialization Mode) exchange their initial outputs with the
+others until the chains settle, the others (blocks) compute theirs once from the settled
+inputs, and everyone exits initialization.
+"""
 
 from __future__ import annotations
 
 import ctypes
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any, Protocol, TypeVar
 
 import fmpy
 import numpy as np
@@ -16,14 +28,89 @@ from fmpy.fmi2 import (
     fmi2CallbackLoggerTYPE,
 )
 
+from .blocks import Block
 from .system import FmuEntry
+
+T = TypeVar("T")
 
 
 class RunError(RuntimeError):
     """A co-simulation run that failed; the message names the instance, the call and the time."""
 
 
+class Participant(Protocol):
+    """What a master needs of a participant. ``u`` is always in the order of ``inputs``; the
+    returned arrays are in the order of ``outputs`` and may be reused by the next call."""
+
+    name: str
+    inputs: list[str]
+    outputs: list[str]
+    iterative_start: bool  # initial outputs exchanged with the others before exiting initialization
+
+    def enter_initialization(self, t0: float, stop_time: float) -> None: ...
+
+    def initial_outputs(self, t0: float, u: np.ndarray) -> np.ndarray: ...
+
+    def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray: ...
+
+    def do_step(self, t: float, h: float, u: np.ndarray) -> None: ...
+
+    def get_outputs(self, t: float) -> np.ndarray: ...
+
+    def close(self) -> None: ...
+
+
+class BlockParticipant:
+    """A Python block in a run; ``outputs`` are the block's, ``inputs`` its (connected) inputs."""
+
+    iterative_start = False
+
+    def __init__(self, name: str, block: Block):
+        self.name = name
+        self.block = block
+        self.inputs = list(block.inputs)
+        self.outputs = list(block.outputs)
+        self.last = np.zeros(len(self.outputs))
+
+    def _call(self, what: str, action: Callable[[], Any], t: float) -> np.ndarray:
+        try:
+            values = np.asarray(action(), dtype=float)
+        except RunError:
+            raise
+        except Exception as error:  # noqa: BLE001 - any failure of user code names the block
+            raise RunError(f"{self.name} (block): {what} at t = {t:.6g} s failed: "
+                           f"{type(error).__name__}: {error}") from error
+        if values.shape != (len(self.outputs),):
+            raise RunError(f"{self.name} (block): {what} at t = {t:.6g} s returned {values.size} values; "
+                           f"expected {len(self.outputs)} ({', '.join(self.outputs)})")
+        return values
+
+    def enter_initialization(self, t0: float, stop_time: float) -> None:
+        """Nothing to do: a block starts in ``initial_outputs``."""
+
+    def initial_outputs(self, t0: float, u: np.ndarray) -> np.ndarray:
+        self.last = self._call("start", lambda: self.block.start(t0, u), t0)
+        return self.last
+
+    def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray:
+        return self.last
+
+    def do_step(self, t: float, h: float, u: np.ndarray) -> None:
+        self.last = self._call("step", lambda: self.block.step(t, h, u), t)
+
+    def get_outputs(self, t: float) -> np.ndarray:
+        return self.last
+
+    def close(self) -> None:
+        """Blocks hold no external resources."""
+
+
 class FmuParticipant:
+    """An FMU instance in a run; ``inputs`` are its connected inputs, ``outputs`` the variables
+    read from it (connected or recorded), both fixed by :meth:`configure`."""
+
+    iterative_start = True
+
     def __init__(self, entry: FmuEntry, unzip_root: Path):
         self.name = entry.name
         self.entry = entry
@@ -40,7 +127,7 @@ class FmuParticipant:
         self._callbacks.freeMemory = defaultCallbacks.freeMemory
         self._call("fmi2Instantiate", lambda: self.fmu.instantiate(callbacks=self._callbacks))
         self.inputs: list[str] = []
-        self.reads: list[str] = []
+        self.outputs: list[str] = []
         self.input_values = np.zeros(0)
         self.read_values = np.zeros(0)
 
@@ -48,7 +135,7 @@ class FmuParticipant:
         if status >= 2:  # discard, error, fatal
             self.messages.append(message.decode(errors="replace"))
 
-    def _call(self, what: str, action, t: float | None = None):
+    def _call(self, what: str, action: Callable[[], T], t: float | None = None) -> T:
         try:
             return action()
         except Exception as error:  # noqa: BLE001 - FMPy raises plain Exceptions on fmi2Error
@@ -58,7 +145,7 @@ class FmuParticipant:
 
     def configure(self, inputs: list[str], reads: list[str]) -> None:
         """Fix the inputs set and the variables read at every step (preallocated arrays)."""
-        self.inputs, self.reads = list(inputs), list(reads)
+        self.inputs, self.outputs = list(inputs), list(reads)
         self._in_refs = (ctypes.c_uint * max(1, len(inputs)))(*[self.refs[n] for n in inputs])
         self._read_refs = (ctypes.c_uint * max(1, len(reads)))(*[self.refs[n] for n in reads])
         self.input_values = np.zeros(len(inputs))
@@ -70,14 +157,21 @@ class FmuParticipant:
         if names:
             self._call("fmi2SetReal", lambda: self.fmu.setReal([self.refs[n] for n in names], list(names.values())))
 
-    def setup(self, start_time: float, stop_time: float) -> None:
-        self._call("fmi2SetupExperiment", lambda: self.fmu.setupExperiment(startTime=start_time, stopTime=stop_time))
+    def enter_initialization(self, t0: float, stop_time: float) -> None:
+        """fmi2SetupExperiment, the parameters and start values, fmi2EnterInitializationMode."""
+        self._call("fmi2SetupExperiment", lambda: self.fmu.setupExperiment(startTime=t0, stopTime=stop_time))
         self.set_values(self.entry.parameters)
         self.set_values(self.entry.start)
         self._call("fmi2EnterInitializationMode", self.fmu.enterInitializationMode)
 
-    def finish_initialization(self) -> None:
+    def initial_outputs(self, t0: float, u: np.ndarray) -> np.ndarray:
+        self.set_inputs(u, t0)
+        return self.get_outputs(t0)
+
+    def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray:
+        self.set_inputs(u, t0)
         self._call("fmi2ExitInitializationMode", self.fmu.exitInitializationMode)
+        return self.get_outputs(t0)
 
     def set_inputs(self, values: np.ndarray, t: float) -> None:
         """Set all connected inputs in one call (values in the order given to configure)."""
@@ -87,14 +181,16 @@ class FmuParticipant:
         self._call("fmi2SetReal", lambda: self.fmu.fmi2SetReal(self.fmu.component, self._in_refs, len(self.inputs),
                                                                self._in_pointer), t)
 
-    def get_values(self, t: float) -> np.ndarray:
+    def get_outputs(self, t: float) -> np.ndarray:
         """All read variables in one call; the returned array is reused by the next call."""
-        if self.reads:
+        if self.outputs:
             self._call("fmi2GetReal", lambda: self.fmu.fmi2GetReal(self.fmu.component, self._read_refs,
-                                                                   len(self.reads), self._read_pointer), t)
+                                                                   len(self.outputs), self._read_pointer), t)
         return self.read_values
 
-    def do_step(self, t: float, h: float) -> None:
+    def do_step(self, t: float, h: float, u: np.ndarray) -> None:
+        """Set the inputs held over the step, then fmi2DoStep from ``t`` to ``t + h``."""
+        self.set_inputs(u, t)
         self._call("fmi2DoStep", lambda: self.fmu.fmi2DoStep(self.fmu.component, t, h, 1), t)
 
     def close(self) -> None:

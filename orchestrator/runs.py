@@ -5,8 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+
 from .master import RunResult
-from .outputs import file_sha256, json_bytes, run_record, write_all
 from .system import System
 
 

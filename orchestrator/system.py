@@ -42,7 +42,7 @@ from typing import Any
 
 import fmpy
 
-from fmubuild.units import base_units
+from rover_cosim.common.units import base_units
 
 from .blocks import Block, make_block
 
@@ -101,11 +101,23 @@ class System:
     order: list[str] = field(default_factory=list)
     record: list[Port] = field(default_factory=list)
 
+    def participants(self) -> dict[str, FmuEntry | BlockEntry]:
+        """Every FMU and block entry by instance name."""
+        entries: dict[str, FmuEntry | BlockEntry] = {f.name: f for f in self.fmus}
+        entries.update({b.name: b for b in self.blocks})
+        return entries
+
     def participant(self, name: str) -> FmuEntry | BlockEntry:
-        for entry in [*self.fmus, *self.blocks]:
-            if entry.name == name:
-                return entry
-        raise KeyError(name)
+        return self.participants()[name]
+
+
+#: The keys each section of a system file may have.
+SECTION_KEYS = {
+    "simulation": {"stop_time", "step", "start_time", "algorithm", "order"},
+    "fmu": {"name", "path", "parameters", "start"},
+    "connection": {"from", "to"},
+    "record": {"variables"},
+}
 
 
 def _port(text: Any, where: str) -> Port:
@@ -129,6 +141,42 @@ def _table(value: Any, where: str) -> dict[str, Any]:
     return value
 
 
+def _tables(value: Any, where: str) -> list[dict[str, Any]]:
+    """An array of tables (``[[fmu]]``, ``[[block]]``, ``[[connection]]``); absent is empty."""
+    if value is None:
+        return []
+    if not isinstance(value, list):
+        raise SystemFileError(f"{where}: expected an array of tables ([[...]] entries)")
+    return [_table(entry, f"{where} {i}") for i, entry in enumerate(value, start=1)]
+
+
+class _Context:
+    """The file being parsed (for messages), where relative FMU paths start, the names in use."""
+
+    def __init__(self, name: str, base: Path):
+        self.name, self.base = name, base
+        self.names: set[str] = set()
+
+    def error(self, where: str, message: str) -> SystemFileError:
+        return SystemFileError(f"{self.name}: {where}: {message}")
+
+    def number(self, value: Any, where: str) -> float:
+        return _number(value, f"{self.name}: {where}")
+
+    def known_keys(self, entry: dict[str, Any], section: str, where: str) -> None:
+        unknown = set(entry) - SECTION_KEYS[section]
+        if unknown:
+            raise self.error(where, f"unknown key(s) {sorted(unknown)}; expected {sorted(SECTION_KEYS[section])}")
+
+    def claim(self, instance: Any, where: str) -> str:
+        if not isinstance(instance, str) or not instance or "." in instance:
+            raise self.error(where, f"name = {instance!r}: expected a non-empty name without dots")
+        if instance in self.names:
+            raise self.error(where, f"name {instance!r} is used twice")
+        self.names.add(instance)
+        return instance
+
+
 def load_system(path: Path | str, *, fmu_dir: Path | None = None) -> System:
     """Read and validate a system file. Relative FMU paths are resolved against ``fmu_dir`` if
     given, else against the file's folder."""
@@ -143,166 +191,215 @@ def load_system(path: Path | str, *, fmu_dir: Path | None = None) -> System:
 
 
 def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path | None = None) -> System:
-    def error(where: str, message: str) -> SystemFileError:
-        return SystemFileError(f"{name}: {where}: {message}")
-
+    """A checked :class:`System` from the parsed TOML ``data`` (``name`` is used in messages)."""
+    context = _Context(name, base)
+    unknown = set(data) - {"simulation", "fmu", "block", "connection", "record"}
+    if unknown:
+        raise context.error("top level", f"unknown table(s) {sorted(unknown)}; expected [simulation], [[fmu]], "
+                            "[[block]], [[connection]], [record]")
     simulation = _table(data.get("simulation"), f"{name}: [simulation]")
+    step, stop_time, start_time, algorithm = parse_simulation(simulation, context)
+    fmus = [parse_fmu(entry, i, context) for i, entry in enumerate(_tables(data.get("fmu"), f"{name}: [[fmu]]"), 1)]
+    blocks = [parse_block(entry, i, context)
+              for i, entry in enumerate(_tables(data.get("block"), f"{name}: [[block]]"), 1)]
+    if not fmus and not blocks:
+        raise context.error("[[fmu]]", "the system has no FMU and no block")
+    ports = _PortTable(fmus, blocks, context)
+    connections = parse_connections(_tables(data.get("connection"), f"{name}: [[connection]]"), ports, context)
+    check_inputs_driven(fmus, blocks, connections, context)
+    order = parse_order(simulation.get("order"), fmus, blocks, context)
+    record = parse_record(_table(data.get("record"), f"{name}: [record]"), order, ports, context)
+    return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, order, record)
+
+
+def parse_simulation(simulation: dict[str, Any], context: _Context) -> tuple[float, float, float, str]:
+    """[simulation]: (step, stop_time, start_time [s], algorithm)."""
+    context.known_keys(simulation, "simulation", "[simulation]")
     for key in ("stop_time", "step"):
         if key not in simulation:
-            raise error("[simulation]", f"{key} is missing (seconds)")
-    step = _number(simulation["step"], f"{name}: [simulation] step")
-    stop_time = _number(simulation["stop_time"], f"{name}: [simulation] stop_time")
-    start_time = _number(simulation.get("start_time", 0.0), f"{name}: [simulation] start_time")
+            raise context.error("[simulation]", f"{key} is missing (seconds)")
+    step = context.number(simulation["step"], "[simulation] step")
+    stop_time = context.number(simulation["stop_time"], "[simulation] stop_time")
+    start_time = context.number(simulation.get("start_time", 0.0), "[simulation] start_time")
     if not step > 0:
-        raise error("[simulation] step", f"{step!r}: expected a communication step > 0 s")
+        raise context.error("[simulation] step", f"{step!r}: expected a communication step > 0 s")
     if not stop_time > start_time:
-        raise error("[simulation] stop_time", f"{stop_time!r}: expected a stop time > start time {start_time} s")
+        raise context.error("[simulation] stop_time",
+                            f"{stop_time!r}: expected a stop time > start time {start_time} s")
     if step > stop_time - start_time:
-        raise error("[simulation] step", f"{step!r} s is longer than the run ({stop_time - start_time!r} s)")
+        raise context.error("[simulation] step", f"{step!r} s is longer than the run ({stop_time - start_time!r} s)")
     algorithm = simulation.get("algorithm", "gauss-seidel")
     if algorithm not in ALGORITHMS:
-        raise error("[simulation] algorithm", f"{algorithm!r}: expected one of {', '.join(ALGORITHMS)}")
-    unknown_keys = set(simulation) - {"stop_time", "step", "start_time", "algorithm", "order"}
-    if unknown_keys:
-        raise error("[simulation]", f"unknown key(s) {sorted(unknown_keys)}")
+        raise context.error("[simulation] algorithm", f"{algorithm!r}: expected one of {', '.join(ALGORITHMS)}")
+    return step, stop_time, start_time, algorithm
 
-    names: set[str] = set()
 
-    def claim(instance: str, where: str) -> None:
-        if not isinstance(instance, str) or not instance or "." in instance:
-            raise error(where, f"name = {instance!r}: expected a non-empty name without dots")
-        if instance in names:
-            raise error(where, f"name {instance!r} is used twice")
-        names.add(instance)
+def _read_fmu(fmu_path: Path, where: str, context: _Context) -> Any:
+    """The model description of an FMI 2.0 Co-Simulation FMU file."""
+    if not fmu_path.is_file():
+        raise context.error(where, f"FMU file {fmu_path} not found (run `make fmus`?)")
+    try:
+        description = fmpy.read_model_description(str(fmu_path))
+    except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds
+        raise context.error(where, f"{fmu_path} is not a readable FMU: {failure}") from None
+    if description.fmiVersion != "2.0" or description.coSimulation is None:
+        raise context.error(where, f"{fmu_path}: expected an FMI 2.0 Co-Simulation FMU (got FMI "
+                            f"{description.fmiVersion}, CS {'yes' if description.coSimulation else 'no'})")
+    return description
 
-    fmus: list[FmuEntry] = []
-    for i, entry in enumerate(data.get("fmu", []), start=1):
-        where = f"[[fmu]] {i}"
-        entry = _table(entry, f"{name}: {where}")
-        instance = entry.get("name")
-        claim(instance, where)
-        where = f"[[fmu]] {instance!r}"
-        if "path" not in entry:
-            raise error(where, "path is missing")
-        fmu_path = Path(entry["path"])
-        if not fmu_path.is_absolute():
-            fmu_path = base / fmu_path
-        if not fmu_path.is_file():
-            raise error(where, f"FMU file {fmu_path} not found (run `make fmus`?)")
-        try:
-            description = fmpy.read_model_description(str(fmu_path))
-        except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds
-            raise error(where, f"{fmu_path} is not a readable FMU: {failure}") from None
-        if description.fmiVersion != "2.0" or description.coSimulation is None:
-            raise error(where, f"{fmu_path}: expected an FMI 2.0 Co-Simulation FMU "
-                        f"(got FMI {description.fmiVersion}, CS {'yes' if description.coSimulation else 'no'})")
-        fmu = FmuEntry(instance, fmu_path, {}, {}, description)
-        variables = fmu.variables()
-        for key, table in (("parameters", fmu.parameters), ("start", fmu.start)):
-            for variable, value in _table(entry.get(key), f"{name}: {where} {key}").items():
-                if variable not in variables:
-                    raise error(f"{where} {key}", f"{instance} has no variable {variable!r}")
-                v = variables[variable]
-                if key == "parameters" and v.causality != "parameter":
-                    raise error(f"{where} parameters", f"{instance}.{variable} is not a parameter "
+
+def _fmu_values(fmu: FmuEntry, key: str, values: dict[str, Any], where: str, context: _Context) -> dict[str, float]:
+    """``parameters`` or ``start`` of an [[fmu]] entry, checked against the FMU's variables."""
+    variables = fmu.variables()
+    checked: dict[str, float] = {}
+    for variable, value in values.items():
+        if variable not in variables:
+            raise context.error(f"{where} {key}", f"{fmu.name} has no variable {variable!r}")
+        v = variables[variable]
+        if key == "parameters" and v.causality != "parameter":
+            raise context.error(f"{where} parameters", f"{fmu.name}.{variable} is not a parameter "
                                 f"(causality {v.causality}); inputs and states go under start")
-                if key == "start" and not (v.causality == "input" or v.initial in ("exact", "approx")):
-                    raise error(f"{where} start", f"{instance}.{variable} cannot be given a start value "
+        if key == "start" and not (v.causality == "input" or v.initial in ("exact", "approx")):
+            raise context.error(f"{where} start", f"{fmu.name}.{variable} cannot be given a start value "
                                 f"(causality {v.causality}, initial {v.initial})")
-                table[variable] = _number(value, f"{name}: {where} {key} {variable}")
-        unknown_keys = set(entry) - {"name", "path", "parameters", "start"}
-        if unknown_keys:
-            raise error(where, f"unknown key(s) {sorted(unknown_keys)}")
-        fmus.append(fmu)
+        checked[variable] = context.number(value, f"{where} {key} {variable}")
+    return checked
 
-    blocks: list[BlockEntry] = []
-    for i, entry in enumerate(data.get("block", []), start=1):
-        where = f"[[block]] {i}"
-        entry = _table(entry, f"{name}: {where}")
-        instance = entry.get("name")
-        claim(instance, where)
-        kind = entry.get("type")
-        params = {k: v for k, v in entry.items() if k not in ("name", "type")}
-        try:
-            block = make_block(instance, kind, params)
-        except ValueError as failure:
-            raise error(f"[[block]] {instance!r}", str(failure)) from None
-        blocks.append(BlockEntry(instance, kind, block))
 
-    if not fmus and not blocks:
-        raise error("[[fmu]]", "the system has no FMU and no block")
+def parse_fmu(entry: dict[str, Any], number: int, context: _Context) -> FmuEntry:
+    """One [[fmu]] entry: name, path (relative to the base folder), parameters, start values."""
+    instance = context.claim(entry.get("name"), f"[[fmu]] {number}")
+    where = f"[[fmu]] {instance!r}"
+    context.known_keys(entry, "fmu", where)
+    if "path" not in entry:
+        raise context.error(where, "path is missing")
+    if not isinstance(entry["path"], str):
+        raise context.error(where, f"path = {entry['path']!r}: expected a file name")
+    fmu_path = Path(entry["path"])
+    if not fmu_path.is_absolute():
+        fmu_path = context.base / fmu_path
+    fmu = FmuEntry(instance, fmu_path, {}, {}, _read_fmu(fmu_path, where, context))
+    for key in ("parameters", "start"):
+        values = _table(entry.get(key), f"{context.name}: {where} {key}")
+        getattr(fmu, key).update(_fmu_values(fmu, key, values, where, context))
+    return fmu
 
-    def lookup(port: Port, where: str) -> tuple[str, str | None]:
-        """(causality, unit) of a port; errors for unknown instances and variables."""
-        if port.instance not in names:
-            raise error(where, f"no instance {port.instance!r}; expected one of {', '.join(sorted(names))}")
-        for fmu in fmus:
-            if fmu.name == port.instance:
-                variables = fmu.variables()
-                if port.variable not in variables:
-                    raise error(where, f"{fmu.name} ({fmu.path.name}) has no variable {port.variable!r}")
-                v = variables[port.variable]
-                return v.causality, v.unit
-        block = next(b.block for b in blocks if b.name == port.instance)
+
+def parse_block(entry: dict[str, Any], number: int, context: _Context) -> BlockEntry:
+    """One [[block]] entry: name, type and the block's own keys."""
+    instance = context.claim(entry.get("name"), f"[[block]] {number}")
+    kind = entry.get("type")
+    if not isinstance(kind, str):
+        raise context.error(f"[[block]] {instance!r}", f"type = {kind!r}: expected a block type name")
+    params = {k: v for k, v in entry.items() if k not in ("name", "type")}
+    try:
+        block = make_block(instance, kind, params)
+    except ValueError as failure:
+        raise context.error(f"[[block]] {instance!r}", str(failure)) from None
+    return BlockEntry(instance, kind, block)
+
+
+class _PortTable:
+    """Causality and unit of every port of the system's participants."""
+
+    def __init__(self, fmus: list[FmuEntry], blocks: list[BlockEntry], context: _Context):
+        self.fmus = {f.name: f for f in fmus}
+        self.blocks = {b.name: b.block for b in blocks}
+        self.context = context
+
+    def lookup(self, port: Port, where: str) -> tuple[str, str | None]:
+        """(causality, unit) of ``port``; errors for unknown instances and variables."""
+        names = sorted([*self.fmus, *self.blocks])
+        if port.instance in self.fmus:
+            fmu = self.fmus[port.instance]
+            variables = fmu.variables()
+            if port.variable not in variables:
+                raise self.context.error(where, f"{fmu.name} ({fmu.path.name}) has no variable {port.variable!r}")
+            v = variables[port.variable]
+            return v.causality, v.unit
+        if port.instance not in self.blocks:
+            raise self.context.error(where, f"no instance {port.instance!r}; expected one of {', '.join(names)}")
+        block = self.blocks[port.instance]
         if port.variable in block.inputs:
             return "input", block.units.get(port.variable)
         if port.variable in block.outputs:
             return "output", block.units.get(port.variable)
-        raise error(where, f"block {port.instance} has no variable {port.variable!r} "
-                    f"(inputs {list(block.inputs)}, outputs {list(block.outputs)})")
+        raise self.context.error(where, f"block {port.instance} has no variable {port.variable!r} "
+                                 f"(inputs {list(block.inputs)}, outputs {list(block.outputs)})")
 
+    def outputs(self, instance: str) -> list[Port]:
+        if instance in self.fmus:
+            return [Port(instance, v.name) for v in self.fmus[instance].description.modelVariables
+                    if v.causality == "output"]
+        return [Port(instance, o) for o in self.blocks[instance].outputs]
+
+
+def _check_connection(source: Port, target: Port, ports: _PortTable, where: str, context: _Context) -> None:
+    source_causality, source_unit = ports.lookup(source, where)
+    target_causality, target_unit = ports.lookup(target, where)
+    if source_causality != "output":
+        raise context.error(where, f"{source} is not an output (causality {source_causality}); "
+                            "a connection goes from an output to an input")
+    if target_causality != "input":
+        raise context.error(where, f"{target} is not an input (causality {target_causality}); "
+                            "a connection goes from an output to an input")
+    if source_unit is not None and target_unit is not None and base_units(source_unit) != base_units(target_unit):
+        raise context.error(where, f"unit mismatch: {source} is in {source_unit}, {target} in {target_unit}")
+
+
+def parse_connections(entries: list[dict[str, Any]], ports: _PortTable, context: _Context) -> list[Connection]:
+    """[[connection]] entries: from an output to an input of the same unit, each input once."""
     connections: list[Connection] = []
     driven: dict[Port, int] = {}
-    for i, entry in enumerate(data.get("connection", []), start=1):
-        entry = _table(entry, f"{name}: [[connection]] {i}")
+    for i, entry in enumerate(entries, start=1):
         where = f"[[connection]] {i} (from = {entry.get('from')!r}, to = {entry.get('to')!r})"
-        source = _port(entry.get("from"), f"{name}: {where} from")
-        target = _port(entry.get("to"), f"{name}: {where} to")
-        source_causality, source_unit = lookup(source, where)
-        target_causality, target_unit = lookup(target, where)
-        if source_causality != "output":
-            raise error(where, f"{source} is not an output (causality {source_causality}); "
-                        "a connection goes from an output to an input")
-        if target_causality != "input":
-            raise error(where, f"{target} is not an input (causality {target_causality}); "
-                        "a connection goes from an output to an input")
-        if source_unit is not None and target_unit is not None and base_units(source_unit) != base_units(target_unit):
-            raise error(where, f"unit mismatch: {source} is in {source_unit}, {target} in {target_unit}")
+        context.known_keys(entry, "connection", where)
+        source = _port(entry.get("from"), f"{context.name}: {where} from")
+        target = _port(entry.get("to"), f"{context.name}: {where} to")
+        _check_connection(source, target, ports, where, context)
         if target in driven:
-            raise error(where, f"input {target} is connected twice (also by [[connection]] {driven[target]})")
+            raise context.error(where, f"input {target} is connected twice (also by [[connection]] {driven[target]})")
         driven[target] = i
         connections.append(Connection(i, source, target))
+    return connections
 
+
+def check_inputs_driven(fmus: list[FmuEntry], blocks: list[BlockEntry], connections: list[Connection],
+                        context: _Context) -> None:
+    """Every FMU input connected or given a start value; every block input connected."""
+    driven = {c.target for c in connections}
     for fmu in fmus:
         for v in fmu.description.modelVariables:
             if v.causality == "input" and Port(fmu.name, v.name) not in driven and v.name not in fmu.start:
-                raise error(f"[[fmu]] {fmu.name!r}", f"input {fmu.name}.{v.name} is neither connected nor "
-                            "given a value (add a [[connection]] or start = {{ ... }})")
+                raise context.error(f"[[fmu]] {fmu.name!r}", f"input {fmu.name}.{v.name} is neither connected nor "
+                                    "given a value (add a [[connection]] or start = { ... })")
     for entry in blocks:
         for variable in entry.block.inputs:
             if Port(entry.name, variable) not in driven:
-                raise error(f"[[block]] {entry.name!r}", f"input {entry.name}.{variable} is not connected")
+                raise context.error(f"[[block]] {entry.name!r}", f"input {entry.name}.{variable} is not connected")
 
-    order = simulation.get("order")
+
+def parse_order(order: Any, fmus: list[FmuEntry], blocks: list[BlockEntry], context: _Context) -> list[str]:
+    """[simulation] order: every instance once; default: sources, FMUs, other blocks."""
     if order is None:
-        order = ([b.name for b in blocks if not b.block.inputs] + [f.name for f in fmus]
-                 + [b.name for b in blocks if b.block.inputs])
-    elif not isinstance(order, list) or sorted(order) != sorted(names):
-        raise error("[simulation] order", f"{order!r}: expected every instance once: {sorted(names)}")
+        return ([b.name for b in blocks if not b.block.inputs] + [f.name for f in fmus]
+                + [b.name for b in blocks if b.block.inputs])
+    if not isinstance(order, list) or sorted(map(str, order)) != sorted(context.names):
+        raise context.error("[simulation] order", f"{order!r}: expected every instance once: {sorted(context.names)}")
+    return [str(name) for name in order]
 
-    record_table = _table(data.get("record"), f"{name}: [record]")
+
+def parse_record(record_table: dict[str, Any], order: list[str], ports: _PortTable, context: _Context) -> list[Port]:
+    """[record] variables: the recorded ports; default: every output of every participant."""
+    context.known_keys(record_table, "record", "[record]")
+    if "variables" not in record_table:
+        return [port for instance in order for port in ports.outputs(instance)]
+    variables = record_table["variables"]
+    if not isinstance(variables, list):
+        raise context.error("[record] variables", f"{variables!r}: expected a list of \"instance.variable\"")
     record: list[Port] = []
-    if "variables" in record_table:
-        for text in record_table["variables"]:
-            port = _port(text, f"{name}: [record] variables")
-            lookup(port, f"[record] variables {text!r}")
-            record.append(port)
-    else:
-        for instance in order:
-            participant = next(e for e in [*fmus, *blocks] if e.name == instance)
-            if isinstance(participant, FmuEntry):
-                record += [Port(instance, v.name) for v in participant.description.modelVariables
-                           if v.causality == "output"]
-            else:
-                record += [Port(instance, o) for o in participant.block.outputs]
-    return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, list(order), record)
+    for text in variables:
+        port = _port(text, f"{context.name}: [record] variables")
+        ports.lookup(port, f"[record] variables {text!r}")
+        record.append(port)
+    return record

@@ -1,4 +1,5 @@
-"""Pure-numpy reference wheel: Wong-Reece/Ishigami terramechanics as in Yoshikawa et al.
+"""``rover_cosim.terramechanics``, the pure-numpy reference wheel: Wong-Reece/Ishigami
+terramechanics as in Yoshikawa et al.
 
 Public API: ``Wheel``, ``Soil`` (parameters, Table 2 defaults), ``slip_ratio`` (Eq. 4),
 ``contact_forces`` (Eqs. 1-13) and ``wheel_state`` (sinkage solving Fz = W).

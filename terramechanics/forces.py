@@ -20,8 +20,9 @@ Rows are processed in blocks so that the (rows, pieces, nodes) temporaries stay 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
-from typing import Callable, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike

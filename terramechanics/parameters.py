@@ -97,7 +97,7 @@ class Soil:
         _check("lam", self.lam, 0 < self.lam <= 1, "0 < lam <= 1")
 
     @classmethod
-    def from_degrees(cls, phi_deg: float, **others: float) -> "Soil":
+    def from_degrees(cls, phi_deg: float, **others: float) -> Soil:
         """Soil with the friction angle given in degrees [deg]; other fields as keywords."""
         _check("phi_deg", phi_deg, isinstance(phi_deg, (int, float)) and 0 < phi_deg < 90,
                "0 < phi_deg < 90 deg")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import simpson
 
-from terramechanics import (
+from rover_cosim.terramechanics import (
     Soil,
     Wheel,
     entry_angle,

@@ -4,8 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from orchestrator import cli, fig3
-from orchestrator.outputs import write_all
+from rover_cosim import cli
+from rover_cosim.common.outputs import write_all
+from rover_cosim.jobs import fig3
 
 
 def test_fig3_writes_csv_png_and_record(tmp_path, capsys):

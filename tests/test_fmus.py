@@ -17,7 +17,6 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
-from conftest import FMU_DIR
 from fmpy.fmi2 import (
     FMU2Model,
     FMU2Slave,
@@ -27,9 +26,9 @@ from fmpy.fmi2 import (
 )
 from fmpy.validation import validate_fmu
 
-from fmubuild import build, source
-from fmubuild.expressions import UnsupportedConstruct
-from terramechanics import Wheel, slip_ratio, wheel_state
+from rover_cosim.fmubuild import build, source
+from rover_cosim.fmubuild.expressions import UnsupportedConstruct
+from rover_cosim.terramechanics import Wheel, slip_ratio, wheel_state
 
 STEP_LOADS = (275.0, 575.0, 875.0)
 
@@ -77,7 +76,8 @@ def test_model_description_interfaces_match_the_modelica_readme(fmus):
     single = variables(fmus["SingleWheel"])
     assert single["tau"].causality == "input" and single["tau"].unit == "N.m"
     assert single["W"].causality == "parameter" and single["W"].unit == "N"
-    assert {"Fx", "Fz", "Tx", "slip", "sinkage", "omega", "v"} <= {n for n, v in single.items() if v.causality == "output"}
+    outputs = {n for n, v in single.items() if v.causality == "output"}
+    assert {"Fx", "Fz", "Tx", "slip", "sinkage", "omega", "v"} <= outputs
     wheel = variables(fmus["Wheel"])
     assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub"}
     body = variables(fmus["RoverBody"])
@@ -415,9 +415,9 @@ def test_fmu_sources_rebuild_the_binary(fmus, tmp_path):
 
 # --- the build ----------------------------------------------------------------------------------
 
-def test_unchanged_sources_are_not_rebuilt(fmus):
+def test_unchanged_sources_are_not_rebuilt(fmu_dir, fmus):
     before = {name: path.stat().st_mtime_ns for name, path in fmus.items()}
-    results = build.build_all(build.FMU_MODELS, FMU_DIR, backend="builtin", jobs=1)
+    results = build.build_all(build.FMU_MODELS, fmu_dir, backend="builtin", jobs=1)
     assert [r.rebuilt for r in results] == [False] * 4
     assert {r.name: r.path.stat().st_mtime_ns for r in results} == before
 
@@ -457,17 +457,17 @@ def test_unsupported_construct_is_rejected_and_leaves_the_output_folder_untouche
     assert (out / "SingleWheel.fmu").read_bytes() == b"previous build"
 
 
-def test_build_cli_reports_up_to_date_fmus(fmus, capsys):
-    from orchestrator.cli import main
+def test_build_cli_reports_up_to_date_fmus(fmu_dir, fmus, capsys):
+    from rover_cosim.cli import main
 
-    assert main(["build-fmus", "--out", str(FMU_DIR), "--backend", "builtin", "--jobs", "1", "Wheel"]) == 0
+    assert main(["build-fmus", "--out", str(fmu_dir), "--backend", "builtin", "--jobs", "1", "Wheel"]) == 0
     assert "Wheel.fmu is up to date" in capsys.readouterr().out
-    assert main(["build-fmus", "--out", str(FMU_DIR), "NoSuchModel"]) == 1
+    assert main(["build-fmus", "--out", str(fmu_dir), "NoSuchModel"]) == 1
     assert "NoSuchModel" in capsys.readouterr().err
 
 
 def test_backend_choice_and_the_omc_script(monkeypatch):
-    from fmubuild.omc import script
+    from rover_cosim.fmubuild.omc import script
 
     monkeypatch.setenv("PATH", "/nonexistent")
     assert build.resolve_backend("auto") == "builtin"
@@ -491,7 +491,7 @@ cp "$PREPARED_FMU" Wheel.fmu
 def test_omc_backend_plumbing_with_a_stand_in_omc(fmus, tmp_path, monkeypatch):
     """build_fmu_omc runs omc on its script in a scratch folder, records its inputs in the FMU and
     moves it into place; a second call is skipped. (OpenModelica itself: the hosted workflow.)"""
-    from fmubuild.omc import build_fmu_omc
+    from rover_cosim.fmubuild.omc import build_fmu_omc
 
     bin_dir = tmp_path / "bin"
     bin_dir.mkdir()
@@ -510,7 +510,7 @@ def test_omc_backend_plumbing_with_a_stand_in_omc(fmus, tmp_path, monkeypatch):
 
 @pytest.mark.skipif(shutil.which("omc") is None, reason="omc not on PATH")
 def test_omc_backend_builds_a_single_wheel_fmu_that_agrees_with_the_reference(tmp_path):
-    from fmubuild.omc import build_fmu_omc
+    from rover_cosim.fmubuild.omc import build_fmu_omc
 
     result = build_fmu_omc("SingleWheel", tmp_path)
     assert validate_fmu(str(result.path)) == []

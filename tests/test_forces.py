@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from reference_quadrature import POINTS, reference_forces
 
-from terramechanics import DEFAULT_NODES, Soil, Wheel, contact_forces
+from rover_cosim.terramechanics import DEFAULT_NODES, Soil, Wheel, contact_forces
 
 WHEEL = Wheel()
 SINKAGES = (1e-4, 0.005, 0.03, 0.1, 0.2, 0.3, 0.35)  # [m]

@@ -11,8 +11,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from identification import sweep as sweep_module
-from identification.fits import (
+from rover_cosim.identification import sweep as sweep_module
+from rover_cosim.identification.fits import (
     IdentifiedModel,
     first_order_fit,
     fit_percent,
@@ -20,9 +20,9 @@ from identification.fits import (
     identify,
     step_table,
 )
-from identification.job import run_identification
-from identification.sweep import SweepPlan, compute_run, run_file, run_sweep
-from identification.validate import PAPER_FIT
+from rover_cosim.identification.sweep import SweepPlan, compute_run, run_file, run_sweep
+from rover_cosim.identification.validate import PAPER_FIT
+from rover_cosim.jobs.identify import IdentificationResult
 
 SMALL = SweepPlan(loads=(300.0, 600.0), torques=(10.0, 30.0), stop_time=0.02, sample_time=1e-3)
 
@@ -118,13 +118,13 @@ def test_reference_test_bed_and_fmu_give_the_same_a_and_b(single_wheel, tmp_path
 
 
 @pytest.fixture(scope="module")
-def identified(single_wheel, tmp_path_factory) -> tuple[Path, dict]:
-    out = tmp_path_factory.mktemp("identification")
-    return out, run_identification(single_wheel, out, workers=2)
+def out(identified: IdentificationResult) -> Path:
+    """The folder `make identify` wrote (the session's shared identification)."""
+    return identified.files[0].parent
 
 
-def test_identify_writes_every_output(identified):
-    out, _outcome = identified
+def test_identify_writes_every_output(out, identified):
+    assert set(identified.files) <= set(out.iterdir()) and all(p.parent == out for p in identified.files)
     names = {p.name for p in out.iterdir()}
     assert {"runs.csv", "steps.csv", "model.json", "fit_table.csv", "fit_models.csv", "fit_detail.csv", "failures.csv",
             "fig5_fx_vs_slip.png", "fig6_a_of_W.png", "fig7_b_of_W.png", "fig8_validation_575N.png",
@@ -139,18 +139,16 @@ def test_identify_writes_every_output(identified):
     assert model["fmu"]["sha256"] and model["plan"]["loads"] == list(plan.loads)
 
 
-def test_identified_model_meets_table_1(identified):
+def test_identified_model_meets_table_1(out):
     """Fit (Eq. 15) of the recommended (quadratic) model at least the paper's Table 1 at each load;
     the linear model of Eq. (14) is reported beside it."""
-    out, _ = identified
     fits = pd.read_csv(out / "fit_models.csv").set_index("load_N")
     for load, paper in PAPER_FIT.items():
         assert fits.loc[load, "fit_percent_quadratic"] >= paper, (load, fits.loc[load].to_dict())
     assert np.isfinite(fits["fit_percent_linear"]).all()
 
 
-def test_model_json_round_trips(identified):
-    out, _ = identified
+def test_model_json_round_trips(out):
     model = json.loads((out / "model.json").read_text())
     for label, data in model["models"].items():
         restored = IdentifiedModel.from_dict(data)

@@ -3,7 +3,7 @@ import math
 import numpy as np
 import pytest
 
-from terramechanics import (
+from rover_cosim.terramechanics import (
     Soil,
     Wheel,
     entry_angle,

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from fmubuild.source import MODELICA_ROOT, PACKAGE, class_file, class_files
+from rover_cosim.fmubuild.source import MODELICA_ROOT, PACKAGE, class_file, class_files
 
 CLASS_RE = re.compile(
     r"^\s*(?:partial\s+)?(?:encapsulated\s+)?(model|block|function|record|package|connector)\s+(\w+)", re.MULTILINE)
@@ -86,7 +86,9 @@ def test_real_declarations_in_models_and_records_carry_units():
     missing = []
     for path in ALL_FILES:
         code = path.read_text()
-        kind = CLASS_RE.search(STRING_RE.sub('""', code)).group(1)
+        match = CLASS_RE.search(STRING_RE.sub('""', code))
+        assert match is not None, path
+        kind = match.group(1)
         if kind in ("function", "package"):
             continue
         for line in code.splitlines():

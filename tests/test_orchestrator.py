@@ -9,13 +9,12 @@ import tomllib
 
 import numpy as np
 import pytest
-from conftest import FMU_DIR
 
-from orchestrator.cli import EXAMPLES, main
-from orchestrator.libcosim import run_libcosim
-from orchestrator.master import RunError, run
-from orchestrator.progress import ProgressBar
-from orchestrator.system import SystemFileError, load_system, system_from_dict
+from rover_cosim.cli import EXAMPLES, main
+from rover_cosim.orchestrator.libcosim import run_libcosim
+from rover_cosim.orchestrator.master import RunError, run
+from rover_cosim.orchestrator.system import SystemFileError, load_system, system_from_dict
+from rover_cosim.progress import ProgressBar
 
 
 def example(name: str, **simulation: object) -> dict:
@@ -24,12 +23,16 @@ def example(name: str, **simulation: object) -> dict:
     return data
 
 
-def system(data: dict, name: str = "test.toml"):
-    return system_from_dict(data, name=name, base=FMU_DIR)
+@pytest.fixture(scope="module")
+def system(fmu_dir):
+    """A checked System from a parsed system file, FMUs taken from the built fmus/."""
+    def load(data: dict, name: str = "test.toml"):
+        return system_from_dict(data, name=name, base=fmu_dir)
+    return load
 
 
 @pytest.fixture(scope="module")
-def rover_runs(fmus) -> dict[str, object]:
+def rover_runs(system) -> dict[str, object]:
     """The co-simulated rover (RoverBody + 6 Wheel, Gauss-Seidel, 1 ms) and the monolithic
     Rover.fmu under the same open-loop torque, 6 s."""
     return {"cosim": run(system(example("rover_cosim"))).data,
@@ -39,8 +42,8 @@ def rover_runs(fmus) -> dict[str, object]:
 # --- example systems ----------------------------------------------------------------------------
 
 @pytest.mark.parametrize("name", sorted(EXAMPLES))
-def test_shipped_examples_load(fmus, name: str):
-    loaded = load_system(EXAMPLES[name], fmu_dir=FMU_DIR)
+def test_shipped_examples_load(fmu_dir, fmus, name: str):
+    loaded = load_system(EXAMPLES[name], fmu_dir=fmu_dir)
     assert loaded.step == 1e-3 and loaded.fmus and loaded.record
 
 
@@ -56,7 +59,7 @@ def test_cosimulated_rover_matches_the_monolithic_rover(rover_runs):
     assert mono["rover.v"].iloc[-1] > 0.9  # the run really drives the rover to ~1 m/s
 
 
-def test_libcosim_runs_the_same_cosimulated_rover_to_the_same_trajectories(fmus):
+def test_libcosim_runs_the_same_cosimulated_rover_to_the_same_trajectories(system, fmus):
     """libcosim's fixed-step master exchanges values like our Jacobi master: same FMUs, same step,
     same trajectories (to round-off)."""
     data = example("rover_cosim", algorithm="jacobi", stop_time=1.0)
@@ -68,7 +71,7 @@ def test_libcosim_runs_the_same_cosimulated_rover_to_the_same_trajectories(fmus)
         np.testing.assert_allclose(theirs[column], ours[column], rtol=0, atol=1e-9 * scale, err_msg=column)
 
 
-def test_jacobi_and_gauss_seidel_differ_by_a_coupling_error_that_shrinks_with_the_step(fmus):
+def test_jacobi_and_gauss_seidel_differ_by_a_coupling_error_that_shrinks_with_the_step(system, fmus):
     reference = run(system(example("rover_cosim", stop_time=1.0, step=2.5e-4))).data.set_index("time")
     errors = {}
     for algorithm in ("jacobi", "gauss-seidel"):
@@ -96,7 +99,7 @@ class Gain:
         return self.k * u
 
 
-def test_python_block_closes_a_loop_around_an_fmu(fmus):
+def test_python_block_closes_a_loop_around_an_fmu(system, fmus):
     """A speed-feedback brake written in Python (tau = -k omega) slows a spinning wheel."""
     data = example("single_wheel_step", stop_time=0.5)
     data["block"] = [{"name": "brake", "type": "python", "factory": "test_orchestrator:Gain", "k": -200.0}]
@@ -107,7 +110,7 @@ def test_python_block_closes_a_loop_around_an_fmu(fmus):
     assert np.all(np.isfinite(result.to_numpy()))
 
 
-def test_sources_take_part_like_fmus(fmus):
+def test_sources_take_part_like_fmus(system, fmus):
     data = example("single_wheel_step", stop_time=0.3)
     result = run(system(data)).data
     expected = np.where(result["time"] >= 0.1 - 1e-12, 60.0, 0.0)
@@ -141,14 +144,15 @@ BAD_SYSTEMS = {
     "zero step": (lambda d: d["simulation"].update(step=0.0), "step: 0.0: expected a communication step > 0"),
     "negative stop time": (lambda d: d["simulation"].update(stop_time=-1.0), "stop_time: -1.0: expected a stop time"),
     "unknown algorithm": (lambda d: d["simulation"].update(algorithm="newton"), "algorithm: 'newton'"),
-    "parameter that is an input": (lambda d: d["fmu"][1].update(parameters={"tau": 1.0}), "wheel1.tau is not a parameter"),
+    "parameter that is an input": (lambda d: d["fmu"][1].update(parameters={"tau": 1.0}),
+                                   "wheel1.tau is not a parameter"),
     "unknown block type": (lambda d: d["block"][0].update(type="sine"), "type 'sine'"),
     "duplicate name": (lambda d: d["fmu"][2].update(name="wheel1"), "name 'wheel1' is used twice"),
 }
 
 
 @pytest.mark.parametrize("case", sorted(BAD_SYSTEMS))
-def test_bad_system_files_get_an_error_naming_the_entry(fmus, case: str):
+def test_bad_system_files_get_an_error_naming_the_entry(system, fmus, case: str):
     change, expected = BAD_SYSTEMS[case]
     with pytest.raises(SystemFileError) as error:
         system(broken(change), name="bad.toml")
@@ -166,9 +170,9 @@ def test_not_toml_and_missing_file(tmp_path):
 
 # --- results, failures, CLI ---------------------------------------------------------------------
 
-def test_cli_run_writes_csv_and_sidecar(fmus, tmp_path, capsys):
+def test_cli_run_writes_csv_and_sidecar(fmu_dir, fmus, tmp_path, capsys):
     out = tmp_path / "out" / "step.csv"
-    assert main(["run", "single_wheel_step", "-o", str(out), "--fmu-dir", str(FMU_DIR), "--stop-time", "0.2",
+    assert main(["run", "single_wheel_step", "-o", str(out), "--fmu-dir", str(fmu_dir), "--stop-time", "0.2",
                  "--quiet"]) == 0
     import pandas as pd
 
@@ -181,10 +185,10 @@ def test_cli_run_writes_csv_and_sidecar(fmus, tmp_path, capsys):
     assert "wrote" in capsys.readouterr().out
 
 
-def test_a_failing_run_names_the_instance_and_writes_nothing(fmus, tmp_path, capsys):
+def test_a_failing_run_names_the_instance_and_writes_nothing(fmu_dir, fmus, tmp_path, capsys):
     """An internal step limit of 1e-12 s makes the FMU's integrator give up in the first step."""
     path = tmp_path / "failing.toml"
-    fmu_path = (FMU_DIR / "SingleWheel.fmu").as_posix()
+    fmu_path = (fmu_dir / "SingleWheel.fmu").as_posix()
     lines = ["[simulation]", "stop_time = 0.2", "step = 1e-3", "[[fmu]]", 'name = "testbed"', f'path = "{fmu_path}"',
              'parameters = { W = 575.0, "solver.maxStep" = 1e-12 }', 'start = { tau = 60.0 }']
     path.write_text("\n".join(lines) + "\n")

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from terramechanics import Soil, Wheel, contact_forces, wheel_state
-from terramechanics.sinkage import GRID_BATCH_SIZE
+from rover_cosim.terramechanics import Soil, Wheel, contact_forces, wheel_state
+from rover_cosim.terramechanics.sinkage import GRID_BATCH_SIZE
 
 LOADS = np.geomspace(1.0, 5000.0, 25)  # [N]
 SLIPS = np.linspace(-1.0, 1.0, 21)

@@ -3,8 +3,8 @@ import math
 import numpy as np
 import pytest
 
-from terramechanics import Soil, Wheel, normal_stress, shear_displacement, shear_stress
-from terramechanics.stress import normal_stress_front, normal_stress_rear
+from rover_cosim.terramechanics import Soil, Wheel, normal_stress, shear_displacement, shear_stress
+from rover_cosim.terramechanics.stress import normal_stress_front, normal_stress_rear
 
 WHEEL, SOIL = Wheel(), Soil()
 K = 1.37e3 / 0.175 + 8.14e5  # kc/b + kphi [N/m^3], by hand from Table 2

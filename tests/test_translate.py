@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import rumoca
 
-from fmubuild import source
-from fmubuild.expressions import UnsupportedConstruct
-from fmubuild.ode import translate
+from rover_cosim.fmubuild import source
+from rover_cosim.fmubuild.expressions import UnsupportedConstruct
+from rover_cosim.fmubuild.ode import translate
 
 
 def integrate(ode, params: dict[str, float], stop: float, interval: float):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from terramechanics import wheel_state
+from rover_cosim.terramechanics import wheel_state
 
 LOADS = np.arange(100.0, 801.0, 100.0)  # [N]
 SLIPS = np.linspace(0.0, 0.9, 91)

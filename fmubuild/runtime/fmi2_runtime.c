@@ -1,8 +1,21 @@
 /* rover-cosim FMI 2.0 runtime: Model Exchange and Co-Simulation around a generated model
  * (model.h). All state lives in the instance: many instances per process and per thread.
- * Every failure is reported through the logger and returned as fmi2Error; nothing aborts. */
+ *
+ * Shape (after the Modelica Association's Reference-FMUs):
+ * - FUNCTIONS: one table with, per FMI function, its name and the instance states in which it may
+ *   be called; every function starts with ENTER(F), which checks the instance pointer and the
+ *   state against that table.
+ * - fail(): the one error path. It logs "<function>: <message>" under logStatusError and returns
+ *   fmi2Error; with BROKEN it also puts the instance into the error state (a failed model
+ *   evaluation or integration: only inspection, fmi2SetFMUstate, fmi2Reset, fmi2Terminate and
+ *   fmi2FreeInstance are allowed then). A REJECTED call (bad argument, illegal state) is refused
+ *   before anything changes: the instance stays where it was.
+ * - Every array argument is checked for NULL, every value reference against the range (as an
+ *   unsigned number), every serialized FMU state against its size, layout and checksum.
+ * Nothing aborts, nothing is read or written out of bounds whatever the caller passes. */
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,9 +25,79 @@
 #include "ode23s.h"
 
 typedef enum { MODE_INSTANTIATED, MODE_INITIALIZATION, MODE_EVENT, MODE_CONTINUOUS, MODE_STEP,
-               MODE_TERMINATED, MODE_ERROR } Mode;
+               MODE_TERMINATED, MODE_ERROR, MODE_COUNT } Mode;
 
-#define FMU_STATE_MAGIC 0x524f5643u /* "ROVC" */
+static const char *const MODE_NAMES[MODE_COUNT] = {"instantiated", "initialization", "event", "continuous-time",
+                                                   "step-complete", "terminated", "error"};
+
+/* ---- the FMI functions and the states they may be called in ---------------------------- */
+#define S(m) (1u << (m))
+#define ANY_MODE (S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | S(MODE_EVENT) | S(MODE_CONTINUOUS) | \
+                  S(MODE_STEP) | S(MODE_TERMINATED) | S(MODE_ERROR))
+#define RUNNING (S(MODE_EVENT) | S(MODE_CONTINUOUS) | S(MODE_STEP))
+#define NOT_ERROR (ANY_MODE & ~S(MODE_ERROR))
+#define ME_MODES (S(MODE_EVENT) | S(MODE_CONTINUOUS))
+
+typedef enum {
+    F_SetDebugLogging, F_FreeInstance, F_SetupExperiment, F_EnterInitializationMode, F_ExitInitializationMode,
+    F_Terminate, F_Reset, F_GetReal, F_SetReal, F_GetInteger, F_GetBoolean, F_GetString, F_SetInteger,
+    F_SetBoolean, F_SetString, F_GetFMUstate, F_SetFMUstate, F_FreeFMUstate, F_SerializedFMUstateSize,
+    F_SerializeFMUstate, F_DeSerializeFMUstate, F_GetDirectionalDerivative, F_EnterEventMode,
+    F_NewDiscreteStates, F_EnterContinuousTimeMode, F_CompletedIntegratorStep, F_SetTime,
+    F_SetContinuousStates, F_GetDerivatives, F_GetEventIndicators, F_GetContinuousStates,
+    F_GetNominalsOfContinuousStates, F_SetRealInputDerivatives, F_GetRealOutputDerivatives, F_DoStep,
+    F_CancelStep, F_GetStatus, F_GetRealStatus, F_GetIntegerStatus, F_GetBooleanStatus, F_GetStringStatus,
+    F_COUNT
+} Function;
+
+static const struct {
+    const char *name;
+    unsigned allowed; /* bit set of Mode */
+} FUNCTIONS[F_COUNT] = {
+    [F_SetDebugLogging] = {"fmi2SetDebugLogging", ANY_MODE},
+    [F_FreeInstance] = {"fmi2FreeInstance", ANY_MODE},
+    [F_SetupExperiment] = {"fmi2SetupExperiment", S(MODE_INSTANTIATED)},
+    [F_EnterInitializationMode] = {"fmi2EnterInitializationMode", S(MODE_INSTANTIATED)},
+    [F_ExitInitializationMode] = {"fmi2ExitInitializationMode", S(MODE_INITIALIZATION)},
+    [F_Terminate] = {"fmi2Terminate", RUNNING | S(MODE_TERMINATED) | S(MODE_ERROR)},
+    [F_Reset] = {"fmi2Reset", ANY_MODE},
+    [F_GetReal] = {"fmi2GetReal", ANY_MODE},
+    [F_SetReal] = {"fmi2SetReal", S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | RUNNING},
+    [F_GetInteger] = {"fmi2GetInteger", ANY_MODE},
+    [F_GetBoolean] = {"fmi2GetBoolean", ANY_MODE},
+    [F_GetString] = {"fmi2GetString", ANY_MODE},
+    [F_SetInteger] = {"fmi2SetInteger", S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | RUNNING},
+    [F_SetBoolean] = {"fmi2SetBoolean", S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | RUNNING},
+    [F_SetString] = {"fmi2SetString", S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | RUNNING},
+    [F_GetFMUstate] = {"fmi2GetFMUstate", NOT_ERROR},
+    [F_SetFMUstate] = {"fmi2SetFMUstate", ANY_MODE},
+    [F_FreeFMUstate] = {"fmi2FreeFMUstate", ANY_MODE},
+    [F_SerializedFMUstateSize] = {"fmi2SerializedFMUstateSize", ANY_MODE},
+    [F_SerializeFMUstate] = {"fmi2SerializeFMUstate", ANY_MODE},
+    [F_DeSerializeFMUstate] = {"fmi2DeSerializeFMUstate", ANY_MODE},
+    [F_GetDirectionalDerivative] = {"fmi2GetDirectionalDerivative", S(MODE_INITIALIZATION) | RUNNING},
+    [F_EnterEventMode] = {"fmi2EnterEventMode", ME_MODES},
+    [F_NewDiscreteStates] = {"fmi2NewDiscreteStates", S(MODE_EVENT)},
+    [F_EnterContinuousTimeMode] = {"fmi2EnterContinuousTimeMode", S(MODE_EVENT)},
+    [F_CompletedIntegratorStep] = {"fmi2CompletedIntegratorStep", S(MODE_CONTINUOUS)},
+    [F_SetTime] = {"fmi2SetTime", ME_MODES},
+    [F_SetContinuousStates] = {"fmi2SetContinuousStates", ME_MODES},
+    [F_GetDerivatives] = {"fmi2GetDerivatives", S(MODE_INITIALIZATION) | ME_MODES | S(MODE_TERMINATED)},
+    [F_GetEventIndicators] = {"fmi2GetEventIndicators", NOT_ERROR},
+    [F_GetContinuousStates] = {"fmi2GetContinuousStates", NOT_ERROR},
+    [F_GetNominalsOfContinuousStates] = {"fmi2GetNominalsOfContinuousStates", NOT_ERROR},
+    [F_SetRealInputDerivatives] = {"fmi2SetRealInputDerivatives", ANY_MODE},
+    [F_GetRealOutputDerivatives] = {"fmi2GetRealOutputDerivatives", ANY_MODE},
+    [F_DoStep] = {"fmi2DoStep", S(MODE_STEP)},
+    [F_CancelStep] = {"fmi2CancelStep", ANY_MODE},
+    [F_GetStatus] = {"fmi2GetStatus", ANY_MODE},
+    [F_GetRealStatus] = {"fmi2GetRealStatus", ANY_MODE},
+    [F_GetIntegerStatus] = {"fmi2GetIntegerStatus", ANY_MODE},
+    [F_GetBooleanStatus] = {"fmi2GetBooleanStatus", ANY_MODE},
+    [F_GetStringStatus] = {"fmi2GetStringStatus", ANY_MODE},
+};
+
+#define FMU_STATE_MAGIC 0x524f5644u /* "ROVD": layout 2, with a checksum */
 
 /* What fmi2Get/SetFMUstate save and restore. */
 typedef struct {
@@ -22,6 +105,7 @@ typedef struct {
     int mode;
     int f0_valid, jac_valid, jac_current, jac_age;  /* integrator memory, so a restored run repeats exactly */
     double t, rtol, max_step, h;
+    uint64_t checksum;  /* FNV-1a of the header (this field zero) and the doubles that follow */
     /* followed by x[nx], u[nu], p[np], x_set[nx], F0[nx], J[nx*nx] (doubles) */
 } StateHeader;
 
@@ -49,7 +133,6 @@ typedef struct {
 #define DEFAULT_MAX_STEP 0.0
 
 /* ---- value references ------------------------------------------------------------------- */
-static int off_p(void) { return 0; }
 static int off_x(void) { return model_info.np; }
 static int off_dx(void) { return model_info.np + model_info.nx; }
 static int off_u(void) { return model_info.np + 2 * model_info.nx; }
@@ -58,39 +141,76 @@ static int vr_rtol(void) { return off_y() + model_info.ny; }
 static int vr_max_step(void) { return vr_rtol() + 1; }
 static int n_real(void) { return vr_max_step() + 1; }
 
-/* ---- logging ---------------------------------------------------------------------------- */
+/* A value reference as an index, or -1 when it is no Real variable (compared unsigned, so
+ * 0xFFFFFFFF and values >= 2^31 are out of range, not negative). */
+static int real_index(fmi2ValueReference vr) {
+    return vr < (fmi2ValueReference)n_real() ? (int)vr : -1;
+}
+
+static const char *real_name(fmi2ValueReference vr) {
+    int r = real_index(vr);
+    return r >= 0 ? model_info.real_names[r] : "?";
+}
+
+/* ---- logging and the one error path -------------------------------------------------------- */
+static void log_text(const fmi2CallbackFunctions *cb, fmi2String name, fmi2Status status, const char *category,
+                     const char *text) {
+    if (!cb || !cb->logger) return;
+    /* The logger takes a printf format: pass the text itself with '%' doubled, so importers
+     * that do not expand the variable arguments (e.g. ctypes callbacks) still get the text. */
+    char escaped[2048];
+    size_t j = 0;
+    for (size_t i = 0; text[i] && j + 2 < sizeof escaped; i++) {
+        if (text[i] == '%') escaped[j++] = '%';
+        escaped[j++] = text[i];
+    }
+    escaped[j] = '\0';
+    cb->logger(cb->componentEnvironment, name ? name : "?", status, category, escaped);
+}
+
 static void log_message(Instance *c, fmi2Status status, const char *category, const char *format, ...) {
-    if (!c || !c->cb.logger) return;
-    if (status == fmi2OK && !c->logging) return;
-    char buffer[1024], escaped[2048];
+    if (!c || (status == fmi2OK && !c->logging)) return;
+    char buffer[1024];
     va_list args;
     va_start(args, format);
     vsnprintf(buffer, sizeof buffer, format, args);
     va_end(args);
-    /* The logger takes a printf format: pass the text itself with '%' doubled, so importers
-     * that do not expand the variable arguments (e.g. ctypes callbacks) still get the text. */
-    size_t j = 0;
-    for (size_t i = 0; buffer[i] && j + 2 < sizeof escaped; i++) {
-        if (buffer[i] == '%') escaped[j++] = '%';
-        escaped[j++] = buffer[i];
-    }
-    escaped[j] = '\0';
-    c->cb.logger(c->cb.componentEnvironment, c->name ? c->name : "?", status, category, escaped);
+    log_text(&c->cb, c->name, status, category, buffer);
 }
 
-static fmi2Status fail(Instance *c, const char *function, const char *format, ...) {
+typedef enum { REJECTED, BROKEN } Severity;
+
+static fmi2Status fail(Instance *c, Function f, Severity severity, const char *format, ...) {
     char buffer[900];
     va_list args;
     va_start(args, format);
     vsnprintf(buffer, sizeof buffer, format, args);
     va_end(args);
-    log_message(c, fmi2Error, "logStatusError", "%s: %s", function, buffer);
+    log_message(c, fmi2Error, "logStatusError", "%s: %s", FUNCTIONS[f].name, buffer);
+    if (severity == BROKEN) c->mode = MODE_ERROR;
     return fmi2Error;
 }
 
-static const char *real_name(fmi2ValueReference vr) {
-    return (int)vr < n_real() ? model_info.real_names[vr] : "?";
+/* The instance behind a component handle, if it may call f in its state; NULL otherwise
+ * (a NULL handle cannot be reported: there is no logger without an instance). */
+static Instance *enter(fmi2Component component, Function f) {
+    Instance *c = component;
+    if (!c) return NULL;
+    if (c->mode < 0 || c->mode >= MODE_COUNT || !(FUNCTIONS[f].allowed & S(c->mode))) {
+        fail(c, f, REJECTED, "not allowed in the %s state",
+             c->mode >= 0 && c->mode < MODE_COUNT ? MODE_NAMES[c->mode] : "unknown");
+        return NULL;
+    }
+    return c;
 }
+
+#define ENTER(F)                       \
+    Instance *c = enter(component, F); \
+    if (!c) return fmi2Error
+
+/* Arrays of n elements must not be NULL when n > 0. */
+#define NOT_NULL(F, array, n) \
+    if ((n) > 0 && !(array)) return fail(c, F, REJECTED, "%s is NULL (%zu elements expected)", #array, (size_t)(n))
 
 /* ---- model evaluation ------------------------------------------------------------------- */
 static int call4(Instance *c, casadi_eval f, double t, const double *x, double *out0, double *out1) {
@@ -115,7 +235,7 @@ static int jacobian(void *ctx, double t, const double *x, double *dfdx, double *
 }
 
 /* States whose start value is an expression of the parameters, unless the user set them. */
-static fmi2Status initial_states(Instance *c, const char *function) {
+static fmi2Status initial_states(Instance *c, Function f) {
     int any = 0;
     for (int i = 0; i < model_info.nx; i++) any |= model_info.x_start_calculated[i] && !c->x_set[i];
     if (!any) return fmi2OK;
@@ -123,24 +243,24 @@ static fmi2Status initial_states(Instance *c, const char *function) {
     c->arg[0] = c->p;
     c->res[0] = x0;
     if (model_initial(c->arg, c->res, c->iw, c->w, 0) || !all_finite(x0, model_info.nx))
-        return fail(c, function, "the start values of the states are not finite for these parameters");
+        return fail(c, f, BROKEN, "the start values of the states are not finite for these parameters");
     for (int i = 0; i < model_info.nx; i++)
         if (model_info.x_start_calculated[i] && !c->x_set[i]) c->x[i] = x0[i];
     return fmi2OK;
 }
 
-static fmi2Status update(Instance *c, const char *function, int need_xdot, int need_y) {
+static fmi2Status update(Instance *c, Function f, int need_xdot, int need_y) {
     if (c->mode == MODE_INSTANTIATED || c->mode == MODE_INITIALIZATION) {
-        if (initial_states(c, function) != fmi2OK) return fmi2Error;
+        if (initial_states(c, f) != fmi2OK) return fmi2Error;
     }
     if (need_xdot && !c->xdot_valid) {
         if (call4(c, model_ode, c->t, c->x, c->xdot, NULL) || !all_finite(c->xdot, model_info.nx))
-            return fail(c, function, "the derivatives are not finite at t = %.17g", c->t);
+            return fail(c, f, BROKEN, "the derivatives are not finite at t = %.17g", c->t);
         c->xdot_valid = 1;
     }
     if (need_y && !c->y_valid) {
         if (call4(c, model_outputs, c->t, c->x, c->y, NULL) || !all_finite(c->y, model_info.ny))
-            return fail(c, function, "the outputs are not finite at t = %.17g", c->t);
+            return fail(c, f, BROKEN, "the outputs are not finite at t = %.17g", c->t);
         c->y_valid = 1;
     }
     return fmi2OK;
@@ -167,33 +287,14 @@ static void set_defaults(Instance *c) {
     invalidate(c);
 }
 
-/* ---- checks ----------------------------------------------------------------------------- */
-static Instance *check(fmi2Component component, const char *function, unsigned allowed) {
-    Instance *c = component;
-    if (!c) return NULL;
-    if (!(allowed & (1u << c->mode))) {
-        static const char *names[] = {"instantiated", "initialization", "event", "continuous-time",
-                                      "step-complete", "terminated", "error"};
-        fail(c, function, "not allowed in the %s state", names[c->mode]);
-        return NULL;
-    }
-    return c;
-}
-
-#define S(m) (1u << (m))
-#define ANY_MODE (S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | S(MODE_EVENT) | S(MODE_CONTINUOUS) | \
-                  S(MODE_STEP) | S(MODE_TERMINATED) | S(MODE_ERROR))
-#define RUNNING (S(MODE_EVENT) | S(MODE_CONTINUOUS) | S(MODE_STEP))
-
 /* ---- common functions ------------------------------------------------------------------- */
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char *fmi2GetVersion(void) { return fmi2Version; }
 
 fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn, size_t nCategories,
                                const fmi2String categories[]) {
-    Instance *c = check(component, "fmi2SetDebugLogging", ANY_MODE);
-    if (!c) return fmi2Error;
-    (void)nCategories; (void)categories;
+    ENTER(F_SetDebugLogging);
+    NOT_NULL(F_SetDebugLogging, categories, nCategories);
     c->logging = loggingOn;
     return fmi2OK;
 }
@@ -207,38 +308,10 @@ static void free_instance(Instance *c) {
     release(c);
 }
 
-static casadi_eval const EVALS[] = {model_ode, model_outputs, model_initial, model_ode_jacobian, model_directional};
 static casadi_work const WORKS[] = {model_ode_work, model_outputs_work, model_initial_work,
                                     model_ode_jacobian_work, model_directional_work};
 
-fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
-                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
-                              fmi2Boolean visible, fmi2Boolean loggingOn) {
-    (void)fmuResourceLocation; (void)visible; (void)EVALS;
-    if (!functions || !functions->allocateMemory || !functions->freeMemory) return NULL;
-    if (!instanceName || !instanceName[0]) {
-        if (functions->logger)
-            functions->logger(functions->componentEnvironment, "?", fmi2Error, "logStatusError",
-                              "fmi2Instantiate: the instance name is empty");
-        return NULL;
-    }
-    if (!fmuGUID || strcmp(fmuGUID, model_info.guid) != 0) {
-        if (functions->logger) {
-            char text[512];
-            snprintf(text, sizeof text, "fmi2Instantiate: GUID %s does not match this binary of %s (%s)",
-                     fmuGUID ? fmuGUID : "(null)", model_info.identifier, model_info.guid);
-            functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
-                              strchr(text, '%') ? "fmi2Instantiate: GUID does not match this binary" : text);
-        }
-        return NULL;
-    }
-    Instance *c = functions->allocateMemory(1, sizeof(Instance));
-    if (!c) return NULL;
-    c->cb = *functions;
-    c->type = fmuType;
-    c->logging = loggingOn;
-    c->name = functions->allocateMemory(strlen(instanceName) + 1, 1);
-    if (c->name) strcpy(c->name, instanceName);
+static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     casadi_int sz_arg = 6, sz_res = 2, sz_iw = 0, sz_w = 0;
     for (size_t i = 0; i < sizeof(WORKS) / sizeof(WORKS[0]); i++) {
         casadi_int a = 0, r = 0, iw = 0, w = 0;
@@ -248,28 +321,58 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
         if (iw > sz_iw) sz_iw = iw;
         if (w > sz_w) sz_w = w;
     }
+    fmi2CallbackAllocateMemory alloc = functions->allocateMemory;
     size_t nx = model_info.nx ? model_info.nx : 1, nu = model_info.nu ? model_info.nu : 1;
     size_t np = model_info.np ? model_info.np : 1, ny = model_info.ny ? model_info.ny : 1;
-    c->p = functions->allocateMemory(np, sizeof(double));
-    c->x = functions->allocateMemory(nx, sizeof(double));
-    c->u = functions->allocateMemory(nu, sizeof(double));
-    c->xdot = functions->allocateMemory(nx, sizeof(double));
-    c->y = functions->allocateMemory(ny, sizeof(double));
-    c->x_set = functions->allocateMemory(nx, sizeof(double));
-    c->arg = functions->allocateMemory((size_t)sz_arg, sizeof(double *));
-    c->res = functions->allocateMemory((size_t)sz_res, sizeof(double *));
-    c->iw = functions->allocateMemory((size_t)sz_iw + 1, sizeof(casadi_int));
-    c->w = functions->allocateMemory((size_t)sz_w + 1, sizeof(double));
-    c->seed_x = functions->allocateMemory(nx, sizeof(double));
-    c->seed_u = functions->allocateMemory(nu, sizeof(double));
-    c->sens_x = functions->allocateMemory(nx, sizeof(double));
-    c->sens_y = functions->allocateMemory(ny, sizeof(double));
-    int solver_failed = ode23s_alloc(&c->solver, model_info.nx, functions->allocateMemory);
-    if (!c->name || !c->p || !c->x || !c->u || !c->xdot || !c->y || !c->x_set || !c->arg || !c->res || !c->iw ||
-        !c->w || !c->seed_x || !c->seed_u || !c->sens_x || !c->sens_y || solver_failed) {
-        if (functions->logger)
-            functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
-                              "fmi2Instantiate: out of memory");
+    c->p = alloc(np, sizeof(double));
+    c->x = alloc(nx, sizeof(double));
+    c->u = alloc(nu, sizeof(double));
+    c->xdot = alloc(nx, sizeof(double));
+    c->y = alloc(ny, sizeof(double));
+    c->x_set = alloc(nx, sizeof(double));
+    c->arg = alloc((size_t)sz_arg, sizeof(double *));
+    c->res = alloc((size_t)sz_res, sizeof(double *));
+    c->iw = alloc((size_t)sz_iw + 1, sizeof(casadi_int));
+    c->w = alloc((size_t)sz_w + 1, sizeof(double));
+    c->seed_x = alloc(nx, sizeof(double));
+    c->seed_u = alloc(nu, sizeof(double));
+    c->sens_x = alloc(nx, sizeof(double));
+    c->sens_y = alloc(ny, sizeof(double));
+    int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
+    return c->p && c->x && c->u && c->xdot && c->y && c->x_set && c->arg && c->res && c->iw && c->w && c->seed_x &&
+           c->seed_u && c->sens_x && c->sens_y && !solver_failed;
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn) {
+    (void)fmuResourceLocation; (void)visible;
+    if (!functions || !functions->allocateMemory || !functions->freeMemory) return NULL;
+    if (!instanceName || !instanceName[0]) {
+        log_text(functions, "?", fmi2Error, "logStatusError", "fmi2Instantiate: the instance name is empty");
+        return NULL;
+    }
+    if (fmuType != fmi2ModelExchange && fmuType != fmi2CoSimulation) {
+        log_text(functions, instanceName, fmi2Error, "logStatusError",
+                 "fmi2Instantiate: fmuType is neither fmi2ModelExchange nor fmi2CoSimulation");
+        return NULL;
+    }
+    if (!fmuGUID || strcmp(fmuGUID, model_info.guid) != 0) {
+        char text[512];
+        snprintf(text, sizeof text, "fmi2Instantiate: GUID %.200s does not match this binary of %s (%s)",
+                 fmuGUID ? fmuGUID : "(null)", model_info.identifier, model_info.guid);
+        log_text(functions, instanceName, fmi2Error, "logStatusError", text);
+        return NULL;
+    }
+    Instance *c = functions->allocateMemory(1, sizeof(Instance));
+    if (!c) return NULL;
+    c->cb = *functions;
+    c->type = fmuType;
+    c->logging = loggingOn;
+    c->name = functions->allocateMemory(strlen(instanceName) + 1, 1);
+    if (c->name) memcpy(c->name, instanceName, strlen(instanceName) + 1);
+    if (!c->name || !allocate_work(c, functions)) {
+        log_text(functions, instanceName, fmi2Error, "logStatusError", "fmi2Instantiate: out of memory");
         free_instance(c);
         return NULL;
     }
@@ -287,16 +390,14 @@ void fmi2FreeInstance(fmi2Component component) {
 
 fmi2Status fmi2SetupExperiment(fmi2Component component, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    Instance *c = check(component, "fmi2SetupExperiment", S(MODE_INSTANTIATED));
-    if (!c) return fmi2Error;
-    if (toleranceDefined) {
-        if (!(tolerance > 0.0 && tolerance < 1.0))
-            return fail(c, "fmi2SetupExperiment", "tolerance %g: expected 0 < tolerance < 1", tolerance);
-        c->rtol = tolerance;
-    }
-    if (!isfinite(startTime)) return fail(c, "fmi2SetupExperiment", "start time %g is not finite", startTime);
+    ENTER(F_SetupExperiment);
+    if (toleranceDefined && !(tolerance > 0.0 && tolerance < 1.0))
+        return fail(c, F_SetupExperiment, REJECTED, "tolerance %g: expected 0 < tolerance < 1", tolerance);
+    if (!isfinite(startTime))
+        return fail(c, F_SetupExperiment, REJECTED, "start time %g is not finite", startTime);
     if (stopTimeDefined && !(stopTime >= startTime))
-        return fail(c, "fmi2SetupExperiment", "stop time %g before start time %g", stopTime, startTime);
+        return fail(c, F_SetupExperiment, REJECTED, "stop time %g before start time %g", stopTime, startTime);
+    if (toleranceDefined) c->rtol = tolerance;
     c->t = startTime;
     c->has_stop = stopTimeDefined;
     c->t_stop = stopTime;
@@ -305,20 +406,15 @@ fmi2Status fmi2SetupExperiment(fmi2Component component, fmi2Boolean toleranceDef
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component component) {
-    Instance *c = check(component, "fmi2EnterInitializationMode", S(MODE_INSTANTIATED));
-    if (!c) return fmi2Error;
+    ENTER(F_EnterInitializationMode);
     c->mode = MODE_INITIALIZATION;
     invalidate(c);
     return fmi2OK;
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
-    Instance *c = check(component, "fmi2ExitInitializationMode", S(MODE_INITIALIZATION));
-    if (!c) return fmi2Error;
-    if (update(c, "fmi2ExitInitializationMode", 1, 1) != fmi2OK) {
-        c->mode = MODE_ERROR;
-        return fmi2Error;
-    }
+    ENTER(F_ExitInitializationMode);
+    if (update(c, F_ExitInitializationMode, 1, 1) != fmi2OK) return fmi2Error;
     c->mode = c->type == fmi2ModelExchange ? MODE_EVENT : MODE_STEP;
     c->solver.h = 0.0;
     c->solver.f0_valid = 0;
@@ -327,8 +423,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
 }
 
 fmi2Status fmi2Terminate(fmi2Component component) {
-    Instance *c = check(component, "fmi2Terminate", RUNNING | S(MODE_ERROR) | S(MODE_TERMINATED));
-    if (!c) return fmi2Error;
+    ENTER(F_Terminate);
     if (c->type == fmi2CoSimulation)
         log_message(c, fmi2OK, "logStatistics", "integrator: %ld steps, %ld rejected, %ld Jacobians, %ld derivative evaluations",
                     c->solver.steps, c->solver.rejected, c->solver.jacobians, c->solver.rhs_calls);
@@ -337,27 +432,28 @@ fmi2Status fmi2Terminate(fmi2Component component) {
 }
 
 fmi2Status fmi2Reset(fmi2Component component) {
-    Instance *c = check(component, "fmi2Reset", ANY_MODE);
-    if (!c) return fmi2Error;
+    ENTER(F_Reset);
     set_defaults(c);
     return fmi2OK;
 }
 
 /* ---- values ----------------------------------------------------------------------------- */
 fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
-    Instance *c = check(component, "fmi2GetReal", ANY_MODE & ~S(MODE_ERROR));
-    if (!c) return fmi2Error;
-    if (nvr > 0 && (!vr || !value)) return fail(c, "fmi2GetReal", "null value-reference or value array");
+    ENTER(F_GetReal);
+    NOT_NULL(F_GetReal, vr, nvr);
+    NOT_NULL(F_GetReal, value, nvr);
     int need_xdot = 0, need_y = 0;
     for (size_t i = 0; i < nvr; i++) {
-        int r = (int)vr[i];
-        if (r >= n_real()) return fail(c, "fmi2GetReal", "value reference %u: no such Real variable (0..%d)", vr[i], n_real() - 1);
+        int r = real_index(vr[i]);
+        if (r < 0)
+            return fail(c, F_GetReal, REJECTED, "value reference %u: no such Real variable (0..%d)", vr[i], n_real() - 1);
         need_xdot |= r >= off_dx() && r < off_u();
         need_y |= r >= off_y() && r < vr_rtol();
     }
-    if (update(c, "fmi2GetReal", need_xdot, need_y) != fmi2OK) return fmi2Error;
+    /* In the error state the values are shown as they are, for inspection. */
+    if (c->mode != MODE_ERROR && update(c, F_GetReal, need_xdot, need_y) != fmi2OK) return fmi2Error;
     for (size_t i = 0; i < nvr; i++) {
-        int r = (int)vr[i];
+        int r = real_index(vr[i]);
         if (r < off_x()) value[i] = c->p[r];
         else if (r < off_dx()) value[i] = c->x[r - off_x()];
         else if (r < off_u()) value[i] = c->xdot[r - off_dx()];
@@ -369,33 +465,35 @@ fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], s
     return fmi2OK;
 }
 
-fmi2Status fmi2SetReal(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
-    Instance *c = check(component, "fmi2SetReal", S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | RUNNING);
-    if (!c) return fmi2Error;
-    if (nvr > 0 && (!vr || !value)) return fail(c, "fmi2SetReal", "null value-reference or value array");
+/* Why the Real ``r`` cannot take ``value`` now, or NULL if it can. */
+static const char *set_real_refusal(const Instance *c, int r, double value) {
     int initializing = c->mode == MODE_INSTANTIATED || c->mode == MODE_INITIALIZATION;
+    if (!isfinite(value)) return "expected a finite value";
+    if (r < off_x() && !initializing)
+        return "is a fixed parameter: it can only be set before fmi2ExitInitializationMode";
+    if (r >= off_x() && r < off_dx() && !initializing)
+        return "is a state: set it before fmi2ExitInitializationMode (Model Exchange: fmi2SetContinuousStates)";
+    if (r >= off_dx() && r < off_u()) return "is a derivative (calculated): it cannot be set";
+    if (r >= off_y() && r < vr_rtol()) return "is calculated by the model: it cannot be set";
+    if (r == vr_rtol() && !(value > 0.0 && value < 1.0)) return "expected 0 < tolerance < 1";
+    if (r == vr_max_step() && !(value >= 0.0)) return "expected >= 0 (0: no limit besides the communication step)";
+    return NULL;
+}
+
+fmi2Status fmi2SetReal(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+    ENTER(F_SetReal);
+    NOT_NULL(F_SetReal, vr, nvr);
+    NOT_NULL(F_SetReal, value, nvr);
     /* Check everything first, so a rejected call changes nothing. */
     for (size_t i = 0; i < nvr; i++) {
-        int r = (int)vr[i];
-        if (r >= n_real()) return fail(c, "fmi2SetReal", "value reference %u: no such Real variable (0..%d)", vr[i], n_real() - 1);
-        const char *name = real_name(vr[i]);
-        if (!isfinite(value[i])) return fail(c, "fmi2SetReal", "%s = %g: expected a finite value", name, value[i]);
-        if (r < off_x() && !initializing)
-            return fail(c, "fmi2SetReal", "%s is a fixed parameter: it can only be set before fmi2ExitInitializationMode", name);
-        if (r >= off_x() && r < off_dx() && !initializing)
-            return fail(c, "fmi2SetReal", "%s is a state: set it before fmi2ExitInitializationMode "
-                        "(Model Exchange: fmi2SetContinuousStates)", name);
-        if (r >= off_dx() && r < off_u())
-            return fail(c, "fmi2SetReal", "%s is a derivative (calculated): it cannot be set", name);
-        if (r >= off_y() && r < vr_rtol())
-            return fail(c, "fmi2SetReal", "%s is calculated by the model: it cannot be set", name);
-        if (r == vr_rtol() && !(value[i] > 0.0 && value[i] < 1.0))
-            return fail(c, "fmi2SetReal", "%s = %g: expected 0 < tolerance < 1", name, value[i]);
-        if (r == vr_max_step() && !(value[i] >= 0.0))
-            return fail(c, "fmi2SetReal", "%s = %g: expected >= 0 (0: no limit besides the communication step)", name, value[i]);
+        int r = real_index(vr[i]);
+        if (r < 0)
+            return fail(c, F_SetReal, REJECTED, "value reference %u: no such Real variable (0..%d)", vr[i], n_real() - 1);
+        const char *refusal = set_real_refusal(c, r, value[i]);
+        if (refusal) return fail(c, F_SetReal, REJECTED, "%s = %g: %s", real_name(vr[i]), value[i], refusal);
     }
     for (size_t i = 0; i < nvr; i++) {
-        int r = (int)vr[i];
+        int r = real_index(vr[i]);
         if (r < off_x()) c->p[r] = value[i];
         else if (r < off_dx()) { c->x[r - off_x()] = value[i]; c->x_set[r - off_x()] = 1.0; }
         else if (r >= off_u() && r < off_y()) c->u[r - off_u()] = value[i];
@@ -406,54 +504,84 @@ fmi2Status fmi2SetReal(fmi2Component component, const fmi2ValueReference vr[], s
     return fmi2OK;
 }
 
-static fmi2Status no_such(Instance *c, const char *function, const char *type, size_t nvr, const fmi2ValueReference vr[]) {
-    if (nvr == 0) return fmi2OK;
-    return fail(c, function, "value reference %u: this model has no %s variables", vr ? vr[0] : 0u, type);
-}
-
 /* The models have Real variables only: the other types' get/set accept empty requests. */
-#define NO_VARIABLES_OF_TYPE(function, type_name, value_type)                                          \
+#define NO_VARIABLES_OF_TYPE(function, F, type_name, value_type)                                       \
     fmi2Status function(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,             \
                         value_type value[]) {                                                           \
-        (void)value;                                                                                    \
-        Instance *c = check(component, #function, ANY_MODE);                                            \
-        return c ? no_such(c, #function, type_name, nvr, vr) : fmi2Error;                               \
+        ENTER(F);                                                                                       \
+        NOT_NULL(F, vr, nvr);                                                                           \
+        NOT_NULL(F, value, nvr);                                                                        \
+        if (nvr == 0) return fmi2OK;                                                                    \
+        return fail(c, F, REJECTED, "value reference %u: this model has no %s variables", vr[0], type_name); \
     }
-NO_VARIABLES_OF_TYPE(fmi2GetInteger, "Integer", fmi2Integer)
-NO_VARIABLES_OF_TYPE(fmi2GetBoolean, "Boolean", fmi2Boolean)
-NO_VARIABLES_OF_TYPE(fmi2GetString, "String", fmi2String)
-NO_VARIABLES_OF_TYPE(fmi2SetInteger, "Integer", const fmi2Integer)
-NO_VARIABLES_OF_TYPE(fmi2SetBoolean, "Boolean", const fmi2Boolean)
-NO_VARIABLES_OF_TYPE(fmi2SetString, "String", const fmi2String)
+NO_VARIABLES_OF_TYPE(fmi2GetInteger, F_GetInteger, "Integer", fmi2Integer)
+NO_VARIABLES_OF_TYPE(fmi2GetBoolean, F_GetBoolean, "Boolean", fmi2Boolean)
+NO_VARIABLES_OF_TYPE(fmi2GetString, F_GetString, "String", fmi2String)
+NO_VARIABLES_OF_TYPE(fmi2SetInteger, F_SetInteger, "Integer", const fmi2Integer)
+NO_VARIABLES_OF_TYPE(fmi2SetBoolean, F_SetBoolean, "Boolean", const fmi2Boolean)
+NO_VARIABLES_OF_TYPE(fmi2SetString, F_SetString, "String", const fmi2String)
 
 /* ---- FMU state -------------------------------------------------------------------------- */
+/* In memory an FMU state is [size_t payload size | payload]; the payload is what
+ * fmi2SerializeFMUstate hands out: a StateHeader and the doubles after it. */
 static size_t state_size(void) {
     return sizeof(StateHeader) +
            sizeof(double) * (size_t)(3 * model_info.nx + model_info.nu + model_info.np + model_info.nx * model_info.nx);
 }
 
-static void state_write(const Instance *c, unsigned char *buffer) {
-    StateHeader head = {FMU_STATE_MAGIC, (unsigned)model_info.nx, (unsigned)model_info.nu, (unsigned)model_info.np,
-                        (int)c->mode, c->solver.f0_valid, c->solver.jac_valid, c->solver.jac_current,
-                        c->solver.jac_age, c->t, c->rtol, c->max_step, c->solver.h};
-    memcpy(buffer, &head, sizeof head);
-    double *v = (double *)(buffer + sizeof head);
+static uint64_t fnv1a(uint64_t hash, const unsigned char *bytes, size_t n) {
+    for (size_t i = 0; i < n; i++) hash = (hash ^ bytes[i]) * 0x100000001b3ULL;
+    return hash;
+}
+
+static uint64_t state_checksum(const unsigned char *payload, size_t size) {
+    StateHeader head;
+    memcpy(&head, payload, sizeof head);
+    head.checksum = 0;
+    uint64_t hash = fnv1a(0xcbf29ce484222325ULL, (const unsigned char *)&head, sizeof head);
+    return fnv1a(hash, payload + sizeof head, size - sizeof head);
+}
+
+static void state_write(const Instance *c, unsigned char *payload) {
+    StateHeader head;
+    memset(&head, 0, sizeof head); /* padding bytes too: the checksum covers them */
+    head.magic = FMU_STATE_MAGIC;
+    head.nx = (unsigned)model_info.nx; head.nu = (unsigned)model_info.nu; head.np = (unsigned)model_info.np;
+    head.mode = (int)c->mode;
+    head.f0_valid = c->solver.f0_valid; head.jac_valid = c->solver.jac_valid;
+    head.jac_current = c->solver.jac_current; head.jac_age = c->solver.jac_age;
+    head.t = c->t; head.rtol = c->rtol; head.max_step = c->max_step; head.h = c->solver.h;
+    memcpy(payload, &head, sizeof head);
+    double *v = (double *)(payload + sizeof head);
     memcpy(v, c->x, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->u, sizeof(double) * model_info.nu); v += model_info.nu;
     memcpy(v, c->p, sizeof(double) * model_info.np); v += model_info.np;
     memcpy(v, c->x_set, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->solver.F0, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->solver.J, sizeof(double) * model_info.nx * model_info.nx);
+    head.checksum = state_checksum(payload, state_size());
+    memcpy(payload, &head, sizeof head);
 }
 
-static fmi2Status state_read(Instance *c, const unsigned char *buffer, size_t size, const char *function) {
+/* Why ``payload`` of ``size`` bytes is not a state of this model, or NULL if it is one. */
+static const char *state_refusal(const unsigned char *payload, size_t size) {
     StateHeader head;
-    if (size < sizeof head) return fail(c, function, "FMU state of %zu bytes is too short", size);
-    memcpy(&head, buffer, sizeof head);
+    if (size != state_size()) return "its size does not match this model's FMU state";
+    memcpy(&head, payload, sizeof head);
     if (head.magic != FMU_STATE_MAGIC || head.nx != (unsigned)model_info.nx || head.nu != (unsigned)model_info.nu ||
-        head.np != (unsigned)model_info.np || size != state_size())
-        return fail(c, function, "the FMU state was not saved by %s", model_info.identifier);
-    const double *v = (const double *)(buffer + sizeof head);
+        head.np != (unsigned)model_info.np)
+        return "it was not saved by this model";
+    if (head.checksum != state_checksum(payload, size)) return "its checksum does not match (corrupted)";
+    if (head.mode < 0 || head.mode >= MODE_COUNT || head.jac_age < 0 || !isfinite(head.t) ||
+        !(head.rtol > 0.0 && head.rtol < 1.0) || !(head.max_step >= 0.0) || !(head.h >= 0.0) || !isfinite(head.h))
+        return "its values are out of range";
+    return NULL;
+}
+
+static void state_read(Instance *c, const unsigned char *payload) {
+    StateHeader head;
+    memcpy(&head, payload, sizeof head);
+    const double *v = (const double *)(payload + sizeof head);
     memcpy(c->x, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->u, v, sizeof(double) * model_info.nu); v += model_info.nu;
     memcpy(c->p, v, sizeof(double) * model_info.np); v += model_info.np;
@@ -465,23 +593,21 @@ static fmi2Status state_read(Instance *c, const unsigned char *buffer, size_t si
     c->rtol = head.rtol;
     c->max_step = head.max_step;
     invalidate(c);
-    c->solver.f0_valid = head.f0_valid;
-    c->solver.jac_valid = head.jac_valid;
-    c->solver.jac_current = head.jac_current;
+    c->solver.f0_valid = head.f0_valid != 0;
+    c->solver.jac_valid = head.jac_valid != 0;
+    c->solver.jac_current = head.jac_current != 0;
     c->solver.jac_age = head.jac_age;
     c->solver.h = head.h;
-    return fmi2OK;
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component component, fmi2FMUstate *state) {
-    Instance *c = check(component, "fmi2GetFMUstate", ANY_MODE & ~S(MODE_ERROR));
-    if (!c) return fmi2Error;
-    if (!state) return fail(c, "fmi2GetFMUstate", "null state pointer");
+    ENTER(F_GetFMUstate);
+    NOT_NULL(F_GetFMUstate, state, 1);
     size_t size = state_size();
     unsigned char *buffer = *state;
     if (!buffer) {
         buffer = c->cb.allocateMemory(size + sizeof(size_t), 1);
-        if (!buffer) return fail(c, "fmi2GetFMUstate", "out of memory");
+        if (!buffer) return fail(c, F_GetFMUstate, REJECTED, "out of memory");
         memcpy(buffer, &size, sizeof size);
     }
     state_write(c, buffer + sizeof(size_t));
@@ -490,50 +616,54 @@ fmi2Status fmi2GetFMUstate(fmi2Component component, fmi2FMUstate *state) {
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component component, fmi2FMUstate state) {
-    Instance *c = check(component, "fmi2SetFMUstate", ANY_MODE & ~S(MODE_ERROR));
-    if (!c) return fmi2Error;
-    if (!state) return fail(c, "fmi2SetFMUstate", "null state");
+    ENTER(F_SetFMUstate);
+    NOT_NULL(F_SetFMUstate, state, 1);
     size_t size;
     memcpy(&size, state, sizeof size);
-    return state_read(c, (const unsigned char *)state + sizeof(size_t), size, "fmi2SetFMUstate");
+    const unsigned char *payload = (const unsigned char *)state + sizeof(size_t);
+    const char *refusal = state_refusal(payload, size);
+    if (refusal) return fail(c, F_SetFMUstate, REJECTED, "not an FMU state of %s: %s", model_info.identifier, refusal);
+    state_read(c, payload);
+    return fmi2OK;
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component component, fmi2FMUstate *state) {
-    Instance *c = check(component, "fmi2FreeFMUstate", ANY_MODE);
-    if (!c) return fmi2Error;
+    ENTER(F_FreeFMUstate);
     if (state && *state) { c->cb.freeMemory(*state); *state = NULL; }
     return fmi2OK;
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component component, fmi2FMUstate state, size_t *size) {
-    Instance *c = check(component, "fmi2SerializedFMUstateSize", ANY_MODE);
-    if (!c) return fmi2Error;
-    if (!state || !size) return fail(c, "fmi2SerializedFMUstateSize", "null argument");
+    ENTER(F_SerializedFMUstateSize);
+    NOT_NULL(F_SerializedFMUstateSize, state, 1);
+    NOT_NULL(F_SerializedFMUstateSize, size, 1);
     memcpy(size, state, sizeof *size);
     return fmi2OK;
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component component, fmi2FMUstate state, fmi2Byte serialized[], size_t size) {
-    Instance *c = check(component, "fmi2SerializeFMUstate", ANY_MODE);
-    if (!c) return fmi2Error;
-    if (!state || !serialized) return fail(c, "fmi2SerializeFMUstate", "null argument");
+    ENTER(F_SerializeFMUstate);
+    NOT_NULL(F_SerializeFMUstate, state, 1);
+    NOT_NULL(F_SerializeFMUstate, serialized, size);
     size_t stored;
     memcpy(&stored, state, sizeof stored);
-    if (size < stored) return fail(c, "fmi2SerializeFMUstate", "buffer of %zu bytes, %zu needed", size, stored);
+    if (size < stored)
+        return fail(c, F_SerializeFMUstate, REJECTED, "buffer of %zu bytes, %zu needed", size, stored);
     memcpy(serialized, (const unsigned char *)state + sizeof(size_t), stored);
     return fmi2OK;
 }
 
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component component, const fmi2Byte serialized[], size_t size, fmi2FMUstate *state) {
-    Instance *c = check(component, "fmi2DeSerializeFMUstate", ANY_MODE);
-    if (!c) return fmi2Error;
-    if (!serialized || !state) return fail(c, "fmi2DeSerializeFMUstate", "null argument");
-    StateHeader head;
-    if (size != state_size()) return fail(c, "fmi2DeSerializeFMUstate", "%zu bytes: expected %zu", size, state_size());
-    memcpy(&head, serialized, sizeof head);
-    if (head.magic != FMU_STATE_MAGIC) return fail(c, "fmi2DeSerializeFMUstate", "not a state of %s", model_info.identifier);
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component component, const fmi2Byte serialized[], size_t size,
+                                   fmi2FMUstate *state) {
+    ENTER(F_DeSerializeFMUstate);
+    NOT_NULL(F_DeSerializeFMUstate, serialized, size);
+    NOT_NULL(F_DeSerializeFMUstate, state, 1);
+    const char *refusal = state_refusal((const unsigned char *)serialized, size);
+    if (refusal)
+        return fail(c, F_DeSerializeFMUstate, REJECTED, "%zu bytes are not an FMU state of %s: %s", size,
+                    model_info.identifier, refusal);
     unsigned char *buffer = *state ? *state : c->cb.allocateMemory(size + sizeof(size_t), 1);
-    if (!buffer) return fail(c, "fmi2DeSerializeFMUstate", "out of memory");
+    if (!buffer) return fail(c, F_DeSerializeFMUstate, REJECTED, "out of memory");
     memcpy(buffer, &size, sizeof size);
     memcpy(buffer + sizeof(size_t), serialized, size);
     *state = buffer;
@@ -541,35 +671,44 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component component, const fmi2Byte seria
 }
 
 /* ---- directional derivatives ------------------------------------------------------------ */
+static fmi2Status seed(Instance *c, const fmi2ValueReference known[], size_t n, const fmi2Real dv[]) {
+    for (int i = 0; i < model_info.nx; i++) c->seed_x[i] = 0.0;
+    for (int i = 0; i < model_info.nu; i++) c->seed_u[i] = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        int r = real_index(known[k]);
+        if (r >= off_x() && r < off_dx()) c->seed_x[r - off_x()] += dv[k];
+        else if (r >= off_u() && r < off_y()) c->seed_u[r - off_u()] += dv[k];
+        else return fail(c, F_GetDirectionalDerivative, REJECTED, "known %u (%s): expected a state or an input",
+                         known[k], real_name(known[k]));
+    }
+    return fmi2OK;
+}
+
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component component, const fmi2ValueReference vUnknown_ref[],
                                         size_t nUnknown, const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[]) {
-    const char *function = "fmi2GetDirectionalDerivative";
-    Instance *c = check(component, function, S(MODE_INITIALIZATION) | RUNNING);
-    if (!c) return fmi2Error;
-    for (int i = 0; i < model_info.nx; i++) c->seed_x[i] = 0.0;
-    for (int i = 0; i < model_info.nu; i++) c->seed_u[i] = 0.0;
-    for (size_t k = 0; k < nKnown; k++) {
-        int r = (int)vKnown_ref[k];
-        if (r >= off_x() && r < off_dx()) c->seed_x[r - off_x()] += dvKnown[k];
-        else if (r >= off_u() && r < off_y()) c->seed_u[r - off_u()] += dvKnown[k];
-        else return fail(c, function, "known %u (%s): expected a state or an input", vKnown_ref[k], real_name(vKnown_ref[k]));
-    }
+    const Function F = F_GetDirectionalDerivative;
+    ENTER(F);
+    NOT_NULL(F, vUnknown_ref, nUnknown);
+    NOT_NULL(F, dvUnknown, nUnknown);
+    NOT_NULL(F, vKnown_ref, nKnown);
+    NOT_NULL(F, dvKnown, nKnown);
+    if (seed(c, vKnown_ref, nKnown, dvKnown) != fmi2OK) return fmi2Error;
     for (size_t k = 0; k < nUnknown; k++) {
-        int r = (int)vUnknown_ref[k];
-        if (!((r >= off_x() && r < off_y()) || (r >= off_y() && r < vr_rtol())))
-            return fail(c, function, "unknown %u (%s): expected a derivative, an output or a local variable",
+        int r = real_index(vUnknown_ref[k]);
+        if (!(r >= off_x() && r < vr_rtol()))
+            return fail(c, F, REJECTED, "unknown %u (%s): expected a derivative, an output or a local variable",
                         vUnknown_ref[k], real_name(vUnknown_ref[k]));
     }
-    if (c->mode == MODE_INITIALIZATION && initial_states(c, function) != fmi2OK) return fmi2Error;
+    if (c->mode == MODE_INITIALIZATION && initial_states(c, F) != fmi2OK) return fmi2Error;
     double t = c->t;
     c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->seed_x; c->arg[5] = c->seed_u;
     c->res[0] = c->sens_x; c->res[1] = c->sens_y;
     if (model_directional(c->arg, c->res, c->iw, c->w, 0) || !all_finite(c->sens_x, model_info.nx) ||
         !all_finite(c->sens_y, model_info.ny))
-        return fail(c, function, "the directional derivative is not finite at t = %.17g", c->t);
+        return fail(c, F, BROKEN, "the directional derivative is not finite at t = %.17g", c->t);
     for (size_t k = 0; k < nUnknown; k++) {
-        int r = (int)vUnknown_ref[k];
+        int r = real_index(vUnknown_ref[k]);
         if (r < off_dx()) dvUnknown[k] = c->seed_x[r - off_x()];
         else if (r < off_u()) dvUnknown[k] = c->sens_x[r - off_dx()];
         else if (r < off_y()) dvUnknown[k] = c->seed_u[r - off_u()];
@@ -580,16 +719,14 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component component, const fmi2Value
 
 /* ---- Model Exchange --------------------------------------------------------------------- */
 fmi2Status fmi2EnterEventMode(fmi2Component component) {
-    Instance *c = check(component, "fmi2EnterEventMode", S(MODE_EVENT) | S(MODE_CONTINUOUS));
-    if (!c) return fmi2Error;
+    ENTER(F_EnterEventMode);
     c->mode = MODE_EVENT;
     return fmi2OK;
 }
 
 fmi2Status fmi2NewDiscreteStates(fmi2Component component, fmi2EventInfo *info) {
-    Instance *c = check(component, "fmi2NewDiscreteStates", S(MODE_EVENT));
-    if (!c) return fmi2Error;
-    if (!info) return fail(c, "fmi2NewDiscreteStates", "null event info");
+    ENTER(F_NewDiscreteStates);
+    NOT_NULL(F_NewDiscreteStates, info, 1);
     info->newDiscreteStatesNeeded = fmi2False;
     info->terminateSimulation = fmi2False;
     info->nominalsOfContinuousStatesChanged = fmi2False;
@@ -600,8 +737,7 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component component, fmi2EventInfo *info) {
 }
 
 fmi2Status fmi2EnterContinuousTimeMode(fmi2Component component) {
-    Instance *c = check(component, "fmi2EnterContinuousTimeMode", S(MODE_EVENT));
-    if (!c) return fmi2Error;
+    ENTER(F_EnterContinuousTimeMode);
     c->mode = MODE_CONTINUOUS;
     return fmi2OK;
 }
@@ -609,65 +745,72 @@ fmi2Status fmi2EnterContinuousTimeMode(fmi2Component component) {
 fmi2Status fmi2CompletedIntegratorStep(fmi2Component component, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
                                        fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation) {
     (void)noSetFMUStatePriorToCurrentPoint;
-    Instance *c = check(component, "fmi2CompletedIntegratorStep", S(MODE_CONTINUOUS));
-    if (!c) return fmi2Error;
-    if (enterEventMode) *enterEventMode = fmi2False;
-    if (terminateSimulation) *terminateSimulation = fmi2False;
+    ENTER(F_CompletedIntegratorStep);
+    NOT_NULL(F_CompletedIntegratorStep, enterEventMode, 1);
+    NOT_NULL(F_CompletedIntegratorStep, terminateSimulation, 1);
+    *enterEventMode = fmi2False;
+    *terminateSimulation = fmi2False;
     return fmi2OK;
 }
 
 fmi2Status fmi2SetTime(fmi2Component component, fmi2Real time) {
-    Instance *c = check(component, "fmi2SetTime", S(MODE_EVENT) | S(MODE_CONTINUOUS));
-    if (!c) return fmi2Error;
-    if (!isfinite(time)) return fail(c, "fmi2SetTime", "time %g is not finite", time);
+    ENTER(F_SetTime);
+    if (!isfinite(time)) return fail(c, F_SetTime, REJECTED, "time %g is not finite", time);
     c->t = time;
     invalidate(c);
     return fmi2OK;
 }
 
+static fmi2Status check_nx(Instance *c, Function f, size_t nx) {
+    if (nx != (size_t)model_info.nx) return fail(c, f, REJECTED, "nx = %zu: expected %d", nx, model_info.nx);
+    return fmi2OK;
+}
+
 fmi2Status fmi2SetContinuousStates(fmi2Component component, const fmi2Real x[], size_t nx) {
-    Instance *c = check(component, "fmi2SetContinuousStates", S(MODE_EVENT) | S(MODE_CONTINUOUS));
-    if (!c) return fmi2Error;
-    if (nx != (size_t)model_info.nx) return fail(c, "fmi2SetContinuousStates", "nx = %zu: expected %d", nx, model_info.nx);
+    ENTER(F_SetContinuousStates);
+    if (check_nx(c, F_SetContinuousStates, nx) != fmi2OK) return fmi2Error;
+    NOT_NULL(F_SetContinuousStates, x, nx);
     for (size_t i = 0; i < nx; i++)
-        if (!isfinite(x[i])) return fail(c, "fmi2SetContinuousStates", "%s = %g: expected a finite value",
-                                         real_name((fmi2ValueReference)(off_x() + (int)i)), x[i]);
+        if (!isfinite(x[i]))
+            return fail(c, F_SetContinuousStates, REJECTED, "%s = %g: expected a finite value",
+                        real_name((fmi2ValueReference)(off_x() + (int)i)), x[i]);
     memcpy(c->x, x, sizeof(double) * nx);
     invalidate(c);
     return fmi2OK;
 }
 
 fmi2Status fmi2GetDerivatives(fmi2Component component, fmi2Real derivatives[], size_t nx) {
-    Instance *c = check(component, "fmi2GetDerivatives", S(MODE_INITIALIZATION) | S(MODE_EVENT) | S(MODE_CONTINUOUS) | S(MODE_TERMINATED));
-    if (!c) return fmi2Error;
-    if (nx != (size_t)model_info.nx) return fail(c, "fmi2GetDerivatives", "nx = %zu: expected %d", nx, model_info.nx);
-    if (update(c, "fmi2GetDerivatives", 1, 0) != fmi2OK) return fmi2Error;
+    ENTER(F_GetDerivatives);
+    if (check_nx(c, F_GetDerivatives, nx) != fmi2OK) return fmi2Error;
+    NOT_NULL(F_GetDerivatives, derivatives, nx);
+    if (update(c, F_GetDerivatives, 1, 0) != fmi2OK) return fmi2Error;
     memcpy(derivatives, c->xdot, sizeof(double) * nx);
     return fmi2OK;
 }
 
 fmi2Status fmi2GetEventIndicators(fmi2Component component, fmi2Real eventIndicators[], size_t ni) {
     (void)eventIndicators;
-    Instance *c = check(component, "fmi2GetEventIndicators", ANY_MODE & ~S(MODE_ERROR));
-    if (!c) return fmi2Error;
-    if (ni != 0) return fail(c, "fmi2GetEventIndicators", "ni = %zu: this model has no event indicators", ni);
+    ENTER(F_GetEventIndicators);
+    if (ni != 0)
+        return fail(c, F_GetEventIndicators, REJECTED, "ni = %zu: this model has no event indicators", ni);
     return fmi2OK;
 }
 
 fmi2Status fmi2GetContinuousStates(fmi2Component component, fmi2Real x[], size_t nx) {
-    Instance *c = check(component, "fmi2GetContinuousStates", ANY_MODE & ~S(MODE_ERROR));
-    if (!c) return fmi2Error;
-    if (nx != (size_t)model_info.nx) return fail(c, "fmi2GetContinuousStates", "nx = %zu: expected %d", nx, model_info.nx);
-    if ((c->mode == MODE_INSTANTIATED || c->mode == MODE_INITIALIZATION) && initial_states(c, "fmi2GetContinuousStates") != fmi2OK)
+    ENTER(F_GetContinuousStates);
+    if (check_nx(c, F_GetContinuousStates, nx) != fmi2OK) return fmi2Error;
+    NOT_NULL(F_GetContinuousStates, x, nx);
+    if ((c->mode == MODE_INSTANTIATED || c->mode == MODE_INITIALIZATION) &&
+        initial_states(c, F_GetContinuousStates) != fmi2OK)
         return fmi2Error;
     memcpy(x, c->x, sizeof(double) * nx);
     return fmi2OK;
 }
 
 fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component component, fmi2Real x_nominal[], size_t nx) {
-    Instance *c = check(component, "fmi2GetNominalsOfContinuousStates", ANY_MODE & ~S(MODE_ERROR));
-    if (!c) return fmi2Error;
-    if (nx != (size_t)model_info.nx) return fail(c, "fmi2GetNominalsOfContinuousStates", "nx = %zu: expected %d", nx, model_info.nx);
+    ENTER(F_GetNominalsOfContinuousStates);
+    if (check_nx(c, F_GetNominalsOfContinuousStates, nx) != fmi2OK) return fmi2Error;
+    NOT_NULL(F_GetNominalsOfContinuousStates, x_nominal, nx);
     for (size_t i = 0; i < nx; i++) x_nominal[i] = 1.0;
     return fmi2OK;
 }
@@ -676,35 +819,34 @@ fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component component, fmi2Real x
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
     (void)vr; (void)order; (void)value;
-    Instance *c = check(component, "fmi2SetRealInputDerivatives", ANY_MODE);
-    if (!c) return fmi2Error;
+    ENTER(F_SetRealInputDerivatives);
     if (nvr == 0) return fmi2OK;
-    return fail(c, "fmi2SetRealInputDerivatives", "input derivatives are not supported (canInterpolateInputs=false)");
+    return fail(c, F_SetRealInputDerivatives, REJECTED,
+                "input derivatives are not supported (canInterpolateInputs=false)");
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
     (void)vr; (void)order; (void)value;
-    Instance *c = check(component, "fmi2GetRealOutputDerivatives", ANY_MODE);
-    if (!c) return fmi2Error;
+    ENTER(F_GetRealOutputDerivatives);
     if (nvr == 0) return fmi2OK;
-    return fail(c, "fmi2GetRealOutputDerivatives", "output derivatives are not provided (maxOutputDerivativeOrder=0)");
+    return fail(c, F_GetRealOutputDerivatives, REJECTED,
+                "output derivatives are not provided (maxOutputDerivativeOrder=0)");
 }
 
 fmi2Status fmi2DoStep(fmi2Component component, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
-    const char *function = "fmi2DoStep";
-    Instance *c = check(component, function, S(MODE_STEP));
-    if (!c) return fmi2Error;
+    const Function F = F_DoStep;
+    ENTER(F);
     if (!(communicationStepSize > 0.0) || !isfinite(communicationStepSize))
-        return fail(c, function, "communication step size %g: expected > 0", communicationStepSize);
-    if (fabs(currentCommunicationPoint - c->t) > 1e-9 * fmax(1.0, fabs(c->t)))
-        return fail(c, function, "current communication point %.17g differs from the FMU's time %.17g",
+        return fail(c, F, REJECTED, "communication step size %g: expected > 0", communicationStepSize);
+    if (!isfinite(currentCommunicationPoint) || fabs(currentCommunicationPoint - c->t) > 1e-9 * fmax(1.0, fabs(c->t)))
+        return fail(c, F, REJECTED, "current communication point %.17g differs from the FMU's time %.17g",
                     currentCommunicationPoint, c->t);
     double t_end = currentCommunicationPoint + communicationStepSize;
     if (c->has_stop && t_end > c->t_stop * (1.0 + 1e-12) + 1e-12)
-        return fail(c, function, "step to t = %.17g goes past the stop time %.17g", t_end, c->t_stop);
+        return fail(c, F, REJECTED, "step to t = %.17g goes past the stop time %.17g", t_end, c->t_stop);
     c->solver.rtol = c->rtol;
     c->solver.atol = c->rtol;
     c->solver.max_step = c->max_step;
@@ -714,45 +856,43 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real currentCommunicationPoin
     c->t = t;
     c->xdot_valid = 0;
     c->y_valid = 0;
-    if (status != 0) {
-        c->mode = MODE_ERROR;
-        return fail(c, function, "integration failed: %s", message);
-    }
+    if (status != 0) return fail(c, F, BROKEN, "integration failed: %s", message);
     c->t = t_end;
     return fmi2OK;
 }
 
 fmi2Status fmi2CancelStep(fmi2Component component) {
-    Instance *c = check(component, "fmi2CancelStep", ANY_MODE);
-    if (!c) return fmi2Error;
-    return fail(c, "fmi2CancelStep", "fmi2DoStep never runs asynchronously here; nothing to cancel");
+    ENTER(F_CancelStep);
+    return fail(c, F_CancelStep, REJECTED, "fmi2DoStep never runs asynchronously here; nothing to cancel");
 }
 
-static fmi2Status status_query(fmi2Component component, const char *function) {
-    Instance *c = check(component, function, ANY_MODE);
+static fmi2Status no_status(fmi2Component component, Function f) {
+    Instance *c = enter(component, f);
     if (!c) return fmi2Error;
-    return fail(c, function, "fmi2DoStep never returns fmi2Pending; no status to query");
+    return fail(c, f, REJECTED, "fmi2DoStep never returns fmi2Pending; no status to query");
 }
 
 fmi2Status fmi2GetStatus(fmi2Component component, const fmi2StatusKind s, fmi2Status *value) {
     (void)s; (void)value;
-    return status_query(component, "fmi2GetStatus");
+    return no_status(component, F_GetStatus);
 }
 fmi2Status fmi2GetRealStatus(fmi2Component component, const fmi2StatusKind s, fmi2Real *value) {
-    Instance *c = component;
-    if (c && s == fmi2LastSuccessfulTime && value) { *value = c->t; return fmi2OK; }
-    return status_query(component, "fmi2GetRealStatus");
+    ENTER(F_GetRealStatus);
+    NOT_NULL(F_GetRealStatus, value, 1);
+    if (s == fmi2LastSuccessfulTime) { *value = c->t; return fmi2OK; }
+    return no_status(component, F_GetRealStatus);
 }
 fmi2Status fmi2GetIntegerStatus(fmi2Component component, const fmi2StatusKind s, fmi2Integer *value) {
     (void)s; (void)value;
-    return status_query(component, "fmi2GetIntegerStatus");
+    return no_status(component, F_GetIntegerStatus);
 }
 fmi2Status fmi2GetBooleanStatus(fmi2Component component, const fmi2StatusKind s, fmi2Boolean *value) {
-    Instance *c = component;
-    if (c && s == fmi2Terminated && value) { *value = fmi2False; return fmi2OK; }
-    return status_query(component, "fmi2GetBooleanStatus");
+    ENTER(F_GetBooleanStatus);
+    NOT_NULL(F_GetBooleanStatus, value, 1);
+    if (s == fmi2Terminated) { *value = fmi2False; return fmi2OK; }
+    return no_status(component, F_GetBooleanStatus);
 }
 fmi2Status fmi2GetStringStatus(fmi2Component component, const fmi2StatusKind s, fmi2String *value) {
     (void)s; (void)value;
-    return status_query(component, "fmi2GetStringStatus");
+    return no_status(component, F_GetStringStatus);
 }

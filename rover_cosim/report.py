@@ -10,9 +10,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .simulate import PAPER_RMS
-
-PAPER_TABLE_1 = {275: 82.1, 575: 96.8, 875: 96.2}
+from rover_cosim.common.paper import TABLE_3_RMS as PAPER_RMS
 
 
 def _image(path: Path, caption: str) -> str:
@@ -34,7 +32,8 @@ def _provenance(path: Path) -> str:
     keep = {k: record[k] for k in ("command", "created_utc", "git_commit", "versions", "parameters", "fmu_sha256",
                                    "fmus", "model_sha256", "wall_seconds", "run_wall_seconds", "sweep_wall_seconds",
                                    "runs_computed", "runs_cached", "runs_failed") if k in record}
-    return f"<details><summary>{html.escape(path.name)}</summary><pre>{html.escape(json.dumps(keep, indent=2))}</pre></details>"
+    text = html.escape(json.dumps(keep, indent=2))
+    return f"<details><summary>{html.escape(path.name)}</summary><pre>{text}</pre></details>"
 
 
 def build_report(results: Path) -> str:
@@ -66,7 +65,8 @@ def build_report(results: Path) -> str:
     rms_path, cosim_path = simulation / "rms.csv", simulation / "rms_cosim.csv"
     if rms_path.exists() and cosim_path.exists():
         ours, cosim = pd.read_csv(rms_path), pd.read_csv(cosim_path)
-        table = pd.DataFrame({"limb": ours["limb"], "paper RMS [N]": [PAPER_RMS.get(i, float("nan")) for i in ours["limb"]],
+        paper = [PAPER_RMS.get(i, float("nan")) for i in ours["limb"]]
+        table = pd.DataFrame({"limb": ours["limb"], "paper RMS [N]": paper,
                               "ours, Rover.fmu [N]": ours["rms_N"], "ours, RoverBody + 6 Wheel [N]": cosim["rms_N"]})
         sections.append(_table(table))
     ablation = simulation / "ablation_fixed_load.csv"

@@ -7,9 +7,11 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from rover_cosim import __version__
+from rover_cosim.orchestrator.examples import examples
+
 #: Example systems shipped with the package (FMU paths relative to --fmu-dir, default fmus/).
-SYSTEMS = Path(__file__).resolve().parent / "systems"
-EXAMPLES = {p.stem: p for p in sorted(SYSTEMS.glob("*.toml"))}
+EXAMPLES = examples()
 
 
 def _positive_loads(text: str) -> tuple[float, ...]:
@@ -36,6 +38,7 @@ def _slip_step(text: str) -> float:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rover-cosim", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"rover-cosim {__version__}")
     commands = parser.add_subparsers(dest="command", required=True)
     fig3 = commands.add_parser("fig3", help="paper Fig. 3: Fx against slip for loads 100..800 N (numpy reference)")
     fig3.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
@@ -92,10 +95,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from .master import RunError, run
-    from .progress import ProgressBar
-    from .runs import write_run
-    from .system import SystemFileError, load_system, system_from_dict
+    from rover_cosim.orchestrator.master import RunError, run
+    from rover_cosim.orchestrator.runs import write_run
+    from rover_cosim.orchestrator.system import SystemFileError, load_system, system_from_dict
+    from rover_cosim.progress import ProgressBar
 
     path = Path(args.system)
     fmu_dir = args.fmu_dir
@@ -136,35 +139,24 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _cosim_study(args: argparse.Namespace) -> int:
-    import time
+    from rover_cosim.jobs.cosim_study import write_cosim_study
+    from rover_cosim.orchestrator.master import RunError
+    from rover_cosim.orchestrator.system import SystemFileError
 
-    from .cosim_study import coupling_errors, figure_png
-    from .master import RunError
-    from .outputs import json_bytes, run_record, write_all
-    from .system import SystemFileError
-
-    started = time.perf_counter()
     try:
-        table = coupling_errors(args.fmu_dir)
+        outcome = write_cosim_study(args.fmu_dir, args.out)
     except (SystemFileError, RunError) as error:
         print(f"rover-cosim cosim-study: {error} (nothing written)", file=sys.stderr)
         return 1
-    record = run_record("rover-cosim cosim-study", {"fmu_dir": str(args.fmu_dir)})
-    record["wall_seconds"] = time.perf_counter() - started
-    files = {args.out / "coupling_error.csv": table.to_csv(index=False, float_format="%.6g").encode(),
-             args.out / "coupling_error.png": figure_png(table),
-             args.out / "coupling_error.json": json_bytes(record)}
-    write_all(files)
-    print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-    for path in files:
+    print(outcome.table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for path in outcome.files:
         print(f"wrote {path}")
     return 0
 
 
 def _identify(args: argparse.Namespace) -> int:
-    from identification.job import run_identification
-
-    from .progress import ProgressBar
+    from rover_cosim.jobs.identify import run_identification
+    from rover_cosim.progress import ProgressBar
 
     if args.workers is not None and args.workers < 1:
         print(f"rover-cosim identify: --workers {args.workers}: expected >= 1", file=sys.stderr)
@@ -181,20 +173,19 @@ def _identify(args: argparse.Namespace) -> int:
         print(f"rover-cosim identify: {error} (nothing written)", file=sys.stderr)
         return 1
     bar.close()
-    record = outcome["record"]
-    print(f"sweep: {record['runs_computed']} runs computed, {record['runs_cached']} from the cache, "
-          f"{record['runs_failed']} failed, {record['sweep_wall_seconds']:.1f} s")
-    print(outcome["fit"].to_string(index=False, float_format=lambda v: f"{v:.1f}"))
-    for path in outcome["files"]:
+    sweep = outcome.sweep
+    print(f"sweep: {sweep.computed} runs computed, {sweep.cached} from the cache, "
+          f"{len(sweep.failures)} failed, {sweep.wall_seconds:.1f} s")
+    print(outcome.fit.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
+    for path in outcome.files:
         print(f"wrote {path}")
     return 0
 
 
 def _simulate(args: argparse.Namespace) -> int:
-    from control.simulate import run_simulation
-
-    from .master import RunError
-    from .system import SystemFileError
+    from rover_cosim.jobs.simulate import run_simulation
+    from rover_cosim.orchestrator.master import RunError
+    from rover_cosim.orchestrator.system import SystemFileError
 
     if not args.model.is_file():
         print(f"rover-cosim simulate: identified model {args.model} not found (run `make identify`)", file=sys.stderr)
@@ -204,21 +195,21 @@ def _simulate(args: argparse.Namespace) -> int:
     except (SystemFileError, RunError, ValueError) as error:
         print(f"rover-cosim simulate: {error} (nothing written)", file=sys.stderr)
         return 1
-    for plant, checks in outcome["record"]["checks"].items():
+    for plant, checks in outcome.record["checks"].items():
         print(f"{plant}: " + ", ".join(f"{k} {v:.4g}" for k, v in checks.items() if v is not None))
-    for plant, table in outcome["rms"].items():
+    for plant, table in outcome.rms.items():
         print(f"RMS(Fx - Fx_des) [N], {plant}: " + ", ".join(f"{r:.3f}" for r in table["rms_N"]))
-    print("fixed-load ablation RMS [N]: " + ", ".join(f"{r:.3f}" for r in outcome["ablation"]["rms_fixed_load_N"]))
-    for path in outcome["files"]:
+    print("fixed-load ablation RMS [N]: " + ", ".join(f"{r:.3f}" for r in outcome.ablation["rms_fixed_load_N"]))
+    for path in outcome.files:
         print(f"wrote {path}")
     return 0
 
 
 def _build_fmus(args: argparse.Namespace) -> int:
-    from fmubuild.build import FMU_MODELS, build_all
-    from fmubuild.expressions import UnsupportedConstruct
+    from rover_cosim.fmubuild.build import FMU_MODELS, BuildResult, build_all
+    from rover_cosim.fmubuild.expressions import UnsupportedConstruct
 
-    def report(result) -> None:  # type: ignore[no-untyped-def]
+    def report(result: BuildResult) -> None:
         if result.rebuilt:
             stages = ", ".join(f"{k} {v:.1f} s" for k, v in result.stages.items())
             print(f"built {result.path} in {result.seconds:.1f} s ({stages})", flush=True)
@@ -237,38 +228,36 @@ def _build_fmus(args: argparse.Namespace) -> int:
     return 0
 
 
+def _report(args: argparse.Namespace) -> int:
+    from rover_cosim.common.outputs import write_all
+    from rover_cosim.report import build_report
+
+    target = args.out or args.results / "report.html"
+    write_all({target: build_report(args.results).encode()})
+    print(f"wrote {target}")
+    return 0
+
+
+def _fig3(args: argparse.Namespace) -> int:
+    from rover_cosim.jobs.fig3 import PAPER_LOADS, slip_grid, write_fig3
+
+    try:
+        written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step))
+    except ValueError as error:
+        print(f"rover-cosim fig3: {error}", file=sys.stderr)
+        return 2
+    for path in written:
+        print(f"wrote {path}")
+    return 0
+
+
+COMMANDS = {"build-fmus": _build_fmus, "run": _run, "cosim-study": _cosim_study, "identify": _identify,
+            "simulate": _simulate, "report": _report, "fig3": _fig3}
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    if args.command == "build-fmus":
-        return _build_fmus(args)
-    if args.command == "run":
-        return _run(args)
-    if args.command == "cosim-study":
-        return _cosim_study(args)
-    if args.command == "identify":
-        return _identify(args)
-    if args.command == "simulate":
-        return _simulate(args)
-    if args.command == "report":
-        from control.report import build_report
-
-        from .outputs import write_all
-
-        target = args.out or args.results / "report.html"
-        write_all({target: build_report(args.results).encode()})
-        print(f"wrote {target}")
-        return 0
-    if args.command == "fig3":
-        from .fig3 import PAPER_LOADS, slip_grid, write_fig3
-
-        try:
-            written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step))
-        except ValueError as error:
-            print(f"rover-cosim fig3: {error}", file=sys.stderr)
-            return 2
-        for path in written:
-            print(f"wrote {path}")
-    return 0
+    return COMMANDS[args.command](args)
 
 
 if __name__ == "__main__":

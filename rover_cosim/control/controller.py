@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from scipy.linalg import expm
 
-from identification.fits import IdentifiedModel
+from rover_cosim.identification.fits import IdentifiedModel
 
 WHEELS = 6
 

@@ -8,22 +8,34 @@ left is the error of cutting the rover at the hubs: the body sees the wheels' Fx
 
 from __future__ import annotations
 
+import io
+import time
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .master import run
-from .system import system_from_dict
+from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.orchestrator.examples import example
+from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.system import System, system_from_dict
 
-STEPS = (1e-3, 2e-3, 5e-3, 10e-3)
+STEPS = (1e-3, 2e-3, 5e-3, 10e-3)  # s
 ALGORITHMS = ("jacobi", "gauss-seidel")
-SYSTEMS = Path(__file__).resolve().parent / "systems"
 
 
-def _system(name: str, fmu_dir: Path, **simulation: object):
-    path = SYSTEMS / f"{name}.toml"
+@dataclass
+class CosimStudyResult:
+    """What ``write_cosim_study`` wrote: the table of coupling errors and the files."""
+
+    table: pd.DataFrame
+    files: list[Path]
+
+
+def _system(name: str, fmu_dir: Path, **simulation: object) -> System:
+    path = example(name)
     data = tomllib.loads(path.read_text())
     data["simulation"].update(simulation)
     return system_from_dict(data, name=f"{path.name} {simulation}", base=fmu_dir, path=path)
@@ -57,8 +69,6 @@ def coupling_errors(fmu_dir: Path, steps: tuple[float, ...] = STEPS, stop_time: 
 
 
 def figure_png(table: pd.DataFrame) -> bytes:
-    import io
-
     import matplotlib
 
     matplotlib.use("Agg")
@@ -81,3 +91,16 @@ def figure_png(table: pd.DataFrame) -> bytes:
     fig.savefig(buffer, format="png", dpi=120)
     plt.close(fig)
     return buffer.getvalue()
+
+
+def write_cosim_study(fmu_dir: Path, out_dir: Path) -> CosimStudyResult:
+    """Run the study and write coupling_error.csv, .png and .json into ``out_dir`` (all or none)."""
+    started = time.perf_counter()
+    table = coupling_errors(fmu_dir)
+    record = run_record("rover-cosim cosim-study", {"fmu_dir": str(fmu_dir)})
+    record["wall_seconds"] = time.perf_counter() - started
+    files = {out_dir / "coupling_error.csv": table.to_csv(index=False, float_format="%.6g").encode(),
+             out_dir / "coupling_error.png": figure_png(table),
+             out_dir / "coupling_error.json": json_bytes(record)}
+    write_all(files)
+    return CosimStudyResult(table, list(files))

@@ -17,26 +17,38 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
-from orchestrator.outputs import file_sha256, json_bytes, run_record, write_all
-
-from . import figures
-from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
-from .sweep import SweepPlan, run_sweep
-from .testbed import shared_test_bed
-from .validate import validate
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.identification import figures
+from rover_cosim.identification.fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
+from rover_cosim.identification.sweep import SweepOutcome, SweepPlan, run_sweep
+from rover_cosim.identification.testbed import shared_test_bed
+from rover_cosim.identification.validate import validate
 
 MODELS = {"quadratic": 2, "linear": 1}  # label -> degree in slip; the first is recommended
 RECOMMENDED = "quadratic"
 
 
+@dataclass
+class IdentificationResult:
+    """What ``run_identification`` wrote and found."""
+
+    files: list[Path]           # every file written, sorted
+    fit: pd.DataFrame           # Table 1: load_N, fit_percent (recommended model) and both models' Fits
+    sweep: SweepOutcome          # the sweep's runs, failures and counts
+    record: dict[str, Any]      # identification.json: parameters, versions, wall times
+    model: dict[str, Any]       # model.json as written
+
+
 def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None = None, workers: int | None = None,
                        scheduler: str | None = None, cache_dir: Path | None = None,
-                       progress: Callable[[float], None] | None = None) -> dict[str, object]:
+                       progress: Callable[[float], None] | None = None) -> IdentificationResult:
+    """Sweep, fit, validate and write every file of ``results/identification/`` (all or none)."""
     started = time.perf_counter()
     plan = plan or SweepPlan()
     cache_dir = cache_dir or out_dir / "cache"
@@ -51,7 +63,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     long = pd.concat([run.assign(load_N=load, torque_N_m=torque) for (load, torque), run in sorted(sweep.runs.items())],
                      ignore_index=True)
     long = long[["load_N", "torque_N_m", *[c for c in long.columns if c not in ("load_N", "torque_N_m")]]]
-    failures = pd.DataFrame([{"load_N": w, "torque_N_m": t, "error": e} for (w, t), e in sorted(sweep.failures.items())],
+    failed = sorted(sweep.failures.items())
+    failures = pd.DataFrame([{"load_N": w, "torque_N_m": t, "error": e} for (w, t), e in failed],
                             columns=["load_N", "torque_N_m", "error"])
     fmu_sha = file_sha256(Path(fmu_path))
     model_json = {
@@ -73,7 +86,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
         out / "runs.csv": long.to_csv(index=False, float_format="%.10g").encode(),
         out / "steps.csv": table.to_csv(index=False, float_format="%.10g").encode(),
         out / "model.json": json_bytes(model_json),
-        out / "fit_table.csv": validation.fit[["load_N", "fit_percent"]].to_csv(index=False, float_format="%.3f").encode(),
+        out / "fit_table.csv":
+            validation.fit[["load_N", "fit_percent"]].to_csv(index=False, float_format="%.3f").encode(),
         out / "fit_models.csv": fit_models.to_csv(index=False, float_format="%.3f").encode(),
         out / "fit_detail.csv": validation.detail.to_csv(index=False, float_format="%.6g").encode(),
         out / "failures.csv": failures.to_csv(index=False).encode(),
@@ -86,5 +100,4 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
         out / "identification.json": json_bytes(record),
     }
     write_all(files)
-    return {"files": sorted(files), "fit": validation.fit, "sweep": sweep, "record": record,
-            "model": json.loads(files[out / "model.json"])}
+    return IdentificationResult(sorted(files), validation.fit, sweep, record, json.loads(files[out / "model.json"]))

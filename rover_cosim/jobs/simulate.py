@@ -13,32 +13,46 @@ results/simulation/
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from orchestrator.master import run
-from orchestrator.outputs import file_sha256, json_bytes, run_record, write_all
-from orchestrator.system import system_from_dict
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
+from rover_cosim.control.figures import fig10
+from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.system import system_from_dict
 
-STOP_TIME = 20.0
-STEP = 1e-3
-LIMBS = range(1, 7)
-PAPER_RMS = {1: 0.7, 2: 0.4, 3: 0.5}  # Table 3 [N], limbs 1-3
-STATIC_LOAD = 1570.0 * 1.62 / 6       # N, the fixed load of the ablation
+STOP_TIME = 20.0  # s
+STEP = 1e-3       # s
+LIMBS = range(1, WHEELS + 1)
+STATIC_LOAD = STATIC_WHEEL_LOAD  # N, the fixed load of the ablation
+
+
+@dataclass
+class SimulationResult:
+    """What ``run_simulation`` wrote and measured."""
+
+    files: list[Path]                   # every file written, sorted
+    record: dict[str, Any]              # simulation.json: parameters, hashes, wall times, checks
+    tables: dict[str, pd.DataFrame]     # per plant ("monolithic", "cosim"): trajectories.csv columns
+    rms: dict[str, pd.DataFrame]        # per plant: limb, rms_N (Table 3)
+    ablation: pd.DataFrame              # limb, rms_lut_N, rms_fixed_load_N
 
 
 def controller_block(model: Path, **options: Any) -> dict[str, Any]:
-    return {"name": "ctrl", "type": "python", "factory": "control.controller:InverseModelController",
+    return {"name": "ctrl", "type": "python", "factory": "rover_cosim.control.controller:InverseModelController",
             "model": str(model), "step": STEP, **options}
 
 
 def monolithic_system(fmu_dir: Path, model: Path, **options: Any) -> dict[str, Any]:
     connections = [{"from": "rover.x", "to": "ctrl.x"}, {"from": "rover.v", "to": "ctrl.v"}]
     for i in LIMBS:
-        connections += [{"from": f"rover.Fz[{i}]", "to": f"ctrl.W[{i}]"}, {"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"}]
+        connections += [{"from": f"rover.Fz[{i}]", "to": f"ctrl.W[{i}]"},
+                        {"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"}]
     return {"simulation": {"stop_time": STOP_TIME, "step": STEP, "algorithm": "gauss-seidel"},
             "fmu": [{"name": "rover", "path": str(fmu_dir / "Rover.fmu")}],
             "block": [controller_block(model, **options)], "connection": connections}
@@ -74,7 +88,8 @@ def trajectories(data: pd.DataFrame, plant: str) -> pd.DataFrame:
 
 def rms(table: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame({"limb": list(LIMBS),
-                         "rms_N": [float(np.sqrt(np.mean((table[f"Fx_{i}"] - table[f"Fx_des_{i}"]) ** 2))) for i in LIMBS]})
+                         "rms_N": [float(np.sqrt(np.mean((table[f"Fx_{i}"] - table[f"Fx_des_{i}"]) ** 2)))
+                                   for i in LIMBS]})
 
 
 def checks(table: pd.DataFrame) -> dict[str, Any]:
@@ -91,9 +106,8 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
             "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
 
 
-def run_simulation(fmu_dir: Path, model: Path, out_dir: Path) -> dict[str, Any]:
-    from .figures import fig10
-
+def run_simulation(fmu_dir: Path, model: Path, out_dir: Path) -> SimulationResult:
+    """The closed loop on both plants and the ablation; writes every file (all or none)."""
     started = time.perf_counter()
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
@@ -130,5 +144,5 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path) -> dict[str, Any]:
         out / "simulation.json": json_bytes(record),
     }
     write_all(files)
-    return {"files": sorted(files), "record": record, "tables": tables, "rms": {"monolithic": rms_mono, "cosim": rms_cosim},
-            "ablation": ablation_table}
+    return SimulationResult(sorted(files), record, tables, {"monolithic": rms_mono, "cosim": rms_cosim},
+                            ablation_table)

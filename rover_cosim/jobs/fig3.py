@@ -14,15 +14,14 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from terramechanics import Soil, Wheel, wheel_state
-
-from .outputs import json_bytes, run_record, write_all
+from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.common.paper import LOADS as PAPER_LOADS
+from rover_cosim.terramechanics import Soil, Wheel, wheel_state
 
 CSV_NAME = "fig3_fx_vs_slip.csv"
 PNG_NAME = "fig3_fx_vs_slip.png"
 RECORD_NAME = "fig3_fx_vs_slip.json"
 COLUMNS = ["load_N", "slip", "sinkage_m", "Fx_N", "Fz_N", "Tx_Nm"]
-
 
 
 def slip_grid(step: float, last: float = 0.9) -> tuple[float, ...]:
@@ -31,7 +30,6 @@ def slip_grid(step: float, last: float = 0.9) -> tuple[float, ...]:
     return tuple(float(k) for k in np.round(np.linspace(0.0, last, count), 10))
 
 
-PAPER_LOADS = tuple(float(w) for w in range(100, 801, 100))  # [N], Sec. 2.2.7
 PAPER_SLIPS = slip_grid(0.01)  # [-]
 
 

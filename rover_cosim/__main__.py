@@ -1,4 +1,4 @@
-"""``python -m orchestrator`` is ``rover-cosim``."""
+"""``python -m rover_cosim`` is ``rover-cosim``."""
 
 import sys
 

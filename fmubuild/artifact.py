@@ -1,0 +1,52 @@
+"""What a built FMU is made from and what it records about that: the runtime files and compiler
+flags, the input digest that decides whether an FMU is up to date, and the build record stored in
+the FMU (``documentation/build.json``). Shared by both backends (``build``, ``omc``)."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import zipfile
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+
+from . import source
+
+RUNTIME = Path(__file__).parent / "runtime"
+RUNTIME_FILES = ("model.h", "ode23s.h", "ode23s.c", "fmi2_runtime.c")
+CFLAGS = ("-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-std=c99", "-D_POSIX_C_SOURCE=200809L")
+BUILD_RECORD = "documentation/build.json"
+
+
+@dataclass
+class BuildResult:
+    name: str
+    path: Path
+    rebuilt: bool
+    seconds: float
+    stages: dict[str, float] = field(default_factory=dict)  # translate, generate, compile, package [s]
+
+
+def input_digest(name: str) -> str:
+    """Digest of everything a built-in FMU of ``name`` is made from."""
+    digest = hashlib.sha256(name.encode())
+    files = sorted((source.MODELICA_ROOT / source.PACKAGE).rglob("*")) + sorted(Path(__file__).parent.glob("*.py"))
+    files += [RUNTIME / f for f in RUNTIME_FILES]
+    for path in files:
+        if path.is_file():
+            digest.update(str(path.relative_to(path.parents[1])).encode())
+            digest.update(path.read_bytes())
+    for package in ("rumoca", "casadi"):
+        digest.update(f"{package}=={metadata.version(package)}".encode())
+    digest.update(" ".join(CFLAGS).encode())
+    return digest.hexdigest()
+
+
+def stored_digest(fmu: Path) -> str | None:
+    """The input digest recorded in an FMU built by this module, or None."""
+    try:
+        with zipfile.ZipFile(fmu) as archive:
+            return json.loads(archive.read(BUILD_RECORD))["input_sha256"]
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return None
