@@ -20,11 +20,12 @@ from pathlib import Path
 
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.fmubuild import build
+from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.libcosim import run_libcosim
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.system import system_from_dict
 
-SYSTEM = Path(__file__).resolve().parent.parent / "orchestrator" / "systems" / "rover_cosim.toml"
+SYSTEM = example("rover_cosim")
 FLOOR_RATIO = 3.0
 TORQUE = 20.0  # N·m
 

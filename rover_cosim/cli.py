@@ -1,4 +1,4 @@
-"""``rover-cosim``: the command behind the Makefile targets."""
+"""rover-cosim: terramechanics rover co-simulation; the command behind the Makefile targets."""
 
 from __future__ import annotations
 
