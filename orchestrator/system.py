@@ -107,9 +107,6 @@ class System:
         entries.update({b.name: b for b in self.blocks})
         return entries
 
-    def participant(self, name: str) -> FmuEntry | BlockEntry:
-        return self.participants()[name]
-
 
 #: The keys each section of a system file may have.
 SECTION_KEYS = {
