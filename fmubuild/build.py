@@ -60,6 +60,14 @@ def fmi_headers() -> Path:
     return folder
 
 
+def _default_experiment(name: str) -> source.Experiment | None:
+    """The class's ``experiment`` annotation, for the model description's DefaultExperiment."""
+    try:
+        return source.experiment(f"{source.PACKAGE}.{name}")
+    except ValueError:
+        return None
+
+
 def _class_description(name: str) -> str:
     text = source.class_file(f"{source.PACKAGE}.{name}").read_text()
     head = text.split("\n", 3)
@@ -104,7 +112,8 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
         source_files = sorted(p.name for p in sources.iterdir())
         version = metadata.version("rover-cosim")
         (root / "modelDescription.xml").write_text(
-            description.model_description(model_layout, guid, source_files, _class_description(name), version))
+            description.model_description(model_layout, guid, source_files, _class_description(name), version,
+                                          _default_experiment(name)))
         stages["generate"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()

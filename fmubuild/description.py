@@ -11,6 +11,7 @@ import xml.etree.ElementTree as ET
 from rover_cosim.common.units import base_units
 
 from .codegen import FmuVariable, ModelLayout
+from .source import Experiment
 
 GENERATOR = "rover-cosim fmubuild (rumoca + CasADi + own FMI 2.0 runtime)"
 
@@ -98,8 +99,9 @@ def _model_structure(root: ET.Element, model_layout: ModelLayout, index: dict[in
 
 
 def model_description(model_layout: ModelLayout, guid: str, sources: list[str], description: str,
-                      version: str) -> str:
-    """The modelDescription.xml text of an FMU of ``model_layout``."""
+                      version: str, experiment: Experiment | None = None) -> str:
+    """The modelDescription.xml text of an FMU of ``model_layout``; ``experiment`` (the model's
+    ``experiment`` annotation) gives the DefaultExperiment's stop time and step size."""
     root = ET.Element("fmiModelDescription", {
         "fmiVersion": "2.0",
         "modelName": model_layout.name,
@@ -114,9 +116,15 @@ def model_description(model_layout: ModelLayout, guid: str, sources: list[str], 
     _unit_definitions(root, model_layout)
     categories = ET.SubElement(root, "LogCategories")
     ET.SubElement(categories, "Category", {"name": "logStatusError", "description": "errors, always reported"})
+    ET.SubElement(categories, "Category", {"name": "logStatusWarning",
+                                           "description": "warnings (assert level warning), always reported"})
     ET.SubElement(categories, "Category", {"name": "logStatistics",
                                            "description": "Co-Simulation integrator counts, at fmi2Terminate"})
-    ET.SubElement(root, "DefaultExperiment", {"startTime": "0.0", "tolerance": "1e-06"})
+    default = {"startTime": "0.0", "tolerance": "1e-06"}
+    if experiment is not None:
+        default = {"startTime": repr(experiment.start), "stopTime": repr(experiment.stop),
+                   "tolerance": repr(experiment.tolerance or 1e-6), "stepSize": repr(experiment.interval)}
+    ET.SubElement(root, "DefaultExperiment", default)
     index = _model_variables(root, model_layout)
     _model_structure(root, model_layout, index)
     ET.indent(root)

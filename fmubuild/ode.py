@@ -12,9 +12,10 @@ names the equation and its source line and suggests the omc backend.
 
 from __future__ import annotations
 
+import json
 import sys
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
@@ -43,6 +44,18 @@ class Variable:
     is_output: bool = False  # a top-level output (a state can be one too)
 
 
+@dataclass(frozen=True)
+class Assertion:
+    """A Modelica ``assert``: the FMU reports ``message`` with the values of the variables the
+    condition reads when the condition does not hold."""
+
+    condition: ca.MX  # 1 where it holds, an expression of (t, x, u, p)
+    message: str
+    level: str  # "error" or "warning"
+    names: tuple[str, ...]  # variables the condition reads, by the name the user knows them
+    values: tuple[ca.MX, ...]  # their values, expressions of (t, x, u, p)
+
+
 @dataclass
 class OdeModel:
     """The explicit ODE of a model; CasADi expressions in the symbols t, x, u, p."""
@@ -62,6 +75,7 @@ class OdeModel:
     x0: ca.MX  # start values of the states, an expression of p
     parameter_values: dict[str, float] = field(default_factory=dict)
     calculated: dict[str, ca.MX] = field(default_factory=dict)  # dependent parameters, expressions of p
+    asserts: list[Assertion] = field(default_factory=list)
 
     def functions(self) -> tuple[ca.Function, ca.Function, ca.Function]:
         """``ode(t, x, u, p) -> xdot``, ``outputs(t, x, u, p) -> y``, ``initial(p) -> x0``."""
@@ -277,11 +291,62 @@ def translate(model: Any, name: str) -> OdeModel:
 
     xdot = ca.vertcat(*[_mx(env[f"der({s})"]) for s in states]) if states else ca.MX(0, 1)
     observed = [s for s in unknowns if not s.startswith("der(")]
-    y = ca.vertcat(*[_mx(env[s]) for s in observed]) if observed else ca.MX(0, 1)
     x0 = _start_values(states, infos, parameters, name)
+    states, observed, renamed = _public_state_names(states, observed, env, x, infos)
+    y = ca.vertcat(*[_mx(env[s]) for s in observed]) if observed else ca.MX(0, 1)
     variables = _variables(infos, types, parameters, inputs, states)
+    for public, inner in renamed.items():  # the public name keeps the inner state's start and description
+        variables[public] = replace(variables[public], start=variables[inner].start,
+                                    description=variables[public].description or variables[inner].description)
+    asserts = _asserts(flat, env, parameters, library, locate, name)
     return OdeModel(name, variables, states, inputs, parameters.free, observed, t, x, u, p, xdot, y, x0,
-                    parameters.defaults, parameters.calculated)
+                    parameters.defaults, parameters.calculated, asserts)
+
+
+def _public_state_names(states: list[str], observed: list[str], env: Mapping[str, Value], x: ca.MX,
+                        infos: dict[str, Info]) -> tuple[list[str], list[str], dict[str, str]]:
+    """States named by the top-level output that equals them (``omega = rigidWheel.omega``
+    makes ``omega`` the state, ``rigidWheel.omega`` an observed alias), so that importers set a
+    state's start under its public name. Returns states, observed and {public: inner name}."""
+    public_of: dict[str, str] = {}
+    for name in observed:
+        info, _, flat_name = infos[name]
+        if _role_names(info)[1] != "Output" or "." in flat_name or not isinstance(env[name], ca.MX):
+            continue
+        for i, state in enumerate(states):
+            if "." in state and state not in public_of and ca.is_equal(env[name], x[i], 2):
+                public_of[state] = name
+                break
+    renamed = {public: inner for inner, public in public_of.items()}
+    new_states = [public_of.get(s, s) for s in states]
+    new_observed = [renamed.get(o, o) for o in observed]
+    return new_states, new_observed, renamed
+
+
+def _asserts(flat: Mapping[str, Any], env: Mapping[str, Value], parameters: _Parameters, library: FunctionLibrary,
+             locate: _Locator, name: str) -> list[Assertion]:
+    """The model's ``assert(condition, "message")`` equations as CasADi expressions, one per
+    distinct (message, variables); conditions are checked by the FMU, not turned into events."""
+    asserts: dict[tuple[str, tuple[str, ...]], Assertion] = {}
+    for equation in flat.get("assert_equations", []):
+        where = f"{name}: assert at {locate(equation.get('span'))}"
+        message_node = equation["message"]
+        if "Literal" not in message_node or "String" not in message_node["Literal"]["value"]:
+            raise UnsupportedConstruct("assert message that is not a string literal", where)
+        message = message_node["Literal"]["value"]["String"]
+        level = "warning" if "warning" in json.dumps(equation.get("level")).lower() else "error"
+        condition = Evaluator(partial(_lookup, env, where=where), library.call, where)(equation["condition"])
+        referenced = sorted(n for n in _incidence(equation["condition"], list(env)) if n != "time")
+        names = tuple(_public_name(n, parameters) for n in referenced)
+        values = tuple(_mx(env[n]) for n in referenced)
+        asserts.setdefault((message, names), Assertion(_mx(condition), message, level, names, values))
+    return list(asserts.values())
+
+
+def _public_name(scalar: str, parameters: _Parameters) -> str:
+    """A parameter bound to another one (``wheels[1].soil.phi = soil.phi``) by the name of that one."""
+    value = parameters.calculated.get(scalar)
+    return value.name() if isinstance(value, ca.MX) and value.is_symbolic() else scalar
 
 
 def _mx(value: Value) -> ca.MX:

@@ -20,11 +20,14 @@ import pandas as pd
 from scipy.interpolate import RegularGridInterpolator
 from scipy.optimize import least_squares
 
-#: Settled points enter the Fx(slip) fits when their torque is within what the rover uses
-#: (its open-loop run drives with 9-40 N·m) and their slip is in SLIP_FIT_RANGE (beyond it the
-#: wheel spins out or skids). The sweep's higher torques still shape the K, T tables.
+#: Settled points enter the Fx(slip) fits when the wheel still rolls (see step_table), their torque
+#: is within what the rover uses (its open-loop run drives with 9-40 N·m) and their slip is in
+#: SLIP_FIT_RANGE (beyond it the wheel spins out or skids). The sweep's higher torques still shape
+#: the K, T tables.
 FIT_TORQUE_MAX = 40.0
 SLIP_FIT_RANGE = (-0.1, 0.5)
+#: m/s: a run whose settled carriage speed is below this has stopped rolling (static regime).
+ROLLING_SPEED = 0.01
 #: The settled value of a run is the mean over its last fraction.
 SETTLED_FRACTION = 0.2
 
@@ -150,20 +153,29 @@ class IdentifiedModel:
 
 
 def step_table(runs: dict[tuple[float, float], pd.DataFrame]) -> pd.DataFrame:
-    """One row per run: load, torque, settled slip and Fx, fitted K and T."""
+    """One row per run: load, torque, settled slip and Fx, fitted K and T, and whether the wheel
+    still rolls at the end (settled speed above ROLLING_SPEED). A wheel that has come to rest is
+    in the static regime, where the paper's torque -> slip -> force model does not apply; such
+    runs are left out of the fits."""
     rows = []
     for (load, torque), run in sorted(runs.items()):
         gain, constant = first_order_fit(run["time"].to_numpy(), run["slip"].to_numpy(), torque)
+        rolling = "v" not in run or settled(run, "v") > ROLLING_SPEED
         rows.append({"load_N": load, "torque_N_m": torque, "slip": settled(run, "slip"), "Fx_N": settled(run, "Fx"),
-                     "K_per_N_m": gain, "T_s": constant})
+                     "K_per_N_m": gain, "T_s": constant, "rolling": bool(rolling)})
     return pd.DataFrame(rows)
+
+
+def _rolling(table: pd.DataFrame) -> pd.DataFrame:
+    """The rows of runs in which the wheel still rolls (all rows of a table without that column)."""
+    return table[table["rolling"].astype(bool)] if "rolling" in table else table
 
 
 def fx_per_load(table: pd.DataFrame, degree: int = 1) -> pd.DataFrame:
     """Per load, the polynomial Fx(slip) of ``degree`` through the settled points with torque up
     to FIT_TORQUE_MAX and slip in SLIP_FIT_RANGE: columns load_N, c0 (= b), c1 (= a), ..."""
     rows = []
-    for load, part in table.groupby("load_N"):
+    for load, part in _rolling(table).groupby("load_N"):
         inside = part[(part["slip"] >= SLIP_FIT_RANGE[0]) & (part["slip"] <= SLIP_FIT_RANGE[1])
                       & (part["torque_N_m"] <= FIT_TORQUE_MAX)]
         if len(inside) < degree + 1:
@@ -175,14 +187,16 @@ def fx_per_load(table: pd.DataFrame, degree: int = 1) -> pd.DataFrame:
 
 
 def _filled(table: pd.DataFrame, column: str, loads: np.ndarray, torques: np.ndarray) -> np.ndarray:
-    """The (load, torque) grid of ``column``; a cell without a run (a failed one) is interpolated
-    along the torque axis of its load."""
+    """The (load, torque) grid of ``column``; a cell without a run (a failed one, or one where the
+    wheel stopped rolling) is interpolated along the torque axis of its load (the nearest value
+    beyond either end)."""
     grid = table.pivot(index="load_N", columns="torque_N_m", values=column).reindex(index=loads, columns=torques)
     values = grid.to_numpy(dtype=float, copy=True)
     for i, row in enumerate(values):
         known = np.isfinite(row)
         if not known.any():
-            raise ValueError(f"load {loads[i]} N: no successful run to fill the look-up table")
+            raise ValueError(f"load {loads[i]} N: no successful run in which the wheel rolls, to fill the "
+                             f"look-up table")
         values[i] = np.interp(torques, torques[known], row[known])
     return values
 
@@ -191,8 +205,8 @@ def identify(table: pd.DataFrame, degree: int = 1) -> IdentifiedModel:
     """The identified model from the step table (LUTs) and the Fx fits (quadratic in W)."""
     loads = np.array(sorted(table["load_N"].unique()))
     torques = np.array(sorted(table["torque_N_m"].unique()))
-    gain = _filled(table, "K_per_N_m", loads, torques)
-    constant = _filled(table, "T_s", loads, torques)
+    gain = _filled(_rolling(table), "K_per_N_m", loads, torques)
+    constant = _filled(_rolling(table), "T_s", loads, torques)
     per_load = fx_per_load(table, degree)
     coefficients = np.array([np.polynomial.polynomial.polyfit(per_load["load_N"], per_load[f"c{k}"], 2)
                              for k in range(degree + 1)])

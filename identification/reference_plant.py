@@ -1,65 +1,72 @@
 """The single-wheel test bed in Python on the numpy reference wheel: the same experiment as
-SingleWheel.fmu, for the cross-check of the identification.
+SingleWheel.fmu, for the cross-check of the identification and of the motion regimes.
 
-    J dω/dt = τ - Tx(W, κ),   (W/g) dv/dt = Fx(W, κ),   κ = slip_ratio(r ω, v, v_eps)
+    J dω/dt = τ - Tx,   (W/g) dv/dt = Fx - W sin(slope),   dx/dt = v
 
-with the forces from :func:`terramechanics.wheel_state` (sinkage solving Fz = W), integrated by
-SciPy's Radau method (the start from rest is stiff: dκ/dω = r/v_eps there).
+with Fx, Tx from :func:`terramechanics.wheel_forces` under the load W cos(slope) normal to the
+slope (positive slope: uphill), integrated by SciPy's Radau method (the start from rest and the
+static regime are stiff).
 """
 
 from __future__ import annotations
 
 import itertools
+import math
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
-from rover_cosim.terramechanics import Soil, Wheel, slip_ratio, wheel_state
+from rover_cosim.terramechanics import Regimes, Soil, Wheel, wheel_forces
 
 from .testbed import RECORDED, TorqueProfile
 
 G_MOON = 1.62   # m/s², as the SingleWheel model's default g
-V_EPS = 1e-3    # m/s, as the SingleWheel model's default vEps
+
+
+@dataclass(frozen=True)
+class TestBedStart:
+    """Initial state of the carriage and wheel: position x [m], speed v [m/s], spin omega [rad/s]."""
+
+    x: float = 0.0
+    v: float = 0.0
+    omega: float = 0.0
 
 
 def run_reference_test_bed(load: float, torque: TorqueProfile, stop_time: float, sample_time: float, *,
-                 wheel: Wheel | None = None, soil: Soil | None = None, g: float = G_MOON,
-                 v_eps: float = V_EPS) -> pd.DataFrame:
-    """Columns as :meth:`identification.testbed.WheelTestBed.run` (time, tau, RECORDED)."""
-    wheel = wheel or Wheel()
-    soil = soil or Soil()
+                           wheel: Wheel | None = None, soil: Soil | None = None, g: float = G_MOON,
+                           regimes: Regimes | None = None, slope: float = 0.0,
+                           start: TestBedStart | None = None) -> pd.DataFrame:
+    """Columns as :meth:`identification.testbed.WheelTestBed.run` (time, tau, RECORDED), then x [m]."""
+    wheel, soil, regimes, start = wheel or Wheel(), soil or Soil(), regimes or Regimes(), start or TestBedStart()
     if not load > 0:
         raise ValueError(f"load = {load!r} N: expected > 0")
-    mass = load / g
+    if not abs(slope) < math.pi / 2:
+        raise ValueError(f"slope = {slope!r} rad: expected -pi/2 < slope < pi/2")
+    mass, normal_load, downhill = load / g, load * math.cos(slope), load * math.sin(slope)
     n = round(stop_time / sample_time)
     times = sample_time * np.arange(n + 1)
     boundaries = sorted({0.0, *[t for t in torque.times if 0 < t < stop_time], stop_time})
 
-    def forces(omega: float, v: float):
-        slip = float(slip_ratio(wheel.r * omega, v, v_eps))
-        return slip, wheel_state(load, slip, wheel, soil)
-
     def rhs(t: float, y: np.ndarray, tau: float) -> np.ndarray:
-        _, state = forces(y[0], y[1])
-        return np.array([(tau - float(state.Tx)) / wheel.J, float(state.Fx) / mass])
+        contact = wheel_forces(normal_load, y[2], y[1], wheel, soil, regimes)
+        return np.array([y[1], (float(contact.Fx) - downhill) / mass, (tau - float(contact.Tx)) / wheel.J])
 
-    states = np.zeros((n + 1, 2))
-    y = np.zeros(2)
-    for start, end in itertools.pairwise(boundaries):
-        tau = float(torque(np.array([start]))[0])
-        inside = (times > start + 1e-12) & (times <= end + 1e-12)
-        solution = solve_ivp(rhs, (start, end), y, method="Radau", t_eval=times[inside], args=(tau,),
+    states = np.zeros((n + 1, 3))
+    y = np.array([start.x, start.v, start.omega], dtype=float)
+    states[0] = y
+    for begin, end in itertools.pairwise(boundaries):
+        tau = float(torque(np.array([begin]))[0])
+        inside = (times > begin + 1e-12) & (times <= end + 1e-12)
+        solution = solve_ivp(rhs, (begin, end), y, method="Radau", t_eval=times[inside], args=(tau,),
                              rtol=1e-7, atol=1e-10)
         if not solution.success:
             raise RuntimeError(f"reference test bed at W = {load} N, tau = {tau} N·m: {solution.message}")
         states[inside] = solution.y.T
         y = solution.y[:, -1] if solution.y.size else y
-    rows = []
-    for omega, v in states:
-        slip, state = forces(omega, v)
-        rows.append([slip, float(state.Fx), float(state.Fz), float(state.Tx), float(state.sinkage), omega, v])
-    data = pd.DataFrame(rows, columns=list(RECORDED))
-    data.insert(0, "tau", torque(times))
-    data.insert(0, "time", times)
-    return data
+    contact = wheel_forces(normal_load, states[:, 2], states[:, 1], wheel, soil, regimes)
+    data = pd.DataFrame({"time": times, "tau": torque(times), "slip": contact.slip, "Fx": contact.Fx,
+                         "Fz": contact.Fz, "Tx": contact.Tx, "sinkage": contact.sinkage,
+                         "omega": states[:, 2], "v": states[:, 1], "x": states[:, 0]})
+    return data[["time", "tau", *RECORDED, "x"]]

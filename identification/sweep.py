@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import tempfile
 import time
@@ -24,6 +25,7 @@ import pandas as pd
 from rover_cosim import terramechanics
 from rover_cosim.common.outputs import file_sha256
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
+from rover_cosim.common.paper import TARGET_VELOCITY
 
 from .testbed import TorqueProfile, shared_test_bed
 
@@ -42,18 +44,25 @@ class SweepPlan:
     stop_time: float = 0.1      # s; slip and Fx settle within a millisecond on this test bed
     sample_time: float = 1e-4   # s; fixed sample time = communication step
     tolerance: float = 1e-8     # integrator tolerance inside the FMU
+    #: m/s; every run starts rolling at this speed with zero slip (omega = v/r): the regime where
+    #: the paper's model applies. From rest a torque below the rolling resistance does not drive
+    #: the wheel (it stays in the static regime), which the identified model is not made for.
+    start_speed: float = TARGET_VELOCITY
 
     def __post_init__(self) -> None:
         if not self.loads or any(not (w > 0) for w in self.loads):
             raise ValueError(f"loads = {self.loads!r}: expected loads > 0 N")
         if not self.torques:
             raise ValueError("torques: expected at least one torque level [N·m]")
+        if not (math.isfinite(self.start_speed) and self.start_speed >= 0):
+            raise ValueError(f"start_speed = {self.start_speed!r}: expected a finite speed >= 0 m/s")
         if not 0 < self.sample_time <= self.stop_time:
             raise ValueError(f"sample_time = {self.sample_time!r}, stop_time = {self.stop_time!r}: "
                              "expected 0 < sample_time <= stop_time [s]")
 
     def digest(self) -> str:
-        settings = {"stop_time": self.stop_time, "sample_time": self.sample_time, "tolerance": self.tolerance}
+        settings = {"stop_time": self.stop_time, "sample_time": self.sample_time, "tolerance": self.tolerance,
+                    "start_speed": self.start_speed}
         return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:12]
 
     def cases(self) -> list[tuple[float, float]]:
@@ -76,7 +85,7 @@ def run_file(folder: Path, load: float, torque: float) -> Path:
 
 
 def compute_run(fmu_path: str | None, load: float, torque: float, stop_time: float, sample_time: float,
-                tolerance: float, target: str) -> tuple[float, float, str | None, float]:
+                tolerance: float, start_speed: float, target: str) -> tuple[float, float, str | None, float]:
     """Run one case and write it to ``target`` atomically. Returns (load, torque, error, seconds);
     never raises, so one failing case does not stop the others (runs in worker processes).
     ``fmu_path`` None runs the numpy reference test bed instead of the FMU."""
@@ -84,11 +93,13 @@ def compute_run(fmu_path: str | None, load: float, torque: float, stop_time: flo
     try:
         profile = TorqueProfile.step(torque)
         if fmu_path is None:
-            from .reference_plant import run_reference_test_bed
+            from .reference_plant import TestBedStart, run_reference_test_bed
 
-            data = run_reference_test_bed(load, profile, stop_time, sample_time)
+            start = TestBedStart(v=start_speed, omega=start_speed / terramechanics.Wheel().r)
+            data = run_reference_test_bed(load, profile, stop_time, sample_time, start=start)
         else:
-            data = shared_test_bed(Path(fmu_path)).run(load, profile, stop_time, sample_time, tolerance)
+            data = shared_test_bed(Path(fmu_path)).run(load, profile, stop_time, sample_time, tolerance,
+                                                       start_speed=start_speed)
         target_path = Path(target)
         handle, temporary = tempfile.mkstemp(prefix=f".{target_path.name}.", suffix=".part", dir=target_path.parent)
         try:
@@ -112,7 +123,7 @@ def _plant_key(fmu_path: Path | None) -> str:
     return "reference-" + hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:12]
 
 
-Arguments = tuple[str | None, float, float, float, float, float, str]
+Arguments = tuple[str | None, float, float, float, float, float, float, str]
 Result = tuple[float, float, str | None, float]
 
 
@@ -159,7 +170,7 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
     if progress:
         progress(done / len(cases))
     arguments = [(str(fmu_path) if fmu_path else None, w, tau, plan.stop_time, plan.sample_time, plan.tolerance,
-                  str(run_file(folder, w, tau))) for w, tau in missing]
+                  plan.start_speed, str(run_file(folder, w, tau))) for w, tau in missing]
     for load, torque, error, seconds in _results(arguments, workers, scheduler):
         run_seconds[load, torque] = seconds
         if error is not None:

@@ -49,6 +49,7 @@ class WheelTestBed:
         fmpy.extract(str(self.path), self._folder.name)
         md = fmpy.read_model_description(str(self.path))
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
+        self.radius = float(next((v.start for v in md.modelVariables if v.name == "wheel.r"), 0.355))
         missing = [n for n in ("W", "tau", *RECORDED) if n not in self.refs]
         if missing:
             raise ValueError(f"{self.path}: not a SingleWheel FMU (no variables {missing})")
@@ -58,8 +59,9 @@ class WheelTestBed:
         self._fresh = True
 
     def run(self, load: float, torque: TorqueProfile, stop_time: float, sample_time: float,
-            tolerance: float = 1e-8) -> pd.DataFrame:
-        """Columns time, tau, then :data:`RECORDED`; rows at 0, sample_time, ..., stop_time."""
+            tolerance: float = 1e-8, *, start_speed: float = 0.0) -> pd.DataFrame:
+        """Columns time, tau, then :data:`RECORDED`; rows at 0, sample_time, ..., stop_time. The
+        carriage starts at ``start_speed`` [m/s] with the wheel rolling without slip (omega = v/r)."""
         if not load > 0:
             raise ValueError(f"load = {load!r} N: expected > 0")
         if not 0 < sample_time <= stop_time:
@@ -74,6 +76,8 @@ class WheelTestBed:
         taus = torque(times)
         fmu.setupExperiment(startTime=0.0)
         fmu.setReal([self.refs["W"], self.refs["tau"], self.refs["solver.tolerance"]], [load, taus[0], tolerance])
+        if start_speed:
+            fmu.setReal([self.refs["v"], self.refs["omega"]], [start_speed, start_speed / self.radius])
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
         outputs = [self.refs[name] for name in RECORDED]

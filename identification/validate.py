@@ -1,6 +1,6 @@
 """Validation of the identified model at loads off the LUT grid (275, 575, 875 N, Table 1).
 
-Per load, the FMU runs a torque staircase from rest through the rover's torque range
+Per load, the FMU runs a torque staircase, starting rolling at 1.0 m/s, through the rover's torque range
 (5, 10, 15, 20, 30, 40 N·m, each held 0.1 s); the identified model gets the same torque. The
 Fit of Eq. (15) on Fx(t) over the whole staircase is the load's figure (one step alone barely
 varies after its first millisecond, which would make Eq. (15) measure the settled error only).
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.paper import TABLE_1_FIT
+from rover_cosim.common.paper import TABLE_1_FIT, TARGET_VELOCITY
 
 from .fits import IdentifiedModel, fit_percent
 from .testbed import TorqueProfile, WheelTestBed
@@ -24,6 +24,9 @@ VALIDATION_TORQUES = (5.0, 10.0, 15.0, 20.0, 30.0, 40.0)
 HOLD = 0.1          # s per torque level
 SAMPLE_TIME = 1e-3  # s
 PAPER_FIT = TABLE_1_FIT  # Table 1 [%]
+#: m/s: the staircase starts rolling at the rover's target speed, as the identification runs do
+#: (identification.sweep.SweepPlan.start_speed), where the paper's model applies.
+START_SPEED = TARGET_VELOCITY
 
 
 @dataclass
@@ -45,7 +48,7 @@ def validate(bed: WheelTestBed, models: dict[str, IdentifiedModel],
     stop = HOLD * len(VALIDATION_TORQUES) - SAMPLE_TIME
     runs, fits, detail = {}, [], []
     for load in loads:
-        run = bed.run(load, profile, stop, SAMPLE_TIME)
+        run = bed.run(load, profile, stop, SAMPLE_TIME, start_speed=START_SPEED)
         time, torque = run["time"].to_numpy(), run["tau"].to_numpy()
         row: dict[str, float | str] = {"load_N": load}
         for i, (label, model) in enumerate(models.items()):

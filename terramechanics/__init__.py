@@ -2,17 +2,20 @@
 terramechanics as in Yoshikawa et al.
 
 Public API: ``Wheel``, ``Soil`` (parameters, Table 2 defaults), ``slip_ratio`` (Eq. 4),
-``contact_forces`` (Eqs. 1-13) and ``wheel_state`` (sinkage solving Fz = W).
+``contact_forces`` (Eqs. 1-13), ``wheel_state`` (sinkage solving Fz = W) and ``wheel_forces``
+(the wheel in every motion regime: reverse, braking, free rolling, standstill; ``Regimes``).
 """
 
 from .forces import DEFAULT_NODES, ContactForces, contact_forces
 from .kinematics import entry_angle, exit_angle, max_stress_angle, slip_ratio
 from .parameters import Soil, Wheel
+from .regimes import Regimes, WheelForces, shear_strength, steady_weight, travel_direction, wheel_forces
 from .sinkage import WheelState, bekker_sinkage, wheel_state
 from .stress import normal_stress, shear_displacement, shear_stress
 
 __all__ = [
-    "DEFAULT_NODES", "ContactForces", "Soil", "Wheel", "WheelState", "bekker_sinkage",
+    "DEFAULT_NODES", "ContactForces", "Regimes", "Soil", "Wheel", "WheelForces", "WheelState", "bekker_sinkage",
     "contact_forces", "entry_angle", "exit_angle", "max_stress_angle", "normal_stress",
-    "shear_displacement", "shear_stress", "slip_ratio", "wheel_state",
+    "shear_displacement", "shear_strength", "shear_stress", "slip_ratio", "steady_weight", "travel_direction",
+    "wheel_forces", "wheel_state",
 ]

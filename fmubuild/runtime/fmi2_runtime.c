@@ -118,6 +118,7 @@ typedef struct {
     double t, t_stop;
     int has_stop;
     double *p, *x, *u, *xdot, *y, *x_set;  /* x_set[i] != 0: the start of state i was set by the user */
+    double *holds, *assert_values;         /* the model's asserts, evaluated with the outputs */
     double rtol, max_step;
     int xdot_valid, y_valid;
     /* CasADi work */
@@ -215,7 +216,8 @@ static Instance *enter(fmi2Component component, Function f) {
 /* ---- model evaluation ------------------------------------------------------------------- */
 static int call4(Instance *c, casadi_eval f, double t, const double *x, double *out0, double *out1) {
     c->arg[0] = &t; c->arg[1] = x; c->arg[2] = c->u; c->arg[3] = c->p;
-    c->res[0] = out0; c->res[1] = out1;
+    c->res[0] = out0; c->res[1] = out1; c->res[2] = NULL;
+    if (f == model_outputs) { c->res[1] = c->holds; c->res[2] = c->assert_values; }
     return f(c->arg, c->res, c->iw, c->w, 0);
 }
 
@@ -249,9 +251,41 @@ static fmi2Status initial_states(Instance *c, Function f) {
     return fmi2OK;
 }
 
+/* Every parameter finite (NaN and infinities pass no range check). */
+static fmi2Status check_parameters(Instance *c, Function f) {
+    for (int i = 0; i < model_info.np; i++)
+        if (!isfinite(c->p[i]))
+            return fail(c, f, BROKEN, "parameter %s = %g: expected a finite value", model_info.real_names[i], c->p[i]);
+    return fmi2OK;
+}
+
+/* The model's asserts as last evaluated with the outputs: each one that does not hold is
+ * reported with the values its condition reads; an error-level one breaks the instance. */
+static fmi2Status check_asserts(Instance *c, Function f) {
+    fmi2Status status = fmi2OK;
+    for (int i = 0; i < model_info.n_asserts; i++) {
+        if (c->holds[i] != 0.0) continue;
+        char text[800];
+        size_t used = (size_t)snprintf(text, sizeof text, "%s (", model_info.assert_messages[i]);
+        for (int k = model_info.assert_value_start[i]; k < model_info.assert_value_start[i + 1]; k++)
+            if (used < sizeof text)
+                used += (size_t)snprintf(text + used, sizeof text - used, "%s%s = %.10g",
+                                         k > model_info.assert_value_start[i] ? ", " : "",
+                                         model_info.assert_value_names[k], c->assert_values[k]);
+        if (used < sizeof text) snprintf(text + used, sizeof text - used, ") at t = %.10g", c->t);
+        if (model_info.assert_is_error[i]) {
+            status = fail(c, f, BROKEN, "%s", text);
+        } else {
+            log_message(c, fmi2Warning, "logStatusWarning", "%s: %s", FUNCTIONS[f].name, text);
+            if (status == fmi2OK) status = fmi2Warning;
+        }
+    }
+    return status;
+}
+
 static fmi2Status update(Instance *c, Function f, int need_xdot, int need_y) {
     if (c->mode == MODE_INSTANTIATED || c->mode == MODE_INITIALIZATION) {
-        if (initial_states(c, f) != fmi2OK) return fmi2Error;
+        if (check_parameters(c, f) != fmi2OK || initial_states(c, f) != fmi2OK) return fmi2Error;
     }
     if (need_xdot && !c->xdot_valid) {
         if (call4(c, model_ode, c->t, c->x, c->xdot, NULL) || !all_finite(c->xdot, model_info.nx))
@@ -259,9 +293,13 @@ static fmi2Status update(Instance *c, Function f, int need_xdot, int need_y) {
         c->xdot_valid = 1;
     }
     if (need_y && !c->y_valid) {
-        if (call4(c, model_outputs, c->t, c->x, c->y, NULL) || !all_finite(c->y, model_info.ny))
+        int failed = call4(c, model_outputs, c->t, c->x, c->y, NULL);
+        fmi2Status checked = failed ? fmi2OK : check_asserts(c, f);
+        if (checked == fmi2Error) return fmi2Error;
+        if (failed || !all_finite(c->y, model_info.ny))
             return fail(c, f, BROKEN, "the outputs are not finite at t = %.17g", c->t);
         c->y_valid = 1;
+        return checked;
     }
     return fmi2OK;
 }
@@ -301,8 +339,8 @@ fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn, s
 
 static void free_instance(Instance *c) {
     fmi2CallbackFreeMemory release = c->cb.freeMemory;
-    void *blocks[] = {c->name, c->p, c->x, c->u, c->xdot, c->y, c->x_set, (void *)c->arg, c->res, c->iw,
-                      c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y};
+    void *blocks[] = {c->name, c->p, c->x, c->u, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
+                      (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y};
     for (size_t i = 0; i < sizeof(blocks) / sizeof(blocks[0]); i++) if (blocks[i]) release(blocks[i]);
     ode23s_free(&c->solver, release);
     release(c);
@@ -312,7 +350,7 @@ static casadi_work const WORKS[] = {model_ode_work, model_outputs_work, model_in
                                     model_ode_jacobian_work, model_directional_work};
 
 static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
-    casadi_int sz_arg = 6, sz_res = 2, sz_iw = 0, sz_w = 0;
+    casadi_int sz_arg = 6, sz_res = 3, sz_iw = 0, sz_w = 0;
     for (size_t i = 0; i < sizeof(WORKS) / sizeof(WORKS[0]); i++) {
         casadi_int a = 0, r = 0, iw = 0, w = 0;
         WORKS[i](&a, &r, &iw, &w);
@@ -330,6 +368,9 @@ static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     c->xdot = alloc(nx, sizeof(double));
     c->y = alloc(ny, sizeof(double));
     c->x_set = alloc(nx, sizeof(double));
+    int n_values = model_info.assert_value_start[model_info.n_asserts];
+    c->holds = alloc(model_info.n_asserts ? (size_t)model_info.n_asserts : 1, sizeof(double));
+    c->assert_values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
     c->arg = alloc((size_t)sz_arg, sizeof(double *));
     c->res = alloc((size_t)sz_res, sizeof(double *));
     c->iw = alloc((size_t)sz_iw + 1, sizeof(casadi_int));
@@ -339,7 +380,7 @@ static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     c->sens_x = alloc(nx, sizeof(double));
     c->sens_y = alloc(ny, sizeof(double));
     int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
-    return c->p && c->x && c->u && c->xdot && c->y && c->x_set && c->arg && c->res && c->iw && c->w && c->seed_x &&
+    return c->p && c->x && c->u && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
            c->seed_u && c->sens_x && c->sens_y && !solver_failed;
 }
 
@@ -414,12 +455,13 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component component) {
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
     ENTER(F_ExitInitializationMode);
-    if (update(c, F_ExitInitializationMode, 1, 1) != fmi2OK) return fmi2Error;
+    fmi2Status status = update(c, F_ExitInitializationMode, 1, 1);
+    if (status == fmi2Error) return fmi2Error;
     c->mode = c->type == fmi2ModelExchange ? MODE_EVENT : MODE_STEP;
     c->solver.h = 0.0;
     c->solver.f0_valid = 0;
     c->solver.jac_valid = 0;
-    return fmi2OK;
+    return status;
 }
 
 fmi2Status fmi2Terminate(fmi2Component component) {
@@ -451,7 +493,7 @@ fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], s
         need_y |= r >= off_y() && r < vr_rtol();
     }
     /* In the error state the values are shown as they are, for inspection. */
-    if (c->mode != MODE_ERROR && update(c, F_GetReal, need_xdot, need_y) != fmi2OK) return fmi2Error;
+    if (c->mode != MODE_ERROR && update(c, F_GetReal, need_xdot, need_y) == fmi2Error) return fmi2Error;
     for (size_t i = 0; i < nvr; i++) {
         int r = real_index(vr[i]);
         if (r < off_x()) value[i] = c->p[r];
@@ -750,7 +792,7 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component component, fmi2Boolean noSe
     NOT_NULL(F_CompletedIntegratorStep, terminateSimulation, 1);
     *enterEventMode = fmi2False;
     *terminateSimulation = fmi2False;
-    return fmi2OK;
+    return update(c, F_CompletedIntegratorStep, 0, 1); /* the asserts */
 }
 
 fmi2Status fmi2SetTime(fmi2Component component, fmi2Real time) {
@@ -858,7 +900,7 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real currentCommunicationPoin
     c->y_valid = 0;
     if (status != 0) return fail(c, F, BROKEN, "integration failed: %s", message);
     c->t = t_end;
-    return fmi2OK;
+    return update(c, F, 0, 1); /* the outputs at t_end, and with them the asserts */
 }
 
 fmi2Status fmi2CancelStep(fmi2Component component) {

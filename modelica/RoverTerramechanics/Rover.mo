@@ -3,9 +3,12 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
+  parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
+  parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
+  parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel";
   output Real x(unit="m") "Position of the centre of gravity";
   output Real v(unit="m/s") "Forward velocity of the centre of gravity";
@@ -16,8 +19,8 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   output Real slip[6](each unit="1") "Slip ratio of each wheel, Eq. (4)";
   output Real sinkage[6](each unit="m") "Sinkage of each wheel";
   output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
-  RoverTerramechanics.Components.Chassis body(rover=rover) "Body and limbs";
-  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nPanels=nPanels, each nIterations=nIterations, each vEps=vEps) "Wheels 1-6";
+  RoverTerramechanics.Components.Chassis body(rover=rover, slope=slope) "Body and limbs";
+  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nPanels=nPanels, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
   for i in 1:6 loop
     wheels[i].tau = tau[i];
@@ -35,13 +38,17 @@ equation
   x = body.x;
   v = body.v;
   pitch = body.pitch;
-  annotation (Documentation(info="<html>
+  annotation (
+    experiment(StartTime=0, StopTime=10, Interval=0.01),
+    Documentation(info="<html>
 <p>Paper Sec. 4: a 1570 kg rover under lunar gravity on six wheels. Body:
 <code>Components.Chassis</code> (x, z, pitch; three compliant limbs per side, mirror-symmetric);
 wheels: <code>Components.RigidWheel</code> (Eqs. 1-13) loaded by the limb forces. Inputs
 <code>tau[1..6]</code>; limb 1 is the front, 3 the rear of one side, 4-6 mirror them.
 Accelerating pitches the nose up: limb 1 unloads and limb 3 loads (paper Fig. 10c). Every
 parameter the paper does not give is in <code>Parameters.RoverParameters</code> and
-<code>Parameters.WheelParameters</code>.</p>
+<code>Parameters.WheelParameters</code>. Parameter <code>slope</code> tilts the ground (positive
+uphill); the states <code>x</code>, <code>v</code>, <code>pitch</code> and <code>omega[i]</code>
+take start values, so a run can start in motion.</p>
 </html>"));
 end Rover;

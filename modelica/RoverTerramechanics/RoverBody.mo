@@ -1,7 +1,9 @@
 within RoverTerramechanics;
 model RoverBody "Rover body alone for co-simulation: inputs Fx[i] and tau[i], outputs wheel loads W[i] and hub speeds v_hub[i]"
   extends RoverTerramechanics.Components.Chassis;
-  annotation (Documentation(info="<html>
+  annotation (
+    experiment(StartTime=0, StopTime=10, Interval=0.01),
+    Documentation(info="<html>
 <p>The body side of the rover cut at the wheel hubs (FMU <code>RoverBody</code>). Inputs: hub
 forces <code>Fx[1..6]</code> [N] from the six <code>Wheel</code>s and the drive torques
 <code>tau[1..6]</code> [N&middot;m] (the same signals the wheels get; their reaction pitches the

@@ -1,38 +1,50 @@
 within RoverTerramechanics;
-model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage of mass W/g that moves freely in x"
+model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage of mass W/g that moves freely in x, on level ground or a slope"
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
-  parameter Real W(unit="N") = 424 "Vertical load on the wheel (the carriage weight)";
+  parameter Real W(unit="N") = 424 "Weight of the carriage, carried by the wheel";
   parameter Real g(unit="m/s2") = 1.62 "Gravity (lunar)";
+  parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
+  parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
+  parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Real tau(unit="N.m") "Drive torque";
-  output Real Fx(unit="N") "Longitudinal force, Eq. (12)";
-  output Real Fz(unit="N") "Vertical force, Eq. (11)";
-  output Real Tx(unit="N.m") "Resistance torque, Eq. (13)";
+  output Real Fx(unit="N") "Longitudinal force, Eq. (12) when rolling";
+  output Real Fz(unit="N") "Vertical force, Eq. (11): the load normal to the ground, W cos(slope)";
+  output Real Tx(unit="N.m") "Resistance torque, Eq. (13) when rolling";
   output Real slip(unit="1") "Slip ratio, Eq. (4)";
   output Real sinkage(unit="m") "Sinkage";
   output Real omega(unit="rad/s") "Wheel angular velocity";
-  output Real v(unit="m/s", start=0, fixed=true) "Carriage (hub) forward velocity";
-  Real x(unit="m", start=0, fixed=true) "Carriage position";
-  RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps) "The wheel";
+  output Real entryAngle(unit="rad") "Entry angle, signed with the direction of travel";
+  output Real v(unit="m/s", start=0, fixed=true) "Carriage (hub) velocity along the ground";
+  output Real x(unit="m", start=0, fixed=true) "Carriage position along the ground";
+  RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick) "The wheel";
 equation
   rigidWheel.tau = tau;
-  rigidWheel.W = W;
+  rigidWheel.W = W*cos(slope);
   rigidWheel.v_hub = v;
   der(x) = v;
-  W/g*der(v) = rigidWheel.Fx;
+  W/g*der(v) = rigidWheel.Fx - W*sin(slope);
   Fx = rigidWheel.Fx;
   Fz = rigidWheel.Fz;
   Tx = rigidWheel.Tx;
   slip = rigidWheel.slip;
   sinkage = rigidWheel.sinkage;
   omega = rigidWheel.omega;
-  annotation (Documentation(info="<html>
-<p>The paper's single-wheel test bed (Sec. 3): the wheel carries the constant load W and pushes
-a carriage of mass W/g that moves freely in x, (W/g) dv/dt = F<sub>x</sub>. Input: drive torque
-<code>tau</code>; parameter <code>W</code>; outputs as listed. The identification applies steps
-in tau to this model.</p>
+  entryAngle = rigidWheel.entryAngle;
+  assert(W > 0, "W: the carriage weight must be > 0 N");
+  assert(g > 0, "g: the gravity must be > 0 m/s2");
+  assert(slope > -1.5707963267948966 and slope < 1.5707963267948966, "slope: must be in (-pi/2, pi/2) rad");
+  annotation (
+    experiment(StartTime=0, StopTime=10, Interval=0.01),
+    Documentation(info="<html>
+<p>The paper's single-wheel test bed (Sec. 3): the wheel carries the carriage weight W and
+pushes a carriage of mass W/g that moves freely along the ground, (W/g) dv/dt = F<sub>x</sub> -
+W sin(slope), with the load W cos(slope) normal to the ground on the wheel. Input: drive torque
+<code>tau</code>; parameters <code>W</code>, <code>slope</code>; outputs as listed. The states
+<code>x</code>, <code>v</code> and <code>omega</code> take start values, so a run can start in
+motion. The identification applies steps in tau to this model on level ground.</p>
 </html>"));
 end SingleWheel;

@@ -1,7 +1,9 @@
 within RoverTerramechanics;
 model Wheel "One terramechanics wheel for co-simulation: inputs tau, W, v_hub (the rover cut at the wheel hub)"
   extends RoverTerramechanics.Components.RigidWheel;
-  annotation (Documentation(info="<html>
+  annotation (
+    experiment(StartTime=0, StopTime=10, Interval=0.01),
+    Documentation(info="<html>
 <p>The wheel side of the rover cut at the hubs (FMU <code>Wheel</code>). Inputs: drive torque
 <code>tau</code> [N&middot;m], load <code>W</code> [N] and hub speed <code>v_hub</code> [m/s]
 from <code>RoverBody</code>. Outputs: <code>Fx</code>, <code>Fz</code> [N], <code>Tx</code>

@@ -1,6 +1,7 @@
 within RoverTerramechanics.Components;
 model Chassis "Rover body in the pitch plane (x, z, pitch) on six vertical compliant limbs, cut at the wheel hubs"
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
+  parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the body";
   output Real W[6](each unit="N") "Wheel loads: the limb forces pressing each wheel into the soil";
@@ -17,7 +18,7 @@ model Chassis "Rover body in the pitch plane (x, z, pitch) on six vertical compl
   Real zHubWorld[6](each unit="m") "Hub height relative to the centre of gravity";
 protected
   parameter Real xHub[6](each unit="m") = {rover.xLimb[1], rover.xLimb[2], rover.xLimb[3], rover.xLimb[1], rover.xLimb[2], rover.xLimb[3]} "Hub positions in the body frame; limbs 4-6 mirror 1-3";
-  parameter Real staticDeflection(unit="m") = rover.M*rover.g/(6*rover.kLimb) "Limb compression at rest";
+  parameter Real staticDeflection(unit="m") = rover.M*rover.g*cos(slope)/(6*rover.kLimb) "Limb compression at rest";
 equation
   der(x) = v;
   der(z) = w;
@@ -30,9 +31,16 @@ equation
     W[i] = noEvent(max(rover.kLimb*deflection[i] + rover.dLimb*deflectionRate[i], 0.0));
     v_hub[i] = v - q*zHubWorld[i];
   end for;
-  rover.M*der(v) = sum(Fx);
-  rover.M*der(w) = sum(W) - rover.M*rover.g;
+  rover.M*der(v) = sum(Fx) - rover.M*rover.g*sin(slope);
+  rover.M*der(w) = sum(W) - rover.M*rover.g*cos(slope);
   rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*Fx[i] + tau[i] for i in 1:6);
+  assert(rover.M > 0, "rover.M: the mass must be > 0 kg");
+  assert(rover.g > 0, "rover.g: the gravity must be > 0 m/s2");
+  assert(rover.Iyy > 0, "rover.Iyy: the pitch inertia must be > 0 kg.m2");
+  assert(rover.hCoG >= 0, "rover.hCoG: the centre of gravity must be at or above the hubs, hCoG >= 0 m");
+  assert(rover.kLimb > 0, "rover.kLimb: the limb stiffness must be > 0 N/m");
+  assert(rover.dLimb >= 0, "rover.dLimb: the limb damping must be >= 0 N.s/m");
+  assert(slope > -1.5707963267948966 and slope < 1.5707963267948966, "slope: must be in (-pi/2, pi/2) rad");
   annotation (Documentation(info="<html>
 <p>A rigid body of mass M and pitch inertia Iyy with three limbs per side (limb 1 front,
 2 middle, 3 rear; 4-6 mirror them). Each limb is a vertical spring-damper between the body and a
@@ -41,14 +49,16 @@ W<sub>i</sub> = max(k&delta;<sub>i</sub> + d d&delta;<sub>i</sub>/dt, 0) (a whee
 pull). With hub position p<sub>i</sub> = R(pitch)(x<sub>i</sub>, -h<sub>CoG</sub>) relative to the
 centre of gravity:</p>
 <ul>
-<li>M dv/dt = &Sigma; F<sub>x,i</sub></li>
-<li>M dw/dt = &Sigma; W<sub>i</sub> - M g</li>
+<li>M dv/dt = &Sigma; F<sub>x,i</sub> - M g sin(slope)</li>
+<li>M dw/dt = &Sigma; W<sub>i</sub> - M g cos(slope)</li>
 <li>Iyy dq/dt = &Sigma; (p<sub>x,i</sub> W<sub>i</sub> - p<sub>z,i</sub> F<sub>x,i</sub> +
 &tau;<sub>i</sub>): loads, hub forces below the centre of gravity, and the reaction of the wheel
 motors.</li>
 </ul>
 <p>Driving forward, the hub forces and motor reactions pitch the nose up: the front limbs extend
-and unload, the rear limbs compress and load (paper Fig. 10c). Parameters and their reasoning:
+and unload, the rear limbs compress and load (paper Fig. 10c). On a slope (positive uphill) the body frame is the ground's: the weight's
+component along the slope acts on the body, the normal one is carried by the limbs; the hub
+forces that hold the body then pitch it and load the downhill limbs. Parameters and their reasoning:
 <code>Parameters.RoverParameters</code>.</p>
 </html>"));
 end Chassis;

@@ -1,27 +1,50 @@
 within RoverTerramechanics.Components;
-model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, drive torque in, contact forces, slip and sinkage out"
+model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, drive torque in, contact forces, slip and sinkage out, in every motion regime"
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
+  parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
+  parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Real tau(unit="N.m") "Drive torque applied to the wheel by its motor";
   input Real W(unit="N") "Vertical load on the wheel";
   input Real v_hub(unit="m/s") "Forward speed of the wheel hub";
   output Real omega(unit="rad/s", start=0, fixed=true) "Wheel angular velocity";
   output Real slip(unit="1") "Slip ratio, Eq. (4)";
   output Real sinkage(unit="m") "Sinkage h at which Fz = W";
-  output Real Fx(unit="N") "Longitudinal force of the soil on the wheel, Eq. (12)";
+  output Real Fx(unit="N") "Longitudinal force of the soil on the wheel, Eq. (12) when rolling";
   output Real Fz(unit="N") "Vertical force of the soil on the wheel, Eq. (11)";
-  output Real Tx(unit="N.m") "Resistance torque of the soil about the axle, Eq. (13)";
+  output Real Tx(unit="N.m") "Resistance torque of the soil about the axle, Eq. (13) when rolling";
+  output Real entryAngle(unit="rad") "Entry angle, Eq. (1), signed with the direction of travel";
 equation
-  slip = RoverTerramechanics.Functions.slipRatio(wheel.r*omega, v_hub, vEps);
-  (sinkage, Fx, Fz, Tx) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel, nPanels, nIterations);
+  (slip, sinkage, Fx, Fz, Tx, entryAngle) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub, soil, wheel, vEps, vHold, vStick, nPanels, nIterations);
   wheel.J*der(omega) = tau - Tx;
+  assert(soil.c >= 0, "soil.c: the cohesion must be >= 0 Pa");
+  assert(soil.phi > 0 and soil.phi < 1.5707963267948966, "soil.phi: the internal friction angle must be in (0, pi/2) rad");
+  assert(soil.kc >= 0, "soil.kc: the cohesive modulus must be >= 0 N/m^(n+1)");
+  assert(soil.kphi > 0, "soil.kphi: the frictional modulus must be > 0 N/m^(n+2)");
+  assert(soil.n > 0, "soil.n: the sinkage exponent must be > 0");
+  assert(soil.kx > 0, "soil.kx: the shear deformation modulus must be > 0 m");
+  assert(soil.a0 > 0 and soil.a0 < 1, "soil.a0: must be in (0, 1)");
+  assert(soil.a1 >= 0 and soil.a1 < soil.a0 and soil.a0 + soil.a1 < 1, "soil.a1: must satisfy 0 <= a1 < min(a0, 1 - a0)");
+  assert(soil.lam > 0 and soil.lam <= 1, "soil.lam: the exit-angle ratio must be in (0, 1]");
+  assert(wheel.r > 0, "wheel.r: the radius must be > 0 m");
+  assert(wheel.b > 0, "wheel.b: the width must be > 0 m");
+  assert(wheel.J > 0, "wheel.J: the spin inertia must be > 0 kg.m2");
+  assert(vEps > 0, "vEps: must be a speed > 0 m/s");
+  assert(vHold > 0, "vHold: must be a speed > 0 m/s");
+  assert(vStick > 0, "vStick: must be a speed > 0 m/s");
+  assert(noEvent(Fz >= 0.999*W), "W: the soil cannot carry this load with a sinkage below the wheel radius; Fz is the most it carries (at h = r)");
   annotation (Documentation(info="<html>
-<p>J d&omega;/dt = &tau; - T<sub>x</sub>, with the slip ratio of Eq. (4) from r&omega; and the hub
-speed, and the sinkage and contact forces of Eqs. (1)-(13) from <code>wheelContact</code>, which
-solves F<sub>z</sub>(h, &kappa;) = W inside a function (no algebraic loop). The hub force on the
-carrier is F<sub>x</sub> forward; the load W is carried by the soil (F<sub>z</sub> = W).</p>
+<p>J d&omega;/dt = &tau; - T<sub>x</sub>, with the slip ratio of Eq. (4), the sinkage and the
+contact forces from <code>Functions.wheelForces</code>: the paper's Eqs. (1)-(13) for a rolling
+wheel (sinkage from F<sub>z</sub>(h, &kappa;) = W inside <code>wheelContact</code>, no algebraic
+loop), mirrored for reverse travel and blended below <code>vHold</code> into a static regime
+that holds the wheel at rest. The hub force on the carrier is F<sub>x</sub> forward; the load W
+is carried by the soil (F<sub>z</sub> = W).</p>
+<p>Parameter checks (asserts, reported by the FMUs at initialization with the value): the
+ranges of <code>terramechanics.Soil</code> and <code>Wheel</code>, speeds &gt; 0, and a load
+the soil carries with a sinkage below r.</p>
 </html>"));
 end RigidWheel;
