@@ -26,7 +26,7 @@ G_MOON = 1.62   # m/s², as the SingleWheel model's default g
 
 
 @dataclass(frozen=True)
-class TestBedStart:
+class StartState:
     """Initial state of the carriage and wheel: position x [m], speed v [m/s], spin omega [rad/s]."""
 
     x: float = 0.0
@@ -37,9 +37,9 @@ class TestBedStart:
 def run_reference_test_bed(load: float, torque: TorqueProfile, stop_time: float, sample_time: float, *,
                            wheel: Wheel | None = None, soil: Soil | None = None, g: float = G_MOON,
                            regimes: Regimes | None = None, slope: float = 0.0,
-                           start: TestBedStart | None = None) -> pd.DataFrame:
+                           start: StartState | None = None) -> pd.DataFrame:
     """Columns as :meth:`identification.testbed.WheelTestBed.run` (time, tau, RECORDED), then x [m]."""
-    wheel, soil, regimes, start = wheel or Wheel(), soil or Soil(), regimes or Regimes(), start or TestBedStart()
+    wheel, soil, regimes, start = wheel or Wheel(), soil or Soil(), regimes or Regimes(), start or StartState()
     if not load > 0:
         raise ValueError(f"load = {load!r} N: expected > 0")
     if not abs(slope) < math.pi / 2:

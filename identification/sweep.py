@@ -93,9 +93,9 @@ def compute_run(fmu_path: str | None, load: float, torque: float, stop_time: flo
     try:
         profile = TorqueProfile.step(torque)
         if fmu_path is None:
-            from .reference_plant import TestBedStart, run_reference_test_bed
+            from .reference_plant import StartState, run_reference_test_bed
 
-            start = TestBedStart(v=start_speed, omega=start_speed / terramechanics.Wheel().r)
+            start = StartState(v=start_speed, omega=start_speed / terramechanics.Wheel().r)
             data = run_reference_test_bed(load, profile, stop_time, sample_time, start=start)
         else:
             data = shared_test_bed(Path(fmu_path)).run(load, profile, stop_time, sample_time, tolerance,

@@ -287,11 +287,7 @@ static fmi2Status update(Instance *c, Function f, int need_xdot, int need_y) {
     if (c->mode == MODE_INSTANTIATED || c->mode == MODE_INITIALIZATION) {
         if (check_parameters(c, f) != fmi2OK || initial_states(c, f) != fmi2OK) return fmi2Error;
     }
-    if (need_xdot && !c->xdot_valid) {
-        if (call4(c, model_ode, c->t, c->x, c->xdot, NULL) || !all_finite(c->xdot, model_info.nx))
-            return fail(c, f, BROKEN, "the derivatives are not finite at t = %.17g", c->t);
-        c->xdot_valid = 1;
-    }
+    fmi2Status status = fmi2OK;
     if (need_y && !c->y_valid) {
         int failed = call4(c, model_outputs, c->t, c->x, c->y, NULL);
         fmi2Status checked = failed ? fmi2OK : check_asserts(c, f);
@@ -299,9 +295,16 @@ static fmi2Status update(Instance *c, Function f, int need_xdot, int need_y) {
         if (failed || !all_finite(c->y, model_info.ny))
             return fail(c, f, BROKEN, "the outputs are not finite at t = %.17g", c->t);
         c->y_valid = 1;
-        return checked;
+        status = checked;
     }
-    return fmi2OK;
+    /* After the outputs: a parameter out of range is reported by its assert, not as a non-finite
+     * derivative. */
+    if (need_xdot && !c->xdot_valid) {
+        if (call4(c, model_ode, c->t, c->x, c->xdot, NULL) || !all_finite(c->xdot, model_info.nx))
+            return fail(c, f, BROKEN, "the derivatives are not finite at t = %.17g", c->t);
+        c->xdot_valid = 1;
+    }
+    return status;
 }
 
 static void invalidate(Instance *c) {
