@@ -64,7 +64,7 @@ class Regimes:
         for name in ("v_eps", "v_hold", "v_stick"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, numbers.Real) or not (
-                    math.isfinite(value) and value > 0):
+                    math.isfinite(float(value)) and float(value) > 0):
                 raise ValueError(f"{name}={value!r}: expected a finite speed > 0 m/s")
 
 

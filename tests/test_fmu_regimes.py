@@ -14,8 +14,8 @@ import tomllib
 
 import fmpy
 import numpy as np
-from fmpy import fmi2
 import pytest
+from fmpy import fmi2
 
 from rover_cosim.identification.reference_plant import StartState, run_reference_test_bed
 from rover_cosim.identification.testbed import TorqueProfile

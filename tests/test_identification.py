@@ -84,7 +84,7 @@ def test_an_interrupted_write_leaves_no_file(single_wheel, tmp_path, monkeypatch
 
     monkeypatch.setattr(pd.DataFrame, "to_csv", interrupted)
     target = tmp_path / "W300_tau10.csv"
-    _load, _torque, error, _ = compute_run(str(single_wheel), 300.0, 10.0, 0.01, 1e-3, 1e-8, str(target))
+    _load, _torque, error, _ = compute_run(str(single_wheel), 300.0, 10.0, 0.01, 1e-3, 1e-8, 1.0, str(target))
     assert error is not None and "disk full" in error
     assert list(tmp_path.iterdir()) == []
 

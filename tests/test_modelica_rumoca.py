@@ -12,7 +12,7 @@ import pytest
 
 from rover_cosim.fmubuild import source
 from rover_cosim.fmubuild.source import MODELICA_ROOT, PACKAGE
-from rover_cosim.terramechanics import Wheel, contact_forces, slip_ratio, wheel_state
+from rover_cosim.terramechanics import Wheel, contact_forces, slip_ratio, wheel_forces, wheel_state
 
 rumoca = pytest.importorskip("rumoca", reason="rumoca is a pinned dependency; install the project with `make venv`")
 
@@ -92,12 +92,12 @@ def assert_close(name: str, got: np.ndarray, ref: np.ndarray, rtol: float, atol:
 @pytest.mark.parametrize("torque", STEP_TORQUES)
 def test_single_wheel_step_agrees_with_the_reference_wheel(step_model, load: float, torque: float):
     """At every output time, (sinkage, Fx, Fz, Tx) of rumoca's simulation equal
-    terramechanics.wheel_state at the same load and slip within 0.5 % (plus an absolute floor
-    of 1 mN, 1 mN·m, 0.1 µm for values that pass through zero), and the slip is Eq. (4) of the
-    simulated speeds."""
+    terramechanics.wheel_forces at the same load, spin and speed within 0.5 % (plus an absolute
+    floor of 1 mN, 1 mN·m, 0.1 µm for values that pass through zero), and the slip is Eq. (4) of
+    the simulated speeds."""
     df = step_model.with_params(W=load, tauStep=torque).simulate(t=(0.0, 2.0), dt=0.002).to_dataframe()
     slip = df["testBed.slip"].to_numpy()
-    state = wheel_state(np.full(slip.shape, load), slip)
+    state = wheel_forces(np.full(slip.shape, load), df["testBed.omega"].to_numpy(), df["testBed.v"].to_numpy())
     assert_close("sinkage", df["testBed.sinkage"].to_numpy(), state.sinkage, 0.005, 1e-7)
     assert_close("Fx", df["testBed.Fx"].to_numpy(), state.Fx, 0.005, 1e-3)
     assert_close("Fz", df["testBed.Fz"].to_numpy(), state.Fz, 0.005, 1e-3)

@@ -120,7 +120,8 @@ def test_reference_test_bed_at_rest_stays_at_rest(load: float):
 
 def test_reference_free_rolling_slows_to_rest_without_turning_back():
     load = 424.0
-    run = run_reference_test_bed(load, TorqueProfile.step(0.0), 20.0, 0.05, start=StartState(v=1.0, omega=1.0 / WHEEL.r))
+    start = StartState(v=1.0, omega=1.0 / WHEEL.r)
+    run = run_reference_test_bed(load, TorqueProfile.step(0.0), 20.0, 0.05, start=start)
     v = run["v"].to_numpy()
     assert v[-1] < 1e-3 and v.min() >= -1e-9
     assert np.diff(kinetic_energy(run, load)).max() <= 1e-9
