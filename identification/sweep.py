@@ -1,5 +1,5 @@
-"""The identification sweep: a torque step from rest on SingleWheel.fmu for every (load, torque)
-of a plan, run on local processes (default: all cores), serially (``workers=1``) or on a Dask
+"""The identification sweep: a torque step on SingleWheel.fmu, rolling at the plan's start speed,
+for every (load, torque) of a plan, run on local processes (default: all cores), serially (``workers=1``) or on a Dask
 cluster (``scheduler="tcp://host:port"``).
 
 Each run is cached as one CSV under ``cache_dir/<FMU SHA-256>/<plan digest>/``, written to a

@@ -1,5 +1,6 @@
 """The single-wheel test bed as an experiment: SingleWheel.fmu (Co-Simulation) driven by a
-piecewise-constant torque from rest, recorded at a fixed sample time (= communication step).
+piecewise-constant torque from rest or rolling (``start_speed``), recorded at a fixed sample time
+(= communication step).
 
 One FMU instance per process is kept and reset between runs (:func:`shared_test_bed`), so a sweep
 pays for unpacking and loading the FMU once per worker.
