@@ -20,6 +20,7 @@ Rows are processed in blocks so that the (rows, pieces, nodes) temporaries stay 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import lru_cache
 from typing import NamedTuple
@@ -29,6 +30,7 @@ from numpy.typing import ArrayLike
 
 from .checks import check_nodes, checked_array
 from .kinematics import BoolArray, FloatArray, IndexArray, entry_angle, exit_angle, max_stress_angle
+from .lateral import lateral_integrals
 from .parameters import Soil, Wheel
 from .stress import normal_stress, pressure_from_cosines, shear_displacement, shear_stress
 
@@ -47,6 +49,8 @@ class ContactForces(NamedTuple):
     Fx: FloatArray  #: longitudinal force (drawbar pull) [N], Eq. (12)
     Fz: FloatArray  #: vertical force [N], Eq. (11)
     Tx: FloatArray  #: resistance torque about the axle [N·m], Eq. (13)
+    Fy: FloatArray  #: lateral force [N] (Ishigami et al. 2007), opposing the hub's sideways sliding
+    Fy_sidewall: FloatArray  #: the sidewall (bulldozing) part of Fy [N]
 
 
 @lru_cache(maxsize=16)
@@ -148,9 +152,12 @@ def _monotone_root(low: FloatArray, high: FloatArray, guesses: tuple[FloatArray,
 
 
 def _sum_over_patch(theta: FloatArray, dtheta: FloatArray, stress: Callable[[FloatArray], FloatArray],
-                    theta_f: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil) -> ContactForces:
+                    theta_f: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
+                    lateral: tuple[FloatArray, FloatArray] | None) -> ContactForces:
     """Eqs. (11)-(13) as weighted sums over quadrature angles θ (M, pieces, nodes) with weights
-    dθ; ``stress`` gives σ at the nodes from cos θ (broadcastable to θ's shape)."""
+    dθ; ``stress`` gives σ at the nodes from cos θ (broadcastable to θ's shape). ``lateral`` is
+    (θr, β) of the rows for a wheel with a slip angle, None for β = 0 (then Fy = 0 and kx is
+    soil.kx: the paper's computation, bit for bit)."""
     cos, sin = np.cos(theta), np.sin(theta)
     sigma = stress(cos)
     # Eq. (10) written out to reuse sin θ (same as shear_displacement).
@@ -160,7 +167,8 @@ def _sum_over_patch(theta: FloatArray, dtheta: FloatArray, stress: Callable[[Flo
     change *= (1.0 - slip)[:, None, None]
     j -= change
     j *= wheel.r
-    tau = shear_stress(sigma, j, soil)
+    kx = None if lateral is None else soil.shear_moduli(lateral[1])[0][:, None, None]
+    tau = shear_stress(sigma, j, soil, kx)
     rb = wheel.r * wheel.b
     integrand = tau * sin
     integrand += sigma * cos
@@ -169,17 +177,24 @@ def _sum_over_patch(theta: FloatArray, dtheta: FloatArray, stress: Callable[[Flo
     integrand -= sigma * sin
     fx = rb * np.einsum("ipn,ipn->i", integrand, dtheta)
     tx = wheel.r * rb * np.einsum("ipn,ipn->i", tau, dtheta)
-    return ContactForces(fx, fz, tx)
+    if lateral is None:
+        zero = np.zeros(fx.shape)
+        return ContactForces(fx, fz, tx, zero, zero.copy())
+    sigma_full = np.broadcast_to(sigma, theta.shape)
+    fy, fy_sidewall = lateral_integrals(theta, dtheta, sigma_full, theta_f, lateral[0], slip, lateral[1], wheel, soil)
+    return ContactForces(fx, fz, tx, fy, fy_sidewall)
 
 
 def contact_integrals(sinkage: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
-                      nodes: int) -> ContactForces:
-    """Eqs. (11)-(13) without input checks, for callers that have already checked them;
-    ``sinkage`` and ``slip`` must broadcast."""
-    h, kappa = np.broadcast_arrays(np.asarray(sinkage, dtype=float), np.asarray(slip, dtype=float))
+                      nodes: int, slip_angle: FloatArray | None = None) -> ContactForces:
+    """Eqs. (11)-(13) and Fy without input checks, for callers that have already checked them;
+    ``sinkage``, ``slip`` and ``slip_angle`` (None: 0) must broadcast."""
+    beta_in = np.zeros(()) if slip_angle is None else np.asarray(slip_angle, dtype=float)
+    h, kappa, beta = np.broadcast_arrays(np.asarray(sinkage, dtype=float), np.asarray(slip, dtype=float), beta_in)
     shape = h.shape
-    h, kappa = h.ravel(), kappa.ravel()
-    results = [np.empty(h.size) for _ in range(3)]
+    h, kappa, beta = h.ravel(), kappa.ravel(), beta.ravel()
+    lateral = bool(np.any(beta != 0.0))
+    results = [np.empty(h.size) for _ in range(5)]
     # A wheel sunk past half its radius has a patch of up to π rad, over which exp(-jx/kx)
     # varies fast: it gets 1.5 times the nodes to keep the same accuracy.
     deep = h > 0.5 * wheel.r
@@ -187,14 +202,16 @@ def contact_integrals(sinkage: FloatArray, slip: FloatArray, wheel: Wheel, soil:
         index = np.flatnonzero(group)
         for start in range(0, index.size, BLOCK_SIZE):
             block = index[start:start + BLOCK_SIZE]
-            _integrate_block(h[block], kappa[block], wheel, soil, group_nodes, results, block)
+            _integrate_block(h[block], kappa[block], beta[block] if lateral else None, wheel, soil, group_nodes,
+                             results, block)
     return ContactForces(*(r.reshape(shape) for r in results))
 
 
-def _integrate_block(h: FloatArray, kappa: FloatArray, wheel: Wheel, soil: Soil, nodes: int,
-                     results: list[FloatArray], into: IndexArray) -> None:
+def _integrate_block(h: FloatArray, kappa: FloatArray, beta: FloatArray | None, wheel: Wheel, soil: Soil,
+                     nodes: int, results: list[FloatArray], into: IndexArray) -> None:
     """contact_integrals on 1-D arrays small enough for the temporaries to stay in cache,
-    written into ``results`` (the caller's Fx, Fz, Tx arrays) at the indices ``into``."""
+    written into ``results`` (the caller's Fx, Fz, Tx, Fy, Fy_sidewall arrays) at the indices
+    ``into``; ``beta`` None for a block without slip angle."""
     theta_f = entry_angle(h, wheel)
     theta_r = exit_angle(h, wheel, soil)
     theta_m = max_stress_angle(theta_f, kappa, soil)
@@ -215,7 +232,8 @@ def _integrate_block(h: FloatArray, kappa: FloatArray, wheel: Wheel, soil: Soil,
         def mirrored_stress(cos: FloatArray) -> FloatArray:
             return pressure_from_cosines(cos[:, 1:, :], cos_f, wheel, soil)
 
-        store(i, _sum_over_patch(theta, dtheta, mirrored_stress, theta_f[i], kappa[i], wheel, soil))
+        store(i, _sum_over_patch(theta, dtheta, mirrored_stress, theta_f[i], kappa[i], wheel, soil,
+                                 None if beta is None else (theta_r[i], beta[i])))
     if not simple.all():
         # Skidding with reversed shear somewhere in the patch: τ has a kink where jx = 0, so
         # the patch is also split there. A missing break point is put at θm, giving an empty
@@ -231,20 +249,27 @@ def _integrate_block(h: FloatArray, kappa: FloatArray, wheel: Wheel, soil: Soil,
         def stress(cos: FloatArray) -> FloatArray:
             return normal_stress(theta, tf, tr, tm, wheel, soil)
 
-        store(i, _sum_over_patch(theta, dtheta, stress, theta_f[i], kappa[i], wheel, soil))
+        store(i, _sum_over_patch(theta, dtheta, stress, theta_f[i], kappa[i], wheel, soil,
+                                 None if beta is None else (theta_r[i], beta[i])))
 
 
 def contact_forces(
     sinkage: ArrayLike, slip: ArrayLike, wheel: Wheel = Wheel(), soil: Soil = Soil(),
-    nodes: int = DEFAULT_NODES,
+    nodes: int = DEFAULT_NODES, *, slip_angle: ArrayLike = 0.0,
 ) -> ContactForces:
-    """Fx, Fz, Tx of a wheel at sinkage h [m] and slip ratio κ [-], Eqs. (1)-(13).
+    """Fx, Fz, Tx of a wheel at sinkage h [m] and slip ratio κ [-], Eqs. (1)-(13), and its
+    lateral force Fy (with its sidewall part) at the slip angle β [rad] (Ishigami et al. 2007,
+    see :mod:`terramechanics.lateral`).
 
-    Vectorized over broadcastable ``sinkage`` (each in [0, r]) and ``slip`` (each in [-1, 1]).
-    ``nodes`` is the Gauss-Legendre node count on each piece of the patch (1.5 times as many
-    for sinkage > r/2).
+    Vectorized over broadcastable ``sinkage`` (each in [0, r]), ``slip`` (each in [-1, 1]) and
+    ``slip_angle`` (each in (-π/2, π/2)). ``nodes`` is the Gauss-Legendre node count on each
+    piece of the patch (1.5 times as many for sinkage > r/2). At β = 0 the outputs are the
+    paper's, bit for bit, and Fy = 0.
     """
     check_nodes(nodes)
     h = checked_array("sinkage", sinkage, 0.0, wheel.r, "m")
     kappa = checked_array("slip", slip, -1.0, 1.0, "")
-    return contact_integrals(h, kappa, wheel, soil, nodes)
+    beta = checked_array("slip_angle", slip_angle, -math.pi / 2, math.pi / 2, "rad", low_open=True)
+    if np.any(np.abs(beta) >= math.pi / 2):
+        raise ValueError(f"slip_angle={float(np.max(np.abs(beta)))!r} rad: expected |slip_angle| < pi/2")
+    return contact_integrals(h, kappa, wheel, soil, nodes, beta)

@@ -11,6 +11,11 @@ import math
 import numbers
 from dataclasses import dataclass, fields
 
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
 
 def _check(name: str, value: float, ok: bool, expected: str) -> None:
     """Raise ValueError naming the field, its value and the accepted range unless ``ok``."""
@@ -67,6 +72,13 @@ class Soil:
         a0: constant of the maximum-stress angle, Eq. (3) [-] (0.4).
         a1: slip coefficient of the maximum-stress angle, Eq. (3) [-] (0.15).
         lam: wheel sinkage ratio λ of the exit angle, Eq. (2) [-] (0.90).
+        kx_beta: growth of kx with the slip angle [m/rad]: kx = kx + kx_beta |β| (Ishigami et al.
+            2007: kx = 0.043 |β| + 0.036 m; the paper's kx is the β = 0 case).
+        ky: lateral shear deformation modulus at β = 0 [m] (Ishigami et al. 2007: 0.013 m).
+        ky_beta: growth of ky with the slip angle [m/rad] (0.020: ky = 0.020 |β| + 0.013 m).
+        rho: dry density of the soil [kg/m³] (Ishigami et al. 2007: 1.6e3), for the sidewall.
+        gravity: gravity acting on the soil [m/s²] (lunar, 1.62); rho·gravity is its weight density.
+        xc: destructive angle of the soil piled against the wheel's side [rad] (45° - φ/2 = 26.4°).
 
     The accepted ranges keep the contact patch well defined for every slip in [-1, 1]:
     0 < a0 - a1 and a0 + a1 < 1 put the maximum-stress angle strictly between the exit and
@@ -82,6 +94,12 @@ class Soil:
     a0: float = 0.4
     a1: float = 0.15
     lam: float = 0.90
+    kx_beta: float = 0.043
+    ky: float = 0.013
+    ky_beta: float = 0.020
+    rho: float = 1.6e3
+    gravity: float = 1.62
+    xc: float = math.radians(26.4)
 
     def __post_init__(self) -> None:
         _check_finite(self)
@@ -95,6 +113,12 @@ class Soil:
         _check("a1", self.a1, 0 <= self.a1 < self.a0 and self.a0 + self.a1 < 1,
                f"0 <= a1 < min(a0, 1 - a0) = {min(self.a0, 1 - self.a0)!r}")
         _check("lam", self.lam, 0 < self.lam <= 1, "0 < lam <= 1")
+        _check("kx_beta", self.kx_beta, self.kx_beta >= 0, "kx_beta >= 0 m/rad")
+        _check("ky", self.ky, self.ky > 0, "ky > 0 m")
+        _check("ky_beta", self.ky_beta, self.ky_beta >= 0, "ky_beta >= 0 m/rad")
+        _check("rho", self.rho, self.rho >= 0, "rho >= 0 kg/m³")
+        _check("gravity", self.gravity, self.gravity >= 0, "gravity >= 0 m/s²")
+        _check("xc", self.xc, 0 < self.xc < math.pi / 2, "0 < xc < pi/2 rad")
 
     @classmethod
     def from_degrees(cls, phi_deg: float, **others: float) -> Soil:
@@ -107,6 +131,11 @@ class Soil:
     def phi_deg(self) -> float:
         """Internal friction angle [deg]."""
         return math.degrees(self.phi)
+
+    def shear_moduli(self, slip_angle: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """kx, ky [m] at the slip angle β [rad] (Ishigami et al. 2007): kx + kx_beta |β|, ky + ky_beta |β|."""
+        size = np.abs(np.asarray(slip_angle, dtype=float))
+        return self.kx + self.kx_beta * size, self.ky + self.ky_beta * size
 
     def bekker_modulus(self, b: float) -> float:
         """k = kc / b + kphi [N/m^(n+2)], the Bekker pressure-sinkage modulus for width b [m]."""

@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike
 
 from .checks import checked_array
 from .kinematics import FloatArray, slip_ratio
+from .lateral import slip_angle
 from .parameters import Soil, Wheel
 from .sinkage import wheel_state
 
@@ -77,6 +78,8 @@ class WheelForces(NamedTuple):
     Fz: FloatArray  #: vertical force [N], equal to the load
     Tx: FloatArray  #: resistance torque of the soil about the axle [N·m]
     entry_angle: FloatArray  #: signed entry angle [rad]: positive ahead of the axle, negative behind when reversing
+    Fy: FloatArray  #: lateral force of the soil on the wheel [N], along the wheel's left
+    slip_angle: FloatArray  #: slip angle β [rad] (terramechanics.lateral.slip_angle)
 
 
 def travel_direction(r_omega: ArrayLike, v: ArrayLike) -> FloatArray:
@@ -109,19 +112,25 @@ def static_shear(slip_velocity: ArrayLike, strength: ArrayLike, v_stick: float) 
 
 
 def wheel_forces(load: ArrayLike, omega: ArrayLike, v: ArrayLike, wheel: Wheel = Wheel(), soil: Soil = Soil(),
-                 regimes: Regimes = Regimes()) -> WheelForces:
-    """Contact of a wheel with spin ω [rad/s] and hub speed v [m/s] under load W [N] (> 0), in
-    any regime; vectorized over broadcastable arguments. See the module docstring."""
+                 regimes: Regimes = Regimes(), v_lateral: ArrayLike = 0.0) -> WheelForces:
+    """Contact of a wheel with spin ω [rad/s], hub speed v [m/s] along its heading and v_lateral
+    [m/s] to its left, under load W [N] (> 0), in any regime; vectorized over broadcastable
+    arguments. See the module docstring; the lateral force is terramechanics.lateral's, mirrored
+    and blended into the static regime like Fx (static lateral hold -F_max tanh(v_y/v_stick))."""
     w = checked_array("load", load, 0.0, math.inf, "N", low_open=True)
     omega = checked_array("omega", omega, -math.inf, math.inf, "rad/s")
     v = checked_array("v", v, -math.inf, math.inf, "m/s")
-    w, omega, v = np.broadcast_arrays(w, omega, v)
+    v_y = checked_array("v_lateral", v_lateral, -math.inf, math.inf, "m/s")
+    w, omega, v, v_y = np.broadcast_arrays(w, omega, v, v_y)
     r_omega = wheel.r * omega
     slip = slip_ratio(r_omega, v, regimes.v_eps)
     direction = travel_direction(r_omega, v)
-    steady = wheel_state(w, direction * slip, wheel, soil)
-    hold = static_shear(r_omega - v, shear_strength(w, steady.sinkage, wheel, soil), regimes.v_stick)
+    angle = slip_angle(r_omega, v, v_y, regimes.v_eps)
+    steady = wheel_state(w, direction * slip, wheel, soil, slip_angle=angle)
+    strength = shear_strength(w, steady.sinkage, wheel, soil)
+    hold = static_shear(r_omega - v, strength, regimes.v_stick)
     beta = steady_weight(v, regimes.v_hold)
     fx = beta * direction * steady.Fx + (1.0 - beta) * hold
     tx = beta * direction * steady.Tx + (1.0 - beta) * wheel.r * hold
-    return WheelForces(slip, steady.sinkage, fx, steady.Fz, tx, direction * steady.entry_angle)
+    fy = beta * direction * steady.Fy - (1.0 - beta) * static_shear(v_y, strength, regimes.v_stick)
+    return WheelForces(slip, steady.sinkage, fx, steady.Fz, tx, direction * steady.entry_angle, fy, angle)

@@ -39,6 +39,9 @@ class WheelState:
     Fx: FloatArray  #: longitudinal force [N], Eq. (12)
     Fz: FloatArray  #: vertical force [N], Eq. (11), equal to the load
     Tx: FloatArray  #: resistance torque [N·m], Eq. (13)
+    Fy: FloatArray  #: lateral force [N] at the slip angle (0 at slip_angle = 0)
+    Fy_sidewall: FloatArray  #: the sidewall (bulldozing) part of Fy [N]
+    slip_angle: FloatArray  #: slip angle β [rad]
     entry_angle: FloatArray  #: θf [rad], Eq. (1)
     exit_angle: FloatArray  #: θr [rad], Eq. (2), negative
     max_stress_angle: FloatArray  #: θm [rad], Eq. (3)
@@ -64,7 +67,7 @@ def _grid_axis(low: float, high: float, count: int, pad: float, limits: tuple[fl
 
 
 def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
-                   nodes: int) -> tuple[FloatArray, FloatArray]:
+                   nodes: int, lateral: bool = False) -> tuple[FloatArray, FloatArray]:
     """Starting log h and slope d log Fz / d log h for the iteration.
 
     Small batches start from Bekker's estimate and slope n + 1/2. Large batches first solve a
@@ -75,7 +78,7 @@ def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
     """
     log_bekker = np.log(bekker_sinkage(load, wheel, soil))
     bekker_slope = np.full(load.shape, soil.n + 0.5)
-    if load.size < GRID_BATCH_SIZE:
+    if load.size < GRID_BATCH_SIZE or lateral:
         return log_bekker, bekker_slope
     log_w = _grid_axis(np.log(load.min()), np.log(load.max()), GRID_SHAPE[0], 0.01, (-np.inf, np.inf))
     kappa = _grid_axis(slip.min(), slip.max(), GRID_SHAPE[1], 0.01, (-1.0, 1.0))
@@ -96,7 +99,7 @@ def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
 
 
 def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
-                  rtol: float, nodes: int) -> tuple[FloatArray, ContactForces]:
+                  rtol: float, nodes: int, slip_angle: FloatArray | None = None) -> tuple[FloatArray, ContactForces]:
     """Sinkage h [m] with |Fz(h, κ)/W - 1| <= rtol, and the contact forces there, for checked
     1-D arrays ``load`` and ``slip``.
 
@@ -109,18 +112,21 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
     log_load = np.log(load)
     lower = np.full(load.shape, math.log(MIN_SINKAGE_RATIO * wheel.r))
     upper = np.full(load.shape, math.log(wheel.r))
-    x, slope = _initial_guess(load, slip, wheel, soil, nodes)
+    lateral = slip_angle is not None and bool(np.any(slip_angle != 0.0))
+    beta = slip_angle if lateral else None
+    x, slope = _initial_guess(load, slip, wheel, soil, nodes, lateral)
     x = np.clip(x, lower, upper)
     x_prev = np.full(load.shape, np.nan)
     f_prev = np.full(load.shape, np.nan)
-    out = ContactForces(np.empty(load.shape), np.empty(load.shape), np.empty(load.shape))
+    out = ContactForces(*(np.empty(load.shape) for _ in ContactForces._fields))
     tol = math.log1p(rtol)
     active = np.arange(load.size)
     for _ in range(MAX_ITERATIONS):
         if active.size == 0:
             break
         xa = x[active]
-        forces = contact_integrals(np.exp(xa), slip[active], wheel, soil, nodes)
+        forces = contact_integrals(np.exp(xa), slip[active], wheel, soil, nodes,
+                                   None if beta is None else beta[active])
         with np.errstate(divide="ignore", invalid="ignore"):
             log_fz = np.where(forces.Fz > 0, np.log(np.maximum(forces.Fz, 1e-300)), -np.inf)
         fa = log_fz - log_load[active]
@@ -138,12 +144,13 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
         x[active] = np.where(done, xa, step)
         active = active[~done]
     if active.size:
-        _raise_unsolved(load[active], slip[active], wheel, soil, nodes)
+        _raise_unsolved(load[active], slip[active], wheel, soil, nodes, None if beta is None else beta[active])
     return np.exp(x), out
 
 
-def _raise_unsolved(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil, nodes: int) -> None:
-    capacity = contact_integrals(np.full(load.shape, wheel.r), slip, wheel, soil, nodes).Fz
+def _raise_unsolved(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil, nodes: int,
+                    beta: FloatArray | None) -> None:
+    capacity = contact_integrals(np.full(load.shape, wheel.r), slip, wheel, soil, nodes, beta).Fz
     too_heavy = load > capacity
     if too_heavy.any():
         i = int(np.argmax(too_heavy))
@@ -157,7 +164,7 @@ def _raise_unsolved(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil
 
 def wheel_state(
     load: ArrayLike, slip: ArrayLike, wheel: Wheel = Wheel(), soil: Soil = Soil(), *,
-    rtol: float = 1e-10, nodes: int = DEFAULT_NODES,
+    rtol: float = 1e-10, nodes: int = DEFAULT_NODES, slip_angle: ArrayLike = 0.0,
 ) -> WheelState:
     """The wheel in equilibrium: sinkage h solving Fz(h, κ) = W, and the forces there.
 
@@ -167,17 +174,22 @@ def wheel_state(
         wheel, soil: parameters (paper Table 2 by default).
         rtol: relative tolerance on Fz = W [-].
         nodes: Gauss-Legendre nodes per piece of the contact patch.
+        slip_angle: slip angle β [rad], each in (-π/2, π/2); broadcasts. At 0 every output is
+            the paper's, bit for bit, and Fy = 0.
     """
     if not (isinstance(rtol, (int, float)) and 1e-15 <= rtol <= 1e-2):
         raise ValueError(f"rtol={rtol!r}: expected a number in [1e-15, 1e-2]")
     check_nodes(nodes)
     w = checked_array("load", load, 0.0, math.inf, "N", low_open=True)
     kappa = checked_array("slip", slip, -1.0, 1.0, "")
-    w, kappa = np.broadcast_arrays(w, kappa)
+    beta = checked_array("slip_angle", slip_angle, -math.pi / 2, math.pi / 2, "rad", low_open=True)
+    if np.any(np.abs(beta) >= math.pi / 2):
+        raise ValueError(f"slip_angle={float(np.max(np.abs(beta)))!r} rad: expected |slip_angle| < pi/2")
+    w, kappa, beta = np.broadcast_arrays(w, kappa, beta)
     shape = w.shape
-    w, kappa = w.ravel().copy(), kappa.ravel().copy()
+    w, kappa, beta = w.ravel().copy(), kappa.ravel().copy(), beta.ravel().copy()
 
-    h, forces = solve_sinkage(w, kappa, wheel, soil, rtol, nodes)
+    h, forces = solve_sinkage(w, kappa, wheel, soil, rtol, nodes, beta)
     theta_f = entry_angle(h, wheel)
 
     def shaped(a: FloatArray) -> FloatArray:
@@ -186,6 +198,7 @@ def wheel_state(
     return WheelState(
         load=shaped(w), slip=shaped(kappa), sinkage=shaped(h),
         Fx=shaped(forces.Fx), Fz=shaped(forces.Fz), Tx=shaped(forces.Tx),
+        Fy=shaped(forces.Fy), Fy_sidewall=shaped(forces.Fy_sidewall), slip_angle=shaped(beta),
         entry_angle=shaped(theta_f), exit_angle=shaped(exit_angle(h, wheel, soil)),
         max_stress_angle=shaped(max_stress_angle(theta_f, kappa, soil)),
     )

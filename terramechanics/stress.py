@@ -62,18 +62,22 @@ def shear_displacement(theta: ArrayLike, theta_f: ArrayLike, slip: ArrayLike, wh
     return wheel.r * (theta_f - theta - (1.0 - np.asarray(slip, dtype=float)) * (np.sin(theta_f) - np.sin(theta)))
 
 
-def shear_stress(sigma: ArrayLike, j: ArrayLike, soil: Soil) -> FloatArray:
+def shear_stress(sigma: ArrayLike, j: ArrayLike, soil: Soil, kx: ArrayLike | None = None) -> FloatArray:
     """τx = (c + σ tan φ)(1 - exp(-jx/kx)) [Pa], Eqs. (7)-(9), from σ [Pa] and jx [m].
 
     Eq. (9) is used as written for jx >= 0. Where the soil is sheared backwards (jx < 0,
     which happens while skidding, κ < 0) the Janosi-Hanamoto law is applied with the sign of
     the displacement, τx = -τmax (1 - exp(jx/kx)), so that |τx| never exceeds the Mohr-Coulomb
     strength τmax of Eq. (8); Eq. (9) read literally would grow like exp(|jx|/kx) there.
+    ``kx`` [m] (broadcastable) replaces soil.kx, for a wheel with a slip angle.
     """
     tau_max = soil.c + np.asarray(sigma, dtype=float) * np.tan(soil.phi)
     j = np.asarray(j, dtype=float)
     factor = np.abs(j, out=np.empty(j.shape))
-    factor *= -1.0 / soil.kx
+    if kx is None:
+        factor *= -1.0 / soil.kx
+    else:
+        factor *= -1.0 / np.asarray(kx, dtype=float)
     np.expm1(factor, out=factor)
     np.negative(factor, out=factor)
     np.copysign(factor, j, out=factor)

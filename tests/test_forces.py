@@ -13,7 +13,7 @@ SOILS = {"table 2": Soil(), "n=0.8": Soil(n=0.8), "n=1.3": Soil(n=1.3), "lam=1":
 def _relative_error(got, ref):
     """Largest component error relative to the size of the load vector (Fx, Fz, Tx/r)."""
     scale = np.array([1.0, 1.0, 1.0 / WHEEL.r])
-    return np.max(np.abs((np.asarray(got) - ref) * scale)) / np.max(np.abs(ref * scale))
+    return np.max(np.abs((np.asarray(got[:3]) - ref) * scale)) / np.max(np.abs(ref * scale))
 
 
 @pytest.mark.parametrize("soil_name", SOILS)
