@@ -9,6 +9,7 @@ package, this builder and the pinned tool versions is stored in ``documentation/
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
 import platform
 import shutil
@@ -130,7 +131,10 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
         stages["compile"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()
+        # Inputs the Modelica source gives a start value: a system may leave them unconnected.
+        optional = [v for v in model.inputs if model.variables[v].start is not None]
         record = {"input_sha256": digest, "backend": "builtin", "model": f"{source.PACKAGE}.{name}",
+                  "optional_inputs": optional,
                   "guid": guid, "rover_cosim": version,
                   "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")}, "cflags": list(CFLAGS),
                   "states": model_layout.n_states, "inputs": model_layout.n_inputs,
@@ -188,7 +192,8 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
             except Exception as error:  # noqa: BLE001 - reported after the others
                 errors.append(error)
     else:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
+        # "spawn": a forked worker can deadlock on the locks of threads (rumoca's) in the parent.
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
             futures = [pool.submit(_build_one, task) for task in tasks]
             for future in futures:
                 try:

@@ -26,6 +26,7 @@ from .expressions import (
     UnsupportedConstruct,
     Value,
     is_symbolic,
+    literal,
     scalar_name,
 )
 from .functions import FunctionLibrary
@@ -253,13 +254,32 @@ def _role(scalar: str, info: Mapping[str, Any], flat_name: str, parameters: _Par
     return "output" if causality == "Output" and "." not in flat_name else "local"
 
 
+def declared_start(info: Mapping[str, Any], locate: _Locator) -> float | None:
+    """The start value the Modelica source declares for a variable (``start=0``), or None. rumoca
+    fills in 0.0 for an undeclared start; a declared one's source span is the literal itself."""
+    start = info.get("start")
+    if not isinstance(start, dict) or "Literal" not in start:
+        return None
+    span = start["Literal"].get("span") or {}
+    path_text = locate.files.get(span.get("source"))
+    if path_text is None:
+        return None
+    try:
+        float(path_text[1][span["start"]:span["end"]])
+    except (KeyError, ValueError):
+        return None
+    return float(literal(start["Literal"]))
+
+
 def _variables(infos: dict[str, Info], types: Mapping[str, str], parameters: _Parameters, inputs: list[str],
-               states: list[str]) -> dict[str, Variable]:
+               states: list[str], locate: _Locator) -> dict[str, Variable]:
     variables = {}
     for s, (info, _, flat_name) in infos.items():
         start = parameters.defaults.get(s)
         if start is None and isinstance(parameters.values.get(s), (int, float)):
             start = float(parameters.values[s])
+        if start is None and s in inputs and declared_start(info, locate) is not None:
+            start = declared_start(info, locate)  # an input the source gives a default
         is_output = _role_names(info)[1] == "Output" and "." not in flat_name
         variables[s] = Variable(s, _role(s, info, flat_name, parameters, inputs, states), types.get(flat_name, "Real"),
                                 info["unit"], info["description"], start, is_output)
@@ -294,7 +314,7 @@ def translate(model: Any, name: str) -> OdeModel:
     x0 = _start_values(states, infos, parameters, name)
     states, observed, renamed = _public_state_names(states, observed, env, x, infos)
     y = ca.vertcat(*[_mx(env[s]) for s in observed]) if observed else ca.MX(0, 1)
-    variables = _variables(infos, types, parameters, inputs, states)
+    variables = _variables(infos, types, parameters, inputs, states, locate)
     for public, inner in renamed.items():  # the public name keeps the inner state's start and description
         variables[public] = replace(variables[public], start=variables[inner].start,
                                     description=variables[public].description or variables[inner].description)

@@ -35,7 +35,9 @@ variables = ["body.v", "wheel1.Fz"]   # default: every output of every participa
 
 from __future__ import annotations
 
+import json
 import tomllib
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -361,13 +363,26 @@ def parse_connections(entries: list[dict[str, Any]], ports: _PortTable, context:
     return connections
 
 
+def optional_inputs(fmu_path: Path) -> set[str]:
+    """Inputs an FMU built by rover-cosim declares optional (``optional_inputs`` of its
+    documentation/build.json): they keep their start value when left unconnected. Other FMUs: none."""
+    try:
+        with zipfile.ZipFile(fmu_path) as archive:
+            return set(json.loads(archive.read("documentation/build.json")).get("optional_inputs", []))
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return set()
+
+
 def check_inputs_driven(fmus: list[FmuEntry], blocks: list[BlockEntry], connections: list[Connection],
                         context: _Context) -> None:
-    """Every FMU input connected or given a start value; every block input connected."""
+    """Every FMU input connected or given a start value (unless the FMU's build record marks it
+    optional: an input its Modelica source gives a default); every block input connected."""
     driven = {c.target for c in connections}
     for fmu in fmus:
+        optional = optional_inputs(fmu.path)
         for v in fmu.description.modelVariables:
-            if v.causality == "input" and Port(fmu.name, v.name) not in driven and v.name not in fmu.start:
+            if (v.causality == "input" and Port(fmu.name, v.name) not in driven and v.name not in fmu.start
+                    and v.name not in optional):
                 raise context.error(f"[[fmu]] {fmu.name!r}", f"input {fmu.name}.{v.name} is neither connected nor "
                                     "given a value (add a [[connection]] or start = { ... })")
     for entry in blocks:

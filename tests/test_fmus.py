@@ -79,7 +79,7 @@ def test_model_description_interfaces_match_the_modelica_readme(fmus):
     outputs = {n for n, v in single.items() if v.causality == "output"}
     assert {"Fx", "Fz", "Tx", "slip", "sinkage", "omega", "v"} <= outputs
     wheel = variables(fmus["Wheel"])
-    assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub"}
+    assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub", "v_lat"}
     body = variables(fmus["RoverBody"])
     assert {f"Fx[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "input"}
     assert {f"W[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "output"}

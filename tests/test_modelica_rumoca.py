@@ -124,6 +124,8 @@ PROBE_COMMON = """
   Real Fx(unit="N");
   Real Fz(unit="N");
   Real Tx(unit="N.m");
+  Real Fy(unit="N");
+  Real FySidewall(unit="N");
   Real clock(start=0, fixed=true);
   RoverTerramechanics.Parameters.SoilParameters soil;
   RoverTerramechanics.Parameters.WheelParameters wheel;
@@ -147,7 +149,7 @@ model ForceProbe
   Real slip(unit="1");
 """ + PROBE_COMMON + """  h = h0*(h1/h0)^time;
   slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*cycles*time));
-  (Fx, Fz, Tx) = RoverTerramechanics.Functions.contactForces(h, slip, soil, wheel, PANELS);
+  (Fx, Fz, Tx, Fy, FySidewall) = RoverTerramechanics.Functions.contactForces(h, slip, soil, wheel, PANELS);
 end ForceProbe;
 """
 
@@ -192,7 +194,7 @@ model SinkageProbe
   Real h(unit="m");
 """ + PROBE_COMMON + """  W = 10^(0.5 + 3*time);
   slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*5*time));
-  (h, Fx, Fz, Tx) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
+  (h, Fx, Fz, Tx, Fy, FySidewall) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
 end SinkageProbe;
 """
 

@@ -26,6 +26,7 @@ equation
     wheels[i].tau = tau[i];
     wheels[i].W = body.W[i];
     wheels[i].v_hub = body.v_hub[i];
+    wheels[i].v_lat = 0 "pitch-plane rover: no sideways motion";
     body.Fx[i] = wheels[i].Fx;
     body.tau[i] = tau[i];
     Fz[i] = wheels[i].Fz;

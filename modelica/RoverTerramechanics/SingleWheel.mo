@@ -5,6 +5,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   parameter Real W(unit="N") = 424 "Weight of the carriage, carried by the wheel";
   parameter Real g(unit="m/s2") = 1.62 "Gravity (lunar)";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
+  parameter Real slipAngle(unit="rad") = 0 "Angle of the carriage's track to the wheel plane (Ishigami's test bed), positive: the hub slides to the wheel's left";
   parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
@@ -18,15 +19,17 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   output Real sinkage(unit="m") "Sinkage";
   output Real omega(unit="rad/s") "Wheel angular velocity";
   output Real entryAngle(unit="rad") "Entry angle, signed with the direction of travel";
+  output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left (Ishigami et al. 2007)";
   output Real v(unit="m/s", start=0, fixed=true) "Carriage (hub) velocity along the ground";
   output Real x(unit="m", start=0, fixed=true) "Carriage position along the ground";
   RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick) "The wheel";
 equation
   rigidWheel.tau = tau;
   rigidWheel.W = W*cos(slope);
-  rigidWheel.v_hub = v;
+  rigidWheel.v_hub = v*cos(slipAngle);
+  rigidWheel.v_lat = v*sin(slipAngle);
   der(x) = v;
-  W/g*der(v) = rigidWheel.Fx - W*sin(slope);
+  W/g*der(v) = rigidWheel.Fx*cos(slipAngle) + rigidWheel.Fy*sin(slipAngle) - W*sin(slope);
   Fx = rigidWheel.Fx;
   Fz = rigidWheel.Fz;
   Tx = rigidWheel.Tx;
@@ -34,9 +37,11 @@ equation
   sinkage = rigidWheel.sinkage;
   omega = rigidWheel.omega;
   entryAngle = rigidWheel.entryAngle;
+  Fy = rigidWheel.Fy;
   assert(W > 0, "W: the carriage weight must be > 0 N");
   assert(g > 0, "g: the gravity must be > 0 m/s2");
   assert(slope > -1.5707963267948966 and slope < 1.5707963267948966, "slope: must be in (-pi/2, pi/2) rad");
+  assert(slipAngle > -1.5707963267948966 and slipAngle < 1.5707963267948966, "slipAngle: must be in (-pi/2, pi/2) rad");
   annotation (
     experiment(StartTime=0, StopTime=10, Interval=0.01),
     Documentation(info="<html>
@@ -46,5 +51,9 @@ W sin(slope), with the load W cos(slope) normal to the ground on the wheel. Inpu
 <code>tau</code>; parameters <code>W</code>, <code>slope</code>; outputs as listed. The states
 <code>x</code>, <code>v</code> and <code>omega</code> take start values, so a run can start in
 motion. The identification applies steps in tau to this model on level ground.</p>
+<p>Parameter <code>slipAngle</code> sets the wheel at an angle to the carriage's track, as on
+Ishigami's single-wheel test bed: the hub moves at v cos(slipAngle) along the wheel and
+v sin(slipAngle) to its left, and the carriage is driven by F<sub>x</sub> cos + F<sub>y</sub> sin
+of it; output <code>Fy</code> is the lateral force in the wheel frame.</p>
 </html>"));
 end SingleWheel;

@@ -10,6 +10,7 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   input Real tau(unit="N.m") "Drive torque applied to the wheel by its motor";
   input Real W(unit="N") "Vertical load on the wheel";
   input Real v_hub(unit="m/s") "Forward speed of the wheel hub";
+  input Real v_lat(unit="m/s", start=0) "Speed of the hub to the wheel's left (lateral, in the wheel frame)";
   output Real omega(unit="rad/s", start=0, fixed=true) "Wheel angular velocity";
   output Real slip(unit="1") "Slip ratio, Eq. (4)";
   output Real sinkage(unit="m") "Sinkage h at which Fz = W";
@@ -17,8 +18,10 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   output Real Fz(unit="N") "Vertical force of the soil on the wheel, Eq. (11)";
   output Real Tx(unit="N.m") "Resistance torque of the soil about the axle, Eq. (13) when rolling";
   output Real entryAngle(unit="rad") "Entry angle, Eq. (1), signed with the direction of travel";
+  output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left (Ishigami et al. 2007)";
+  output Real slipAngle(unit="rad") "Slip angle of the hub velocity, seen from the direction of travel";
 equation
-  (slip, sinkage, Fx, Fz, Tx, entryAngle) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub, soil, wheel, vEps, vHold, vStick, nPanels, nIterations);
+  (slip, sinkage, Fx, Fz, Tx, entryAngle, Fy, slipAngle) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub, soil, wheel, vEps, vHold, vStick, nPanels, nIterations, v_lat);
   wheel.J*der(omega) = tau - Tx;
   assert(soil.c >= 0, "soil.c: the cohesion must be >= 0 Pa");
   assert(soil.phi > 0 and soil.phi < 1.5707963267948966, "soil.phi: the internal friction angle must be in (0, pi/2) rad");
@@ -29,6 +32,12 @@ equation
   assert(soil.a0 > 0 and soil.a0 < 1, "soil.a0: must be in (0, 1)");
   assert(soil.a1 >= 0 and soil.a1 < soil.a0 and soil.a0 + soil.a1 < 1, "soil.a1: must satisfy 0 <= a1 < min(a0, 1 - a0)");
   assert(soil.lam > 0 and soil.lam <= 1, "soil.lam: the exit-angle ratio must be in (0, 1]");
+  assert(soil.kxBeta >= 0, "soil.kxBeta: must be >= 0 m/rad");
+  assert(soil.ky > 0, "soil.ky: the lateral shear deformation modulus must be > 0 m");
+  assert(soil.kyBeta >= 0, "soil.kyBeta: must be >= 0 m/rad");
+  assert(soil.rho >= 0, "soil.rho: the dry density must be >= 0 kg/m3");
+  assert(soil.gravity >= 0, "soil.gravity: must be >= 0 m/s2");
+  assert(soil.xc > 0 and soil.xc < 1.5707963267948966, "soil.xc: the destructive angle must be in (0, pi/2) rad");
   assert(wheel.r > 0, "wheel.r: the radius must be > 0 m");
   assert(wheel.b > 0, "wheel.b: the width must be > 0 m");
   assert(wheel.J > 0, "wheel.J: the spin inertia must be > 0 kg.m2");

@@ -2,7 +2,8 @@ within RoverTerramechanics.Examples;
 model SingleWheelStep "Torque step at t = 0 on the single-wheel test bed, wheel and carriage at rest"
   parameter Real W(unit="N") = 424 "Load on the wheel";
   parameter Real tauStep(unit="N.m") = 50 "Torque after the step";
-  RoverTerramechanics.SingleWheel testBed(W=W) "Test bed";
+  parameter Real slipAngle(unit="rad") = 0 "Angle of the carriage's track to the wheel plane";
+  RoverTerramechanics.SingleWheel testBed(W=W, slipAngle=slipAngle) "Test bed";
 equation
   testBed.tau = tauStep;
   annotation (

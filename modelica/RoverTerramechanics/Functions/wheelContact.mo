@@ -8,10 +8,13 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   input Integer nIterations = 12 "Bound on the number of force evaluations";
   input Real tolerance(unit="1") = 1e-10 "Relative tolerance on Fz/W - 1";
   input Real WMin(unit="N") = 1e-3 "Smallest load considered (a lifted wheel)";
+  input Real slipAngle(unit="rad") = 0 "Slip angle of the hub velocity (Ishigami et al. 2007)";
   output Real h(unit="m") "Sinkage";
   output Real Fx(unit="N") "Longitudinal force at h, Eq. (12)";
   output Real Fz(unit="N") "Vertical force at h, Eq. (11): W once converged";
   output Real Tx(unit="N.m") "Resistance torque at h, Eq. (13)";
+  output Real Fy(unit="N") "Lateral force at h";
+  output Real FySidewall(unit="N") "Sidewall part of Fy";
 protected
   Real load(unit="N") "Load, floored at WMin";
   Real x "log(h/m), the iterate";
@@ -40,12 +43,14 @@ algorithm
   Fx := 0;
   Fz := 0;
   Tx := 0;
+  Fy := 0;
+  FySidewall := 0;
   done := false;
   first := true;
   for k in 1:nIterations loop
     if not done then
       h := exp(x);
-      (Fx, Fz, Tx) := contactForces(h, slip, soil, wheel, nPanels);
+      (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nPanels, slipAngle);
       // A skidding wheel that has barely sunk can have Fz <= 0: treat it as "too shallow".
       f := if noEvent(Fz > 0) then log(Fz/load) else -1e3;
       if noEvent(abs(f) <= tolerance) then

@@ -10,16 +10,21 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   input Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
   input Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
+  input Real vLat(unit="m/s") = 0 "Speed of the hub to the wheel's left (lateral, in the wheel frame)";
   output Real slip(unit="1") "Slip ratio, Eq. (4)";
   output Real h(unit="m") "Sinkage";
   output Real Fx(unit="N") "Longitudinal force of the soil on the wheel";
   output Real Fz(unit="N") "Vertical force of the soil on the wheel (= W)";
   output Real Tx(unit="N.m") "Resistance torque of the soil about the axle";
   output Real entryAngle(unit="rad") "Entry angle, signed: positive ahead of the axle, negative behind it when reversing";
+  output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left";
+  output Real slipAngle(unit="rad") "Slip angle of the hub velocity, seen from the direction of travel";
 protected
   Real direction "+1 travelling forwards, -1 backwards";
   Real FxSteady(unit="N") "Paper's Fx of the mirrored wheel";
   Real TxSteady(unit="N.m") "Paper's Tx of the mirrored wheel";
+  Real FySteady(unit="N") "Ishigami's Fy of the mirrored wheel";
+  Real FySidewall(unit="N") "Its sidewall part";
   Real thetaF(unit="rad") "Entry angle, Eq. (1)";
   Real thetaR(unit="rad") "Exit angle, Eq. (2)";
   Real strength(unit="N") "Mohr-Coulomb strength of the patch, c b L + W tan(phi)";
@@ -29,7 +34,9 @@ protected
 algorithm
   slip := slipRatio(wheel.r*omega, v, vEps);
   direction := if noEvent(v > 0) then 1.0 else if noEvent(v < 0) then -1.0 else if noEvent(omega < 0) then -1.0 else 1.0;
-  (h, FxSteady, Fz, TxSteady) := wheelContact(W, direction*slip, soil, wheel, nPanels, nIterations);
+  slipAngle := atan2(direction*vLat, noEvent(max(abs(v), vEps)));
+  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall) := wheelContact(W, direction*slip, soil, wheel, nPanels, nIterations,
+    1e-10, 1e-3, slipAngle);
   thetaF := acos(1 - h/wheel.r);
   thetaR := -acos(1 - soil.lam*h/wheel.r);
   entryAngle := direction*thetaF;
@@ -39,6 +46,7 @@ algorithm
   weight := u*(2 - u);
   Fx := weight*direction*FxSteady + (1 - weight)*staticShear;
   Tx := weight*direction*TxSteady + (1 - weight)*wheel.r*staticShear;
+  Fy := weight*direction*FySteady - (1 - weight)*strength*tanh(vLat/vStick);
   annotation (Documentation(info="<html>
 <p>The paper's forces (Eqs. 1-13, <code>wheelContact</code>) describe a wheel rolling forwards
 with the soil entering at the front. Two additions make the wheel a drop-in component in any
@@ -56,6 +64,9 @@ c b L + W tan &phi;, L = r(&theta;<sub>f</sub> - &theta;<sub>r</sub>);
 F<sub>x</sub> = &beta; F<sub>steady</sub> + (1 - &beta;) F<sub>static</sub>, T<sub>x</sub> =
 &beta; T<sub>steady</sub> + (1 - &beta;) r F<sub>static</sub>, &beta; = u(2 - u), u = min(|v|/v<sub>hold</sub>, 1).</li>
 </ol>
+<p>Lateral: the slip angle &beta; = atan2(d v<sub>lat</sub>, max(|v|, vEps)), Ishigami's F<sub>y</sub>
+of the mirrored wheel (<code>contactForces</code>) turned back by d, and below vHold the static
+lateral hold -F<sub>max</sub> tanh(v<sub>lat</sub>/vStick).</p>
 <p>Above vHold the forces are exactly the paper's. The stick band is Karnopp's (1985, ASME J. Dyn.
 Syst. Meas. Control 107), in the smooth form of low-speed tyre models that fade the rolling forces
 out below a threshold speed (Bernard and Clover 1995, SAE 950311; Pacejka, <i>Tire and Vehicle
