@@ -9,10 +9,10 @@ the lateral force Fy at a slip angle (Ishigami et al. 2007) in ``contact_forces`
 """
 
 from .forces import DEFAULT_NODES, ContactForces, contact_forces
-from .kinematics import entry_angle, exit_angle, max_stress_angle, slip_ratio
+from .kinematics import entry_angle, exit_angle, max_stress_angle, slip_ratio, travel_direction
 from .lateral import bulldozing_factors, lateral_displacement, sidewall_resistance, slip_angle
 from .parameters import Soil, Wheel
-from .regimes import Regimes, WheelForces, shear_strength, steady_weight, travel_direction, wheel_forces
+from .regimes import Regimes, WheelForces, shear_strength, steady_weight, wheel_forces
 from .sinkage import WheelState, bekker_sinkage, wheel_state
 from .stress import normal_stress, shear_displacement, shear_stress
 

@@ -43,6 +43,13 @@ def slip_ratio(r_omega: ArrayLike, v: ArrayLike, v_eps: float = 0.0) -> FloatArr
     return np.clip(np.where(at_rest, 0.0, kappa), -1.0, 1.0)
 
 
+def travel_direction(r_omega: ArrayLike, v: ArrayLike) -> FloatArray:
+    """+1 where the hub travels forwards (v > 0), -1 backwards; at v = 0 the sign of ω (+1 at rest)."""
+    v = np.asarray(v, dtype=float)
+    r_omega = np.asarray(r_omega, dtype=float)
+    return np.where(v > 0, 1.0, np.where(v < 0, -1.0, np.where(r_omega < 0, -1.0, 1.0)))
+
+
 def entry_angle(sinkage: ArrayLike, wheel: Wheel) -> FloatArray:
     """Entry angle θf = acos(1 - h/r) [rad], Eq. (1); sinkage h [m] in [0, r]."""
     return np.arccos(1.0 - np.asarray(sinkage, dtype=float) / wheel.r)

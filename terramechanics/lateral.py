@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .kinematics import FloatArray
+from .kinematics import FloatArray, travel_direction
 from .parameters import Soil, Wheel
 
 
@@ -37,8 +37,7 @@ def slip_angle(r_omega: ArrayLike, v: ArrayLike, v_lateral: ArrayLike, v_eps: fl
     v = 0): the hub's lateral speed v_y [m/s] against its forward speed v [m/s]; 0 at rest,
     ±π/2 (nearly) for a hub sliding straight sideways."""
     v = np.asarray(v, dtype=float)
-    r_omega = np.asarray(r_omega, dtype=float)
-    direction = np.where(v > 0, 1.0, np.where(v < 0, -1.0, np.where(r_omega < 0, -1.0, 1.0)))
+    direction = travel_direction(r_omega, v)
     return np.arctan2(direction * np.asarray(v_lateral, dtype=float), np.maximum(np.abs(v), v_eps))
 
 

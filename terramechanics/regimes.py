@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .checks import checked_array
-from .kinematics import FloatArray, slip_ratio
+from .kinematics import FloatArray, slip_ratio, travel_direction
 from .lateral import slip_angle
 from .parameters import Soil, Wheel
 from .sinkage import wheel_state
@@ -80,13 +80,6 @@ class WheelForces(NamedTuple):
     entry_angle: FloatArray  #: signed entry angle [rad]: positive ahead of the axle, negative behind when reversing
     Fy: FloatArray  #: lateral force of the soil on the wheel [N], along the wheel's left
     slip_angle: FloatArray  #: slip angle β [rad] (terramechanics.lateral.slip_angle)
-
-
-def travel_direction(r_omega: ArrayLike, v: ArrayLike) -> FloatArray:
-    """+1 where the hub travels forwards (v > 0), -1 backwards; at v = 0 the sign of ω (+1 at rest)."""
-    v = np.asarray(v, dtype=float)
-    r_omega = np.asarray(r_omega, dtype=float)
-    return np.where(v > 0, 1.0, np.where(v < 0, -1.0, np.where(r_omega < 0, -1.0, 1.0)))
 
 
 def steady_weight(v: ArrayLike, v_hold: float) -> FloatArray:
