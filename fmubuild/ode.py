@@ -278,8 +278,8 @@ def _variables(infos: dict[str, Info], types: Mapping[str, str], parameters: _Pa
         start = parameters.defaults.get(s)
         if start is None and isinstance(parameters.values.get(s), (int, float)):
             start = float(parameters.values[s])
-        if start is None and s in inputs and declared_start(info, locate) is not None:
-            start = declared_start(info, locate)  # an input the source gives a default
+        if start is None and s in inputs:
+            start = declared_start(info, locate)  # an input the source gives a default, or None
         is_output = _role_names(info)[1] == "Output" and "." not in flat_name
         variables[s] = Variable(s, _role(s, info, flat_name, parameters, inputs, states), types.get(flat_name, "Real"),
                                 info["unit"], info["description"], start, is_output)
