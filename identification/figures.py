@@ -14,7 +14,7 @@ import pandas as pd
 from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, IdentifiedModel
 
 
-def _png(fig) -> bytes:
+def png_bytes(fig) -> bytes:
     buffer = io.BytesIO()
     fig.tight_layout()
     fig.savefig(buffer, format="png", dpi=110)
@@ -38,7 +38,7 @@ def fig5_fx_vs_slip(table: pd.DataFrame, per_load: pd.DataFrame) -> bytes:
     ax.set_title("Fig. 5: settled Fx against slip (x: not fitted) and Fx = a(W) slip + b(W)")
     ax.legend(ncol=2, fontsize=8)
     ax.grid(alpha=0.3)
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def fig_coefficient(per_load: pd.DataFrame, model: IdentifiedModel, k: int, name: str, unit: str, title: str) -> bytes:
@@ -51,7 +51,7 @@ def fig_coefficient(per_load: pd.DataFrame, model: IdentifiedModel, k: int, name
     ax.set_title(title)
     ax.legend()
     ax.grid(alpha=0.3)
-    return _png(fig)
+    return png_bytes(fig)
 
 
 def fig8_validation(run: pd.DataFrame, load: float, labels: list[str]) -> bytes:
@@ -68,4 +68,4 @@ def fig8_validation(run: pd.DataFrame, load: float, labels: list[str]) -> bytes:
     for ax in axes:
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
-    return _png(fig)
+    return png_bytes(fig)

@@ -1,10 +1,11 @@
 """The single-wheel test bed in Python on the numpy reference wheel: the same experiment as
 SingleWheel.fmu, for the cross-check of the identification and of the motion regimes.
 
-    J dω/dt = τ - Tx,   (W/g) dv/dt = Fx - W sin(slope),   dx/dt = v
+    J dω/dt = τ - Tx,   (W/g) dv/dt = Fx cos β + Fy sin β - W sin(slope),   dx/dt = v
 
-with Fx, Tx from :func:`terramechanics.wheel_forces` under the load W cos(slope) normal to the
-slope (positive slope: uphill), integrated by SciPy's Radau method (the start from rest and the
+with Fx, Fy, Tx from :func:`terramechanics.wheel_forces` under the load W cos(slope) normal to the
+slope (positive slope: uphill) and the hub velocity (v cos β, v sin β) in the wheel frame (β: the
+slip angle of the carriage's track to the wheel plane), integrated by SciPy's Radau method (the start from rest and the
 static regime are stiff).
 """
 
@@ -37,21 +38,25 @@ class StartState:
 def run_reference_test_bed(load: float, torque: TorqueProfile, stop_time: float, sample_time: float, *,
                            wheel: Wheel | None = None, soil: Soil | None = None, g: float = G_MOON,
                            regimes: Regimes | None = None, slope: float = 0.0,
-                           start: StartState | None = None) -> pd.DataFrame:
+                           start: StartState | None = None, slip_angle: float = 0.0) -> pd.DataFrame:
     """Columns as :meth:`identification.testbed.WheelTestBed.run` (time, tau, RECORDED), then x [m]."""
     wheel, soil, regimes, start = wheel or Wheel(), soil or Soil(), regimes or Regimes(), start or StartState()
     if not load > 0:
         raise ValueError(f"load = {load!r} N: expected > 0")
     if not abs(slope) < math.pi / 2:
         raise ValueError(f"slope = {slope!r} rad: expected -pi/2 < slope < pi/2")
+    if not abs(slip_angle) < math.pi / 2:
+        raise ValueError(f"slip_angle = {slip_angle!r} rad: expected -pi/2 < slip_angle < pi/2")
+    along, across = math.cos(slip_angle), math.sin(slip_angle)
     mass, normal_load, downhill = load / g, load * math.cos(slope), load * math.sin(slope)
     n = round(stop_time / sample_time)
     times = sample_time * np.arange(n + 1)
     boundaries = sorted({0.0, *[t for t in torque.times if 0 < t < stop_time], stop_time})
 
     def rhs(t: float, y: np.ndarray, tau: float) -> np.ndarray:
-        contact = wheel_forces(normal_load, y[2], y[1], wheel, soil, regimes)
-        return np.array([y[1], (float(contact.Fx) - downhill) / mass, (tau - float(contact.Tx)) / wheel.J])
+        contact = wheel_forces(normal_load, y[2], y[1] * along, wheel, soil, regimes, v_lateral=y[1] * across)
+        push = float(contact.Fx) * along + float(contact.Fy) * across
+        return np.array([y[1], (push - downhill) / mass, (tau - float(contact.Tx)) / wheel.J])
 
     states = np.zeros((n + 1, 3))
     y = np.array([start.x, start.v, start.omega], dtype=float)
@@ -65,8 +70,10 @@ def run_reference_test_bed(load: float, torque: TorqueProfile, stop_time: float,
             raise RuntimeError(f"reference test bed at W = {load} N, tau = {tau} N·m: {solution.message}")
         states[inside] = solution.y.T
         y = solution.y[:, -1] if solution.y.size else y
-    contact = wheel_forces(normal_load, states[:, 2], states[:, 1], wheel, soil, regimes)
+    contact = wheel_forces(normal_load, states[:, 2], states[:, 1] * along, wheel, soil, regimes,
+                           v_lateral=states[:, 1] * across)
     data = pd.DataFrame({"time": times, "tau": torque(times), "slip": contact.slip, "Fx": contact.Fx,
                          "Fz": contact.Fz, "Tx": contact.Tx, "sinkage": contact.sinkage,
-                         "omega": states[:, 2], "v": states[:, 1], "x": states[:, 0]})
+                         "omega": states[:, 2], "v": states[:, 1], "Fy": contact.Fy,
+                         "beta": np.full(n + 1, slip_angle), "x": states[:, 0]})
     return data[["time", "tau", *RECORDED, "x"]]

@@ -1,6 +1,6 @@
 """The identification sweep: a torque step on SingleWheel.fmu, rolling at the plan's start speed,
-for every (load, torque) of a plan, run on local processes (default: all cores), serially (``workers=1``) or on a Dask
-cluster (``scheduler="tcp://host:port"``).
+for every (load, torque, slip angle) of a plan, run on local processes (default: all cores),
+serially (``workers=1``) or on a Dask cluster (``scheduler="tcp://host:port"``).
 
 Each run is cached as one CSV under ``cache_dir/<FMU SHA-256>/<plan digest>/``, written to a
 temporary name and renamed, so an interrupted sweep leaves only complete runs and a re-run
@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 import pandas as pd
 
@@ -27,7 +28,7 @@ from rover_cosim.common.outputs import file_sha256
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.common.paper import TARGET_VELOCITY
 
-from .testbed import TorqueProfile, shared_test_bed
+from .testbed import RECORDED, TorqueProfile, shared_test_bed
 
 #: Torque levels [N·m]: 5-80 N·m covers what the rover's wheels get (the open-loop run uses
 #: 9-40 N·m at 290-560 N per wheel; the closed loop asks ~5-30 N of drawbar pull per wheel on
@@ -37,10 +38,20 @@ from .testbed import TorqueProfile, shared_test_bed
 PAPER_TORQUES = (5.0, 10.0, 15.0, 20.0, 30.0, 40.0, 50.0, 60.0, 80.0)
 
 
+class Case(NamedTuple):
+    """One run of a sweep: load W [N], torque step [N·m], slip angle of the carriage's track [deg]."""
+
+    load: float
+    torque: float
+    slip_angle_deg: float = 0.0
+
+
 @dataclass(frozen=True)
 class SweepPlan:
     loads: tuple[float, ...] = PAPER_LOADS
     torques: tuple[float, ...] = PAPER_TORQUES
+    #: deg; the carriage's track to the wheel plane (0: the paper's longitudinal sweep)
+    slip_angles_deg: tuple[float, ...] = (0.0,)
     stop_time: float = 0.1      # s; slip and Fx settle within a millisecond on this test bed
     sample_time: float = 1e-4   # s; fixed sample time = communication step
     tolerance: float = 1e-8     # integrator tolerance inside the FMU
@@ -54,6 +65,9 @@ class SweepPlan:
             raise ValueError(f"loads = {self.loads!r}: expected loads > 0 N")
         if not self.torques:
             raise ValueError("torques: expected at least one torque level [N·m]")
+        if not self.slip_angles_deg or any(not (abs(b) < 90) for b in self.slip_angles_deg):
+            raise ValueError(f"slip_angles_deg = {self.slip_angles_deg!r}: expected at least one angle, each "
+                             "in (-90, 90) deg")
         if not (math.isfinite(self.start_speed) and self.start_speed >= 0):
             raise ValueError(f"start_speed = {self.start_speed!r}: expected a finite speed >= 0 m/s")
         if not 0 < self.sample_time <= self.stop_time:
@@ -62,44 +76,53 @@ class SweepPlan:
 
     def digest(self) -> str:
         settings = {"stop_time": self.stop_time, "sample_time": self.sample_time, "tolerance": self.tolerance,
-                    "start_speed": self.start_speed}
+                    "start_speed": self.start_speed, "recorded": list(RECORDED)}
         return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:12]
 
-    def cases(self) -> list[tuple[float, float]]:
-        return [(w, tau) for w in self.loads for tau in self.torques]
+    def cases(self) -> list[Case]:
+        return [Case(w, tau, b) for b in self.slip_angles_deg for w in self.loads for tau in self.torques]
 
 
 @dataclass
 class SweepOutcome:
-    runs: dict[tuple[float, float], pd.DataFrame]
-    failures: dict[tuple[float, float], str]
+    runs: dict[Case, pd.DataFrame]
+    failures: dict[Case, str]
     computed: int
     cached: int
     wall_seconds: float
     cache_folder: Path
-    run_seconds: dict[tuple[float, float], float] = field(default_factory=dict)
+    run_seconds: dict[Case, float] = field(default_factory=dict)
+
+    def at_slip_angle(self, slip_angle_deg: float = 0.0) -> dict[tuple[float, float], pd.DataFrame]:
+        """The runs at one slip angle [deg], keyed by (load, torque)."""
+        return {(c.load, c.torque): run for c, run in self.runs.items() if c.slip_angle_deg == slip_angle_deg}
 
 
-def run_file(folder: Path, load: float, torque: float) -> Path:
-    return folder / f"W{load:g}_tau{torque:g}.csv"
+def run_file(folder: Path, load: float, torque: float, slip_angle_deg: float = 0.0) -> Path:
+    """The cache file of one case (the paper's longitudinal runs keep their name without the angle)."""
+    angle = f"_beta{slip_angle_deg:g}" if slip_angle_deg else ""
+    return folder / f"W{load:g}_tau{torque:g}{angle}.csv"
 
 
-def compute_run(fmu_path: str | None, load: float, torque: float, stop_time: float, sample_time: float,
-                tolerance: float, start_speed: float, target: str) -> tuple[float, float, str | None, float]:
-    """Run one case and write it to ``target`` atomically. Returns (load, torque, error, seconds);
+def compute_run(fmu_path: str | None, case: Case, stop_time: float, sample_time: float,
+                tolerance: float, start_speed: float, target: str) -> tuple[Case, str | None, float]:
+    """Run one case and write it to ``target`` atomically. Returns (case, error, seconds);
     never raises, so one failing case does not stop the others (runs in worker processes).
     ``fmu_path`` None runs the numpy reference test bed instead of the FMU."""
     started = time.perf_counter()
+    case = Case(*case)
     try:
-        profile = TorqueProfile.step(torque)
+        profile = TorqueProfile.step(case.torque)
+        slip_angle = math.radians(case.slip_angle_deg)
         if fmu_path is None:
             from .reference_plant import StartState, run_reference_test_bed
 
-            start = StartState(v=start_speed, omega=start_speed / terramechanics.Wheel().r)
-            data = run_reference_test_bed(load, profile, stop_time, sample_time, start=start)
+            start = StartState(v=start_speed, omega=start_speed * math.cos(slip_angle) / terramechanics.Wheel().r)
+            data = run_reference_test_bed(case.load, profile, stop_time, sample_time, start=start,
+                                          slip_angle=slip_angle)
         else:
-            data = shared_test_bed(Path(fmu_path)).run(load, profile, stop_time, sample_time, tolerance,
-                                                       start_speed=start_speed)
+            data = shared_test_bed(Path(fmu_path)).run(case.load, profile, stop_time, sample_time, tolerance,
+                                                       start_speed=start_speed, slip_angle=slip_angle)
         target_path = Path(target)
         handle, temporary = tempfile.mkstemp(prefix=f".{target_path.name}.", suffix=".part", dir=target_path.parent)
         try:
@@ -108,9 +131,9 @@ def compute_run(fmu_path: str | None, load: float, torque: float, stop_time: flo
             os.replace(temporary, target_path)
         finally:
             Path(temporary).unlink(missing_ok=True)
-        return load, torque, None, time.perf_counter() - started
+        return case, None, time.perf_counter() - started
     except Exception as error:  # noqa: BLE001 - reported per run, the sweep goes on
-        return load, torque, f"{type(error).__name__}: {error}", time.perf_counter() - started
+        return case, f"{type(error).__name__}: {error}", time.perf_counter() - started
 
 
 def _plant_key(fmu_path: Path | None) -> str:
@@ -123,8 +146,8 @@ def _plant_key(fmu_path: Path | None) -> str:
     return "reference-" + hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:12]
 
 
-Arguments = tuple[str | None, float, float, float, float, float, float, str]
-Result = tuple[float, float, str | None, float]
+Arguments = tuple[str | None, Case, float, float, float, float, str]
+Result = tuple[Case, str | None, float]
 
 
 def _results(arguments: list[Arguments], workers: int | None, scheduler: str | None) -> Iterator[Result]:
@@ -163,21 +186,22 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
     (folder / "plan.json").write_text(json.dumps({**asdict(plan), "plant": str(fmu_path or "numpy reference")},
                                                  indent=2) + "\n")
     cases = plan.cases()
-    missing = [(w, tau) for w, tau in cases if not run_file(folder, w, tau).exists()]
-    failures: dict[tuple[float, float], str] = {}
-    run_seconds: dict[tuple[float, float], float] = {}
+    missing = [c for c in cases if not run_file(folder, *c).exists()]
+    failures: dict[Case, str] = {}
+    run_seconds: dict[Case, float] = {}
     done = len(cases) - len(missing)
     if progress:
         progress(done / len(cases))
-    arguments = [(str(fmu_path) if fmu_path else None, w, tau, plan.stop_time, plan.sample_time, plan.tolerance,
-                  plan.start_speed, str(run_file(folder, w, tau))) for w, tau in missing]
-    for load, torque, error, seconds in _results(arguments, workers, scheduler):
-        run_seconds[load, torque] = seconds
+    arguments = [(str(fmu_path) if fmu_path else None, c, plan.stop_time, plan.sample_time, plan.tolerance,
+                  plan.start_speed, str(run_file(folder, *c))) for c in missing]
+    for case, error, seconds in _results(arguments, workers, scheduler):
+        case = Case(*case)
+        run_seconds[case] = seconds
         if error is not None:
-            failures[load, torque] = error
+            failures[case] = error
         done += 1
         if progress:
             progress(done / len(cases))
-    runs = {(w, tau): pd.read_csv(run_file(folder, w, tau)) for w, tau in cases if (w, tau) not in failures}
+    runs = {c: pd.read_csv(run_file(folder, *c)) for c in cases if c not in failures}
     return SweepOutcome(runs, failures, len(missing), len(cases) - len(missing), time.perf_counter() - started,
                         folder, run_seconds)

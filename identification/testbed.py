@@ -1,6 +1,7 @@
 """The single-wheel test bed as an experiment: SingleWheel.fmu (Co-Simulation) driven by a
-piecewise-constant torque from rest or rolling (``start_speed``), recorded at a fixed sample time
-(= communication step).
+piecewise-constant torque from rest or rolling (``start_speed``), with the carriage's track at a
+slip angle to the wheel plane (``slip_angle``, Ishigami's test bed), recorded at a fixed sample
+time (= communication step).
 
 One FMU instance per process is kept and reset between runs (:func:`shared_test_bed`), so a sweep
 pays for unpacking and loading the FMU once per worker.
@@ -8,6 +9,7 @@ pays for unpacking and loading the FMU once per worker.
 
 from __future__ import annotations
 
+import math
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,27 +20,32 @@ import pandas as pd
 from fmpy.fmi2 import FMU2Slave
 
 #: What every run records besides time and torque (SingleWheel outputs, SI units).
-RECORDED = ("slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v")
+RECORDED = ("slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v", "Fy", "beta")
 
 
 @dataclass(frozen=True)
-class TorqueProfile:
-    """Torque levels [N·m] held from the given times [s] on (the first from t = 0)."""
+class Staircase:
+    """Piecewise-constant levels (of a torque [N·m] or an angle [rad]) held from the given times
+    [s] on (the first from t = 0)."""
 
     times: tuple[float, ...]
     levels: tuple[float, ...]
 
     @staticmethod
-    def step(torque: float) -> TorqueProfile:
-        return TorqueProfile((0.0,), (float(torque),))
+    def step(level: float) -> Staircase:
+        return Staircase((0.0,), (float(level),))
 
     @staticmethod
-    def staircase(levels: tuple[float, ...], hold: float) -> TorqueProfile:
-        return TorqueProfile(tuple(i * hold for i in range(len(levels))), tuple(float(x) for x in levels))
+    def staircase(levels: tuple[float, ...], hold: float) -> Staircase:
+        return Staircase(tuple(i * hold for i in range(len(levels))), tuple(float(x) for x in levels))
 
     def __call__(self, t: np.ndarray) -> np.ndarray:
         index = np.searchsorted(np.asarray(self.times), t + 1e-12, side="right") - 1
         return np.asarray(self.levels)[np.clip(index, 0, None)]
+
+
+#: The drive torque of a run [N·m].
+TorqueProfile = Staircase
 
 
 class WheelTestBed:
@@ -51,7 +58,7 @@ class WheelTestBed:
         md = fmpy.read_model_description(str(self.path))
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
         self.radius = float(next((v.start for v in md.modelVariables if v.name == "wheel.r"), 0.355))
-        missing = [n for n in ("W", "tau", *RECORDED) if n not in self.refs]
+        missing = [n for n in ("W", "tau", "slipAngle", "trackAngle", *RECORDED) if n not in self.refs]
         if missing:
             raise ValueError(f"{self.path}: not a SingleWheel FMU (no variables {missing})")
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self._folder.name,
@@ -60,11 +67,16 @@ class WheelTestBed:
         self._fresh = True
 
     def run(self, load: float, torque: TorqueProfile, stop_time: float, sample_time: float,
-            tolerance: float = 1e-8, *, start_speed: float = 0.0) -> pd.DataFrame:
+            tolerance: float = 1e-8, *, start_speed: float = 0.0, slip_angle: float = 0.0,
+            track_angle: Staircase | None = None) -> pd.DataFrame:
         """Columns time, tau, then :data:`RECORDED`; rows at 0, sample_time, ..., stop_time. The
-        carriage starts at ``start_speed`` [m/s] with the wheel rolling without slip (omega = v/r)."""
+        carriage starts at ``start_speed`` [m/s] along its track, which runs at ``slip_angle``
+        [rad] to the wheel plane, with the wheel rolling without slip (omega = v cos(slip_angle)/r).
+        ``track_angle`` [rad] turns the track during the run (the slip angle is recorded as beta)."""
         if not load > 0:
             raise ValueError(f"load = {load!r} N: expected > 0")
+        if not abs(slip_angle) < math.pi / 2:
+            raise ValueError(f"slip_angle = {slip_angle!r} rad: expected -pi/2 < slip_angle < pi/2")
         if not 0 < sample_time <= stop_time:
             raise ValueError(f"sample_time = {sample_time!r} s: "
                              f"expected 0 < sample_time <= stop_time = {stop_time!r} s")
@@ -75,19 +87,26 @@ class WheelTestBed:
         n = round(stop_time / sample_time)
         times = sample_time * np.arange(n + 1)
         taus = torque(times)
+        turns = track_angle(times) if track_angle is not None else np.zeros(n + 1)
+        if not np.all(np.abs(slip_angle + turns) < math.pi / 2):
+            raise ValueError(f"track_angle = {track_angle!r}: the slip angle must stay in (-pi/2, pi/2) rad")
         fmu.setupExperiment(startTime=0.0)
-        fmu.setReal([self.refs["W"], self.refs["tau"], self.refs["solver.tolerance"]], [load, taus[0], tolerance])
+        fmu.setReal([self.refs["W"], self.refs["tau"], self.refs["solver.tolerance"], self.refs["slipAngle"],
+                      self.refs["trackAngle"]], [load, taus[0], tolerance, slip_angle, turns[0]])
         if start_speed:
-            fmu.setReal([self.refs["v"], self.refs["omega"]], [start_speed, start_speed / self.radius])
+            fmu.setReal([self.refs["v"], self.refs["omega"]],
+                        [start_speed, start_speed * math.cos(slip_angle + turns[0]) / self.radius])
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
         outputs = [self.refs[name] for name in RECORDED]
-        tau_ref = [self.refs["tau"]]
+        tau_ref, turn_ref = [self.refs["tau"]], [self.refs["trackAngle"]]
         rows = np.empty((n + 1, len(RECORDED)))
         rows[0] = fmu.getReal(outputs)
         for k in range(n):
             if k and taus[k] != taus[k - 1]:
                 fmu.setReal(tau_ref, [taus[k]])
+            if k and turns[k] != turns[k - 1]:
+                fmu.setReal(turn_ref, [turns[k]])
             fmu.doStep(times[k], sample_time)
             rows[k + 1] = fmu.getReal(outputs)
         fmu.terminate()

@@ -173,10 +173,13 @@ def _identify(args: argparse.Namespace) -> int:
         print(f"rover-cosim identify: {error} (nothing written)", file=sys.stderr)
         return 1
     bar.close()
-    sweep = outcome.sweep
-    print(f"sweep: {sweep.computed} runs computed, {sweep.cached} from the cache, "
-          f"{len(sweep.failures)} failed, {sweep.wall_seconds:.1f} s")
+    for name, sweep in (("sweep", outcome.sweep), ("lateral sweep", outcome.lateral_sweep)):
+        print(f"{name}: {sweep.computed} runs computed, {sweep.cached} from the cache, "
+              f"{len(sweep.failures)} failed, {sweep.wall_seconds:.1f} s")
+    print("Table 1, Fit of Fx [%]:")
     print(outcome.fit.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
+    print("Lateral model, Fit of Fy [%] (Eq. 15) and largest settled error:")
+    print(outcome.lateral_fit.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
     for path in outcome.files:
         print(f"wrote {path}")
     return 0

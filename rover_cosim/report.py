@@ -36,6 +36,38 @@ def _provenance(path: Path) -> str:
     return f"<details><summary>{html.escape(path.name)}</summary><pre>{text}</pre></details>"
 
 
+def _lateral_section(identification: Path) -> list[str]:
+    """The identified lateral model: Fits off the grid, the forms tried, Ishigami's trends."""
+    sections = ["<h2>Lateral force (the paper's future work): Fy(W, beta, slip)</h2>",
+                ("<p>Ishigami et al. (2007)'s side force in the wheel (lateral shear and sidewall bulldozing), "
+                 "identified like Sec. 3 from torque steps on the test bed with its carriage at slip angles "
+                 "0-30 deg. Model: Fy = sum c<sub>ik</sub>(W) phi<sub>i</sub>(beta) slip<sup>k</sup>, "
+                 "phi<sub>i</sub> = beta/(|beta| + beta<sub>i</sub>), c<sub>ik</sub> quadratic in W. "
+                 "Validation (Eq. 15) at loads and slip angles off the sweep's grid, the track turning "
+                 "between +beta and -beta while the torque steps 5-40 N·m.</p>")]
+    fits, forms, trends = (identification / f"lateral_{name}.csv" for name in ("fit_table", "forms", "trends"))
+    if not fits.exists():
+        return [*sections, f"<p class='missing'>{html.escape(str(fits))} not produced.</p>"]
+    table = pd.read_csv(fits).rename(columns={
+        "load_N": "load [N]", "slip_angle_deg": "slip angle [deg]", "fit_percent": "Fit [%]",
+        "max_settled_error_N": "largest settled error [N]", "max_settled_error_percent": "largest settled error [%]"})
+    sections.append(_table(table))
+    if forms.exists():
+        tried = pd.read_csv(forms)[["form", "coefficients", "training_rms_N", "min_fit_percent"]]
+        sections += ["<p>Forms tried (the first is used):</p>", _table(tried.rename(columns={
+            "training_rms_N": "RMS on the sweep [N]", "min_fit_percent": "lowest Fit [%]"}))]
+    if trends.exists():
+        measured = pd.read_csv(trends).rename(columns={"trend": "Ishigami et al. 2007 report", "holds": "ours",
+                                                       "measured": "measured on our sweep"})
+        sections += ["<p>The trends Ishigami et al. report from their single-wheel experiments:</p>",
+                     _table(measured)]
+    for name, caption in (("fig_lateral_fy.png", "Fy against slip angle and slip, sweep and model"),
+                          ("fig_lateral_coefficients.png", "coefficients c_ik(W) of the lateral model"),
+                          ("fig_lateral_validation_575N.png", "lateral validation at 575 N, ±12.5 deg")):
+        sections.append(_image(identification / name, caption))
+    return sections
+
+
 def build_report(results: Path) -> str:
     identification = results / "identification"
     simulation = results / "simulation"
@@ -60,6 +92,7 @@ def build_report(results: Path) -> str:
                           ("fig6_a_of_W.png", "Fig. 6: a(W)"), ("fig7_b_of_W.png", "Fig. 7: b(W)"),
                           ("fig8_validation_575N.png", "Fig. 8: identified model against the FMU at 575 N")):
         sections.append(_image(identification / name, caption))
+    sections += _lateral_section(identification)
 
     sections.append("<h2>Closed loop (Sec. 4): Table 3 and Fig. 10</h2>")
     rms_path, cosim_path = simulation / "rms.csv", simulation / "rms_cosim.csv"

@@ -89,3 +89,5 @@ def test_report_is_self_contained(results):
     assert not re.search(r"(src|href)=['\"]https?://", page)
     cells = re.findall(r"<td>([^<]*)</td>", page)
     assert "0.7" in cells and "82.1" in cells  # the paper's values beside ours, as table cells
+    assert "Lateral force" in page and "Ishigami et al. 2007 report" in page
+    assert page.count("data:image/png;base64,") >= 9  # with the three lateral figures

@@ -20,7 +20,7 @@ from rover_cosim.identification.fits import (
     identify,
     step_table,
 )
-from rover_cosim.identification.sweep import SweepPlan, compute_run, run_file, run_sweep
+from rover_cosim.identification.sweep import Case, SweepPlan, compute_run, run_file, run_sweep
 from rover_cosim.identification.validate import PAPER_FIT
 from rover_cosim.jobs.identify import IdentificationResult
 
@@ -56,8 +56,9 @@ def test_sweep_caches_runs_and_recomputes_only_what_is_missing(single_wheel, tmp
     assert (again.computed, again.cached) == (1, 3)
     for key, run in first.runs.items():
         pd.testing.assert_frame_equal(run, again.runs[key])
-    run = first.runs[600.0, 30.0]
-    assert list(run.columns) == ["time", "tau", "slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v"] and len(run) == 21
+    run = first.runs[Case(600.0, 30.0)]
+    assert list(run.columns) == ["time", "tau", "slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v", "Fy", "beta"]
+    assert len(run) == 21
     assert not list(first.cache_folder.glob("*.part"))
 
 
@@ -72,9 +73,9 @@ def test_a_failing_run_is_recorded_and_the_sweep_goes_on(single_wheel, tmp_path,
 
     monkeypatch.setattr(sweep_module, "shared_test_bed", lambda path: Broken())
     outcome = run_sweep(single_wheel, SMALL, tmp_path, workers=1)
-    assert set(outcome.failures) == {(600.0, 10.0), (600.0, 30.0)}
-    assert "the carriage fell off" in outcome.failures[600.0, 10.0]
-    assert set(outcome.runs) == {(300.0, 10.0), (300.0, 30.0)}
+    assert set(outcome.failures) == {(600.0, 10.0, 0.0), (600.0, 30.0, 0.0)}
+    assert "the carriage fell off" in outcome.failures[Case(600.0, 10.0)]
+    assert set(outcome.runs) == {(300.0, 10.0, 0.0), (300.0, 30.0, 0.0)}
     assert sorted(p.name for p in outcome.cache_folder.glob("*.csv")) == ["W300_tau10.csv", "W300_tau30.csv"]
 
 
@@ -84,7 +85,7 @@ def test_an_interrupted_write_leaves_no_file(single_wheel, tmp_path, monkeypatch
 
     monkeypatch.setattr(pd.DataFrame, "to_csv", interrupted)
     target = tmp_path / "W300_tau10.csv"
-    _load, _torque, error, _ = compute_run(str(single_wheel), 300.0, 10.0, 0.01, 1e-3, 1e-8, 1.0, str(target))
+    _case, error, _ = compute_run(str(single_wheel), Case(300.0, 10.0), 0.01, 1e-3, 1e-8, 1.0, str(target))
     assert error is not None and "disk full" in error
     assert list(tmp_path.iterdir()) == []
 
@@ -107,11 +108,12 @@ def test_reference_test_bed_and_fmu_give_the_same_a_and_b(single_wheel, tmp_path
     reference = run_sweep(None, plan, tmp_path, workers=2)
     fmu = run_sweep(single_wheel, plan, tmp_path, workers=2)
     assert not reference.failures and not fmu.failures
-    ours, theirs = fx_per_load(step_table(fmu.runs)), fx_per_load(step_table(reference.runs))
+    fmu_runs, reference_runs = fmu.at_slip_angle(0.0), reference.at_slip_angle(0.0)
+    ours, theirs = fx_per_load(step_table(fmu_runs)), fx_per_load(step_table(reference_runs))
     np.testing.assert_allclose(ours["c1"], theirs["c1"], rtol=0.01)  # a(W)
     np.testing.assert_allclose(ours["c0"], theirs["c0"], rtol=0.01)  # b(W)
     loads = np.array(plan.loads)
-    model_fmu, model_reference = identify(step_table(fmu.runs), 1), identify(step_table(reference.runs), 1)
+    model_fmu, model_reference = identify(step_table(fmu_runs), 1), identify(step_table(reference_runs), 1)
     for k in (0, 1):
         np.testing.assert_allclose(np.polyval(model_fmu.fx_coefficients[k][::-1], loads),
                                    np.polyval(model_reference.fx_coefficients[k][::-1], loads), rtol=0.01)

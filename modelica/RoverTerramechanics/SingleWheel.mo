@@ -12,6 +12,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Real tau(unit="N.m") "Drive torque";
+  input Real trackAngle(unit="rad", start=0) "Turn of the carriage's track during a run, added to slipAngle (optional input, 0 when not driven)";
   output Real Fx(unit="N") "Longitudinal force, Eq. (12) when rolling";
   output Real Fz(unit="N") "Vertical force, Eq. (11): the load normal to the ground, W cos(slope)";
   output Real Tx(unit="N.m") "Resistance torque, Eq. (13) when rolling";
@@ -20,16 +21,18 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   output Real omega(unit="rad/s") "Wheel angular velocity";
   output Real entryAngle(unit="rad") "Entry angle, signed with the direction of travel";
   output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left (Ishigami et al. 2007)";
+  output Real beta(unit="rad") "Slip angle of the hub velocity in the wheel frame: slipAngle + trackAngle";
   output Real v(unit="m/s", start=0, fixed=true) "Carriage (hub) velocity along the ground";
   output Real x(unit="m", start=0, fixed=true) "Carriage position along the ground";
   RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick) "The wheel";
 equation
   rigidWheel.tau = tau;
   rigidWheel.W = W*cos(slope);
-  rigidWheel.v_hub = v*cos(slipAngle);
-  rigidWheel.v_lat = v*sin(slipAngle);
+  beta = slipAngle + trackAngle;
+  rigidWheel.v_hub = v*cos(beta);
+  rigidWheel.v_lat = v*sin(beta);
   der(x) = v;
-  W/g*der(v) = rigidWheel.Fx*cos(slipAngle) + rigidWheel.Fy*sin(slipAngle) - W*sin(slope);
+  W/g*der(v) = rigidWheel.Fx*cos(beta) + rigidWheel.Fy*sin(beta) - W*sin(slope);
   Fx = rigidWheel.Fx;
   Fz = rigidWheel.Fz;
   Tx = rigidWheel.Tx;
@@ -41,7 +44,7 @@ equation
   assert(W > 0, "W: the carriage weight must be > 0 N");
   assert(g > 0, "g: the gravity must be > 0 m/s2");
   assert(slope > -1.5707963267948966 and slope < 1.5707963267948966, "slope: must be in (-pi/2, pi/2) rad");
-  assert(slipAngle > -1.5707963267948966 and slipAngle < 1.5707963267948966, "slipAngle: must be in (-pi/2, pi/2) rad");
+  assert(beta > -1.5707963267948966 and beta < 1.5707963267948966, "slipAngle + trackAngle: must be in (-pi/2, pi/2) rad");
   annotation (
     experiment(StartTime=0, StopTime=10, Interval=0.01),
     Documentation(info="<html>
@@ -54,6 +57,9 @@ motion. The identification applies steps in tau to this model on level ground.</
 <p>Parameter <code>slipAngle</code> sets the wheel at an angle to the carriage's track, as on
 Ishigami's single-wheel test bed: the hub moves at v cos(slipAngle) along the wheel and
 v sin(slipAngle) to its left, and the carriage is driven by F<sub>x</sub> cos + F<sub>y</sub> sin
-of it; output <code>Fy</code> is the lateral force in the wheel frame.</p>
+of it; output <code>Fy</code> is the lateral force in the wheel frame. The optional input
+<code>trackAngle</code> (start 0) turns the track during a run, e.g. a staircase of slip angles
+for the validation of the identified lateral model; the slip angle is
+<code>beta</code> = slipAngle + trackAngle.</p>
 </html>"));
 end SingleWheel;

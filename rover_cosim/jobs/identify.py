@@ -9,6 +9,13 @@ results/identification/
   fit_detail.csv   per load and torque level: settled Fx and slip of plant and models
   failures.csv     runs that failed, with their error (empty when none did)
   fig5_fx_vs_slip.png, fig6_a_of_W.png, fig7_b_of_W.png, fig8_validation_575N.png
+  lateral_runs.csv       every run of the lateral sweep (slip angles 0-30 deg), long format
+  lateral_steps.csv      per lateral run: settled slip, Fx, Fy, whether it still rolls
+  lateral_fit_table.csv  load_N, slip_angle_deg, fit_percent (Eq. 15) of the lateral model at 275,
+                         575, 875 N and 7.5, 12.5 deg; its largest settled error
+  lateral_forms.csv      every candidate form tried: coefficients, training RMS, Fits
+  lateral_trends.csv     Ishigami's side-force trends, measured on the sweep
+  fig_lateral_fy.png, fig_lateral_coefficients.png, fig_lateral_validation_575N.png
   identification.json  what ran: parameters, versions, wall times
 """
 
@@ -24,14 +31,28 @@ from typing import Any
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
-from rover_cosim.identification import figures
+from rover_cosim.identification import figures, lateral_figures
 from rover_cosim.identification.fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
+from rover_cosim.identification.lateral import (
+    FORMS,
+    LATERAL_SAMPLE_TIME,
+    LATERAL_SLIP_ANGLES_DEG,
+    LateralModel,
+    identify_lateral,
+    ishigami_trends,
+    lateral_table,
+    per_load_coefficients,
+    training_rms,
+)
+from rover_cosim.identification.lateral_validation import LateralValidation, validate_lateral
 from rover_cosim.identification.sweep import SweepOutcome, SweepPlan, run_sweep
-from rover_cosim.identification.testbed import shared_test_bed
+from rover_cosim.identification.testbed import RECORDED, shared_test_bed
 from rover_cosim.identification.validate import validate
 
 MODELS = {"quadratic": 2, "linear": 1}  # label -> degree in slip; the first is recommended
 RECOMMENDED = "quadratic"
+#: The lateral sweep: the longitudinal sweep's loads and torques at slip angles 0-30 deg.
+LATERAL_PLAN = SweepPlan(slip_angles_deg=LATERAL_SLIP_ANGLES_DEG, sample_time=LATERAL_SAMPLE_TIME)
 
 
 @dataclass
@@ -43,29 +64,91 @@ class IdentificationResult:
     sweep: SweepOutcome          # the sweep's runs, failures and counts
     record: dict[str, Any]      # identification.json: parameters, versions, wall times
     model: dict[str, Any]       # model.json as written
+    lateral_sweep: SweepOutcome  # the lateral sweep
+    lateral_fit: pd.DataFrame    # lateral_fit_table.csv
 
 
-def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None = None, workers: int | None = None,
-                       scheduler: str | None = None, cache_dir: Path | None = None,
-                       progress: Callable[[float], None] | None = None) -> IdentificationResult:
-    """Sweep, fit, validate and write every file of ``results/identification/`` (all or none)."""
-    started = time.perf_counter()
-    plan = plan or SweepPlan()
-    cache_dir = cache_dir or out_dir / "cache"
+def _sweep(fmu_path: Path, plan: SweepPlan, cache_dir: Path, workers: int | None, scheduler: str | None,
+           progress: Callable[[float], None] | None) -> SweepOutcome:
     sweep = run_sweep(fmu_path, plan, cache_dir, workers=workers, scheduler=scheduler, progress=progress)
     if not sweep.runs:
         raise RuntimeError(f"every run of the sweep failed; first error: {next(iter(sweep.failures.values()))}")
-    table = step_table(sweep.runs)
+    return sweep
+
+
+def _long(runs: dict, columns: list[str]) -> pd.DataFrame:
+    """The runs one below the other, each row tagged with its case."""
+    frames = [run.assign(load_N=c.load, torque_N_m=c.torque, slip_angle_deg=c.slip_angle_deg)
+              for c, run in sorted(runs.items())]
+    return pd.concat(frames, ignore_index=True)[columns]
+
+
+def _lateral_files(out: Path, sweep: SweepOutcome, models: dict[str, LateralModel],
+                   validation: LateralValidation) -> tuple[dict[Path, bytes], pd.DataFrame]:
+    """lateral_*.csv and the lateral figures, and the fit table."""
+    table = lateral_table(sweep.runs)
+    recommended = next(iter(models.values()))
+    detail = validation.detail
+    error = (detail[f"Fy_{recommended.form.name}_N"] - detail["Fy_plant_N"]).abs()
+    worst = detail.assign(error=error, relative=100 * error / detail["Fy_plant_N"].abs())
+    worst = worst.groupby(["load_N", "slip_angle_deg"])[["error", "relative"]].max().reset_index()
+    fit = validation.fit[["load_N", "slip_angle_deg", "fit_percent"]].merge(worst, on=["load_N", "slip_angle_deg"])
+    fit = fit.rename(columns={"error": "max_settled_error_N", "relative": "max_settled_error_percent"})
+    forms = pd.DataFrame([{"form": name, "basis": m.form.basis, "scales_deg": " ".join(map(str, m.form.scales_deg)),
+                           "slip_degree": m.form.slip_degree, "load_degree": m.form.load_degree,
+                           "coefficients": m.coefficients.size, "training_rms_N": training_rms(m, table),
+                           "min_fit_percent": validation.fit[f"fit_percent_{name}"].min(),
+                           "mean_fit_percent": validation.fit[f"fit_percent_{name}"].mean()}
+                          for name, m in models.items()])
+    columns = ["load_N", "torque_N_m", "slip_angle_deg", "time", "tau", *RECORDED]
+    return {
+        out / "lateral_runs.csv": _long(sweep.runs, columns).to_csv(index=False, float_format="%.10g").encode(),
+        out / "lateral_steps.csv": table.to_csv(index=False, float_format="%.10g").encode(),
+        out / "lateral_fit_table.csv": fit.to_csv(index=False, float_format="%.3f").encode(),
+        out / "lateral_fit_detail.csv": detail.to_csv(index=False, float_format="%.6g").encode(),
+        out / "lateral_forms.csv": forms.to_csv(index=False, float_format="%.4g").encode(),
+        out / "lateral_trends.csv": ishigami_trends(table).to_csv(index=False).encode(),
+        out / "fig_lateral_fy.png": lateral_figures.fy_against_beta_and_slip(table, recommended),
+        out / "fig_lateral_coefficients.png":
+            lateral_figures.coefficient_curves(per_load_coefficients(table, recommended.form), recommended),
+        out / "fig_lateral_validation_575N.png":
+            lateral_figures.validation_run(validation.runs[575.0, 12.5], 575.0, 12.5, recommended.form.name),
+    }, fit
+
+
+def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None = None,
+                       lateral_plan: SweepPlan | None = None, workers: int | None = None,
+                       scheduler: str | None = None, cache_dir: Path | None = None,
+                       progress: Callable[[float], None] | None = None) -> IdentificationResult:
+    """Sweep, fit, validate and write every file of ``results/identification/`` (all or none):
+    the paper's longitudinal model (``plan``) and the lateral model (``lateral_plan``)."""
+    started = time.perf_counter()
+    plan, lateral_plan = plan or SweepPlan(), lateral_plan or LATERAL_PLAN
+    cache_dir = cache_dir or out_dir / "cache"
+    first, second = len(plan.cases()), len(lateral_plan.cases())
+
+    def share(offset: int, count: int) -> Callable[[float], None] | None:
+        if progress is None:
+            return None
+        return lambda fraction: progress((offset + fraction * count) / (first + second))
+
+    sweep = _sweep(fmu_path, plan, cache_dir, workers, scheduler, share(0, first))
+    lateral_sweep = _sweep(fmu_path, lateral_plan, cache_dir, workers, scheduler, share(first, second))
+    table = step_table(sweep.at_slip_angle(0.0))
     models = {label: identify(table, degree) for label, degree in MODELS.items()}
     per_load = fx_per_load(table, 1)
-    validation = validate(shared_test_bed(Path(fmu_path)), models)
+    bed = shared_test_bed(Path(fmu_path))
+    validation = validate(bed, models)
+    lateral_table_ = lateral_table(lateral_sweep.runs)
+    lateral_models = {form.name: identify_lateral(lateral_table_, form) for form in FORMS}
+    lateral_validation = validate_lateral(bed, lateral_models)
 
-    long = pd.concat([run.assign(load_N=load, torque_N_m=torque) for (load, torque), run in sorted(sweep.runs.items())],
-                     ignore_index=True)
-    long = long[["load_N", "torque_N_m", *[c for c in long.columns if c not in ("load_N", "torque_N_m")]]]
-    failed = sorted(sweep.failures.items())
-    failures = pd.DataFrame([{"load_N": w, "torque_N_m": t, "error": e} for (w, t), e in failed],
-                            columns=["load_N", "torque_N_m", "error"])
+    long = _long(sweep.runs, ["load_N", "torque_N_m", "time", "tau", *[c for c in RECORDED if c not in ("Fy", "beta")]])
+    failed = sorted({**sweep.failures, **lateral_sweep.failures}.items())
+    failures = pd.DataFrame([{"load_N": c.load, "torque_N_m": c.torque, "slip_angle_deg": c.slip_angle_deg,
+                              "error": e} for c, e in failed],
+                            columns=["load_N", "torque_N_m", "slip_angle_deg", "error"])
+    recommended_lateral = lateral_models[FORMS[0].name]
     fmu_sha = file_sha256(Path(fmu_path))
     model_json = {
         "recommended": RECOMMENDED,
@@ -75,11 +158,16 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
         "plan": asdict(plan),
         "fmu": {"path": str(fmu_path), "sha256": fmu_sha},
         "failures": len(sweep.failures),
+        "lateral": {**recommended_lateral.to_dict(), "plan": asdict(lateral_plan),
+                    "inputs": "load W [N], slip angle beta [rad], slip ratio (fit rule as fx_fit)",
+                    "failures": len(lateral_sweep.failures)},
     }
     fit_models = validation.fit.drop(columns=["fit_percent"])
-    record = run_record("rover-cosim identify", {"plan": asdict(plan), "workers": workers, "scheduler": scheduler})
-    record.update({"fmu_sha256": fmu_sha, "runs_computed": sweep.computed, "runs_cached": sweep.cached,
-                   "runs_failed": len(sweep.failures), "sweep_wall_seconds": sweep.wall_seconds,
+    record = run_record("rover-cosim identify", {"plan": asdict(plan), "lateral_plan": asdict(lateral_plan),
+                                                 "workers": workers, "scheduler": scheduler})
+    record.update({"fmu_sha256": fmu_sha, "runs_computed": sweep.computed + lateral_sweep.computed,
+                   "runs_cached": sweep.cached + lateral_sweep.cached,
+                   "runs_failed": len(failed), "sweep_wall_seconds": sweep.wall_seconds + lateral_sweep.wall_seconds,
                    "wall_seconds": time.perf_counter() - started, "cache_folder": str(sweep.cache_folder)})
     out = Path(out_dir)
     files = {
@@ -99,5 +187,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
         out / "fig8_validation_575N.png": figures.fig8_validation(validation.runs[575.0], 575.0, list(MODELS)),
         out / "identification.json": json_bytes(record),
     }
+    lateral_files, lateral_fit = _lateral_files(out, lateral_sweep, lateral_models, lateral_validation)
+    files.update(lateral_files)
     write_all(files)
-    return IdentificationResult(sorted(files), validation.fit, sweep, record, json.loads(files[out / "model.json"]))
+    return IdentificationResult(sorted(files), validation.fit, sweep, record, json.loads(files[out / "model.json"]),
+                                lateral_sweep, lateral_fit)
