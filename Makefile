@@ -15,7 +15,7 @@ RESULTS ?= results
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
 BACKEND ?= auto
-FMU_NAMES := SingleWheel Rover RoverBody Wheel
+FMU_NAMES := SingleWheel Rover RoverBody Wheel SteerableRover SteerableRoverBody
 
 # The virtualenv is (re)installed when pyproject.toml changes; the stamp records success.
 $(STAMP): pyproject.toml

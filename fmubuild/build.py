@@ -28,7 +28,7 @@ from .artifact import BUILD_RECORD, CFLAGS, RUNTIME, RUNTIME_FILES, BuildResult,
 from .omc import build_fmu_omc
 
 #: The FMUs ``make fmus`` builds (classes of the Modelica package).
-FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel")
+FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel", "SteerableRover", "SteerableRoverBody")
 
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 

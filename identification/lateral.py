@@ -65,6 +65,16 @@ class LateralForm:
             return [beta / (np.abs(beta) + s) for s in scales]
         return [np.sign(beta) * -np.expm1(-np.abs(beta) / s) for s in scales]
 
+    def angle_basis_slope(self, beta: np.ndarray) -> list[np.ndarray]:
+        """d phi_i / d beta [1/rad]."""
+        beta = np.asarray(beta, float)
+        if self.basis == "polynomial":
+            return [(2 * i + 1) * beta ** (2 * i) for i in range(len(self.scales_deg))]
+        scales = np.radians(self.scales_deg)
+        if self.basis == "rational":
+            return [s / (np.abs(beta) + s) ** 2 for s in scales]
+        return [np.exp(-np.abs(beta) / s) / s for s in scales]
+
     def columns(self, load: np.ndarray, beta: np.ndarray, slip: np.ndarray, *, with_load: bool = True) -> np.ndarray:
         """The regression matrix: phi_i(beta) slip^k W^j, ordered [i, k, j] (j only with_load)."""
         load, slip = np.asarray(load, float), np.asarray(slip, float)
@@ -106,6 +116,20 @@ class LateralModel:
             raise ValueError(f"load = {load!r} N: expected > 0")
         design = self.form.columns(load.ravel(), beta.ravel(), slip.ravel())
         return (design @ self.coefficients.ravel()).reshape(load.shape)
+
+    def angle_coefficients(self, load: np.ndarray, slip: np.ndarray) -> np.ndarray:
+        """a_i(W, slip) = sum_k c_ik(W) slip^k, shape (n, terms): Fy = sum_i a_i phi_i(beta)."""
+        load, slip = np.atleast_1d(np.asarray(load, float)), np.atleast_1d(np.asarray(slip, float))
+        terms, slips, loads = self.form.shape()
+        slip_powers = slip[:, None] ** np.arange(slips)         # (n, k)
+        load_powers = load[:, None] ** np.arange(loads)         # (n, j)
+        return np.einsum("ikj,nk,nj->ni", self.coefficients, slip_powers, load_powers)
+
+    def fy_and_slope(self, coefficients: np.ndarray, slip_angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Fy [N] and dFy/dbeta [N/rad] at slip angles [rad] for angle_coefficients rows."""
+        phi = np.array(self.form.angle_basis(slip_angle))        # (terms, n)
+        slope = np.array(self.form.angle_basis_slope(slip_angle))
+        return (coefficients * phi.T).sum(axis=1), (coefficients * slope.T).sum(axis=1)
 
     def coefficient_at(self, load: float | np.ndarray, term: int, slip_power: int) -> np.ndarray:
         """c_ik(W) [N]: the polynomial in W of one term."""

@@ -68,6 +68,44 @@ def _lateral_section(identification: Path) -> list[str]:
     return sections
 
 
+def _path_section(simulation: Path) -> list[str]:
+    """The steerable rover following the turn and the lane change."""
+    sections = ["<h2>Path following: the steerable rover with the identified Fx and Fy models</h2>",
+                ("<p>SteerableRover (body in x, y, yaw with heave, pitch, roll; every wheel driven and "
+                 "steered). Path tracking at the body gives a force and yaw-moment demand, allocated to the "
+                 "wheels by least squares weighted by their loads; per wheel the inverse identified lateral "
+                 "model gives the steering angle and the inverse longitudinal model the torque. Turn: 10 m, "
+                 "90 deg of radius 10 m, 10 m at 0.5 m/s; lane change: 3 m over 15 m at 1.0 m/s. Ablation: "
+                 "kinematic steering (wheels along the commanded hub velocities, no slip-angle "
+                 "compensation).</p>")]
+    metrics, agreement = simulation / "path_metrics.csv", simulation / "path_agreement.csv"
+    if not metrics.exists():
+        return [*sections, f"<p class='missing'>{html.escape(str(metrics))} not produced.</p>"]
+    table = pd.read_csv(metrics)
+    shown = pd.DataFrame({
+        "scenario": table["scenario"].str.replace("_", " "),
+        "run": table["run"].map({"inverse": "identified models, SteerableRover.fmu",
+                                 "cosim": "identified models, co-simulated", "kinematic": "kinematic steering"}),
+        "cross-track RMS [cm]": 100 * table["cross_track_rms_m"],
+        "cross-track max [cm]": 100 * table["cross_track_max_m"],
+        "speed error max [%]": table["speed_error_max_percent"],
+        "RMS(Fx - Fx_des), worst wheel [N]": table.filter(like="rms_Fx").max(axis=1),
+        "RMS(Fy - Fy_des), worst wheel [N]": table.filter(like="rms_Fy").max(axis=1)})
+    sections += ["<p>Floors of the issue: cross-track RMS &lt; 10 cm, max &lt; 30 cm, speed within 5 %, "
+                 "force errors &lt; 2 N per wheel (every wheel's value in <code>path_metrics.csv</code>).</p>",
+                 _table(shown)]
+    if agreement.exists():
+        agree = pd.read_csv(agreement).rename(columns={
+            "speed_max_difference_percent": "speed, largest difference [% of target]",
+            "load_max_difference_percent": "loads, largest difference [% of static]",
+            "path_max_difference_m": "path, largest distance [m]"})
+        sections += ["<p>Monolithic against co-simulated (SteerableRoverBody + 6 Wheel):</p>", _table(agree)]
+    sections += [_image(simulation / "path_xy.png", "paths in the plane and cross-track error"),
+                 _image(simulation / "path_wheels_turn.png", "turn: wheel forces, slip angles, steering, loads"),
+                 _image(simulation / "path_wheels_lane_change.png", "lane change: wheel forces, slip angles, loads")]
+    return sections
+
+
 def build_report(results: Path) -> str:
     identification = results / "identification"
     simulation = results / "simulation"
@@ -114,12 +152,15 @@ def build_report(results: Path) -> str:
     sections += [_image(simulation / "fig10_closed_loop.png", "Fig. 10 (a)-(h), Rover.fmu"),
                  _image(simulation / "fig10_closed_loop_cosim.png", "Fig. 10 (a)-(h), RoverBody + 6 Wheel")]
 
+    sections += _path_section(simulation)
+
     study = results / "cosim_study" / "coupling_error.png"
     if study.exists():
         sections += ["<h2>Co-simulation coupling error</h2>", _image(study, "co-simulated vs monolithic rover")]
 
     sections.append("<h2>Provenance</h2>")
-    for path in (results / "fig3_fx_vs_slip.json", identification / "identification.json", record_path):
+    for path in (results / "fig3_fx_vs_slip.json", identification / "identification.json", record_path,
+                 simulation / "path_following.json"):
         sections.append(_provenance(path))
     style = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}"
              "img{max-width:100%}table.data{border-collapse:collapse;margin:1em 0}"

@@ -16,7 +16,7 @@ REPOSITORY = Path(__file__).resolve().parent.parent
 
 @pytest.fixture(scope="session")
 def fmus() -> dict[str, Path]:
-    """The four FMUs by model name, built into fmus/ as `make fmus` does (skipped when up to date)."""
+    """The FMUs by model name, built into fmus/ as `make fmus` does (skipped when up to date)."""
     results = build.build_all(build.FMU_MODELS, REPOSITORY / "fmus", backend="builtin")
     return {r.name: r.path for r in results}
 

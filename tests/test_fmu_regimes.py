@@ -182,6 +182,9 @@ BAD_PARAMETERS = {
     "Rover": [({"rover.M": 0.0}, "rover.M"), ({"rover.M": -1570.0}, "rover.M"), ({"wheel.J": 0.0}, "wheel.J"),
               ({"rover.kLimb": 0.0}, "rover.kLimb")],
     "RoverBody": [({"rover.Iyy": -1.0}, "rover.Iyy"), ({"rover.g": 0.0}, "rover.g")],
+    "SteerableRover": [({"rover.Izz": -1.0}, "rover.Izz"), ({"rover.Ixx": 0.0}, "rover.Ixx"),
+                       ({"rover.yLimb": 0.0}, "rover.yLimb"), ({"wheel.J": 0.0}, "wheel.J")],
+    "SteerableRoverBody": [({"rover.Izz": 0.0}, "rover.Izz"), ({"rover.M": -1.0}, "rover.M")],
 }
 
 

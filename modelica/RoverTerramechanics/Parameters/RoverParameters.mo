@@ -1,10 +1,13 @@
 within RoverTerramechanics.Parameters;
-record RoverParameters "ATHLETE-like rover body in the pitch plane: mass, gravity, geometry, limb compliance"
+record RoverParameters "ATHLETE-like rover body: mass, gravity, inertia, geometry, limb compliance"
   parameter Real M(unit="kg") = 1570 "Total rover mass (paper Sec. 4), carried by the six limbs";
   parameter Real g(unit="m/s2") = 1.62 "Lunar gravity (paper Sec. 4)";
   parameter Real Iyy(unit="kg.m2") = 1120 "Pitch moment of inertia about the centre of gravity";
   parameter Real xLimb[3](each unit="m") = {1.5, 0.0, -1.5} "Longitudinal wheel-hub position of the front, middle and rear limb of a side, relative to the centre of gravity";
   parameter Real hCoG(unit="m") = 1.0 "Height of the centre of gravity above the wheel hubs";
+  parameter Real yLimb(unit="m") = 1.5 "Lateral wheel-hub position of the limbs of a side (half the track width): limbs 1-3 at +yLimb (left), 4-6 at -yLimb (right); used by the steerable rover";
+  parameter Real Ixx(unit="kg.m2") = 1120 "Roll moment of inertia about the centre of gravity (steerable rover)";
+  parameter Real Izz(unit="kg.m2") = 1980 "Yaw moment of inertia about the centre of gravity (steerable rover)";
   parameter Real kLimb(unit="N/m") = 2.0e4 "Vertical stiffness of one limb";
   parameter Real dLimb(unit="N.s/m") = 2.0e3 "Vertical damping of one limb";
   annotation (Documentation(info="<html>
@@ -22,6 +25,14 @@ driving posture; with 0.355 m wheels a CoG 1.0 m above the hubs is a middle valu
 load transfer under acceleration (paper Fig. 10c).</td></tr>
 <tr><td>Iyy</td><td>1120 kg&middot;m<sup>2</sup></td><td>uniform box 2.75 m long and 1.0 m
 high: M (2.75<sup>2</sup> + 1.0<sup>2</sup>) / 12.</td></tr>
+<tr><td>yLimb</td><td>1.5 m</td><td>half the track width of the steerable rover: with the
+wheels of a side at x = +1.5, 0, -1.5 m the footprint is a 3 m square, about the splayed ATHLETE
+(hexagonal frame 2.75 m across, legs reaching outwards); left and right symmetric so that the
+static loads stay equal. The pitch-plane rover does not use it.</td></tr>
+<tr><td>Ixx</td><td>1120 kg&middot;m<sup>2</sup></td><td>roll: the same box seen from the front,
+2.75 m wide and 1.0 m high: M (2.75<sup>2</sup> + 1.0<sup>2</sup>) / 12.</td></tr>
+<tr><td>Izz</td><td>1980 kg&middot;m<sup>2</sup></td><td>yaw: a 2.75 m by 2.75 m deck,
+M (2.75<sup>2</sup> + 2.75<sup>2</sup>) / 12.</td></tr>
 <tr><td>kLimb</td><td>2.0e4 N/m</td><td>static deflection 21 mm under 424 N; heave mode
 sqrt(6 k / M) = 1.4 Hz, pitch mode 2.0 Hz: a compliant but not floppy limb, slow enough that
 the wheel spin dynamics stay the fastest physics.</td></tr>

@@ -1,0 +1,102 @@
+within RoverTerramechanics.Components;
+model SteerableChassis "Rover body moving in the plane (x, y, yaw) with heave, pitch and roll on six compliant limbs, every wheel steered, cut at the wheel hubs"
+  parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
+  input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub, along the wheel's heading";
+  input Real Fy[6](each unit="N") "Lateral force of each wheel on its hub, to the wheel's left";
+  input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the body";
+  input Real steer[6](each unit="rad") "Steering angle of each wheel against the body's heading, positive to the left";
+  output Real W[6](each unit="N") "Wheel loads: the limb forces pressing each wheel into the soil";
+  output Real v_hub[6](each unit="m/s") "Hub speed along each wheel's heading";
+  output Real v_lat[6](each unit="m/s") "Hub speed to each wheel's left";
+  output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity, world x";
+  output Real y(unit="m", start=0, fixed=true) "Position of the centre of gravity, world y";
+  output Real yaw(unit="rad", start=0, fixed=true) "Heading of the body against world x, positive to the left";
+  output Real v(unit="m/s", start=0, fixed=true) "Forward velocity of the centre of gravity, along the heading";
+  output Real vy(unit="m/s", start=0, fixed=true) "Lateral velocity of the centre of gravity, to the left of the heading";
+  output Real yawRate(unit="rad/s", start=0, fixed=true) "Yaw rate";
+  output Real z(unit="m", start=0, fixed=true) "Heave of the centre of gravity from static equilibrium";
+  output Real pitch(unit="rad", start=0, fixed=true) "Pitch angle, nose up positive";
+  output Real roll(unit="rad", start=0, fixed=true) "Roll angle, left side up positive";
+  Real w(unit="m/s", start=0, fixed=true) "Heave velocity";
+  Real q(unit="rad/s", start=0, fixed=true) "Pitch rate";
+  Real p(unit="rad/s", start=0, fixed=true) "Roll rate";
+  Real deflection[6](each unit="m") "Limb compression";
+  Real deflectionRate[6](each unit="m/s") "Limb compression rate";
+  Real yRolled[6](each unit="m") "Hub position to the left of the centre of gravity after the roll";
+  Real zRolled[6](each unit="m") "Hub height relative to the centre of gravity after the roll";
+  Real xHubWorld[6](each unit="m") "Hub position ahead of the centre of gravity (heading frame)";
+  Real zHubWorld[6](each unit="m") "Hub height relative to the centre of gravity";
+  Real vxHub[6](each unit="m/s") "Hub velocity along the heading";
+  Real vyHub[6](each unit="m/s") "Hub velocity to the left of the heading";
+  Real FxBody[6](each unit="N") "Hub force along the heading";
+  Real FyBody[6](each unit="N") "Hub force to the left of the heading";
+protected
+  parameter Real xHub[6](each unit="m") = {rover.xLimb[1], rover.xLimb[2], rover.xLimb[3], rover.xLimb[1], rover.xLimb[2], rover.xLimb[3]} "Hub positions ahead of the centre of gravity; limbs 4-6 mirror 1-3";
+  parameter Real yHub[6](each unit="m") = {rover.yLimb, rover.yLimb, rover.yLimb, -rover.yLimb, -rover.yLimb, -rover.yLimb} "Hub positions to the left: limbs 1-3 left, 4-6 right";
+  parameter Real staticDeflection(unit="m") = rover.M*rover.g/(6*rover.kLimb) "Limb compression at rest";
+equation
+  der(x) = v*cos(yaw) - vy*sin(yaw);
+  der(y) = v*sin(yaw) + vy*cos(yaw);
+  der(yaw) = yawRate;
+  der(z) = w;
+  der(pitch) = q;
+  der(roll) = p;
+  for i in 1:6 loop
+    yRolled[i] = yHub[i]*cos(roll) + rover.hCoG*sin(roll);
+    zRolled[i] = yHub[i]*sin(roll) - rover.hCoG*cos(roll);
+    xHubWorld[i] = xHub[i]*cos(pitch) - zRolled[i]*sin(pitch);
+    zHubWorld[i] = xHub[i]*sin(pitch) + zRolled[i]*cos(pitch);
+    deflection[i] = staticDeflection - z - (zHubWorld[i] + rover.hCoG);
+    deflectionRate[i] = -w - q*xHubWorld[i] - p*cos(pitch)*yRolled[i];
+    W[i] = noEvent(max(rover.kLimb*deflection[i] + rover.dLimb*deflectionRate[i], 0.0));
+    vxHub[i] = v - q*zHubWorld[i] - p*sin(pitch)*yRolled[i] - yawRate*yRolled[i];
+    vyHub[i] = vy - p*zRolled[i] + yawRate*xHubWorld[i];
+    v_hub[i] = vxHub[i]*cos(steer[i]) + vyHub[i]*sin(steer[i]);
+    v_lat[i] = vyHub[i]*cos(steer[i]) - vxHub[i]*sin(steer[i]);
+    FxBody[i] = Fx[i]*cos(steer[i]) - Fy[i]*sin(steer[i]);
+    FyBody[i] = Fx[i]*sin(steer[i]) + Fy[i]*cos(steer[i]);
+  end for;
+  rover.M*(der(v) - yawRate*vy) = sum(FxBody);
+  rover.M*(der(vy) + yawRate*v) = sum(FyBody);
+  rover.Izz*der(yawRate) = sum(xHubWorld[i]*FyBody[i] - yRolled[i]*FxBody[i] for i in 1:6);
+  rover.M*der(w) = sum(W) - rover.M*rover.g;
+  rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*FxBody[i] + tau[i]*cos(steer[i]) for i in 1:6);
+  rover.Ixx*der(p) = sum(yRolled[i]*W[i] - zHubWorld[i]*FyBody[i] + tau[i]*sin(steer[i]) for i in 1:6);
+  assert(rover.M > 0, "rover.M: the mass must be > 0 kg");
+  assert(rover.g > 0, "rover.g: the gravity must be > 0 m/s2");
+  assert(rover.Iyy > 0, "rover.Iyy: the pitch inertia must be > 0 kg.m2");
+  assert(rover.Ixx > 0, "rover.Ixx: the roll inertia must be > 0 kg.m2");
+  assert(rover.Izz > 0, "rover.Izz: the yaw inertia must be > 0 kg.m2");
+  assert(rover.yLimb > 0, "rover.yLimb: the half track width must be > 0 m");
+  assert(rover.hCoG >= 0, "rover.hCoG: the centre of gravity must be at or above the hubs, hCoG >= 0 m");
+  assert(rover.kLimb > 0, "rover.kLimb: the limb stiffness must be > 0 N/m");
+  assert(rover.dLimb >= 0, "rover.dLimb: the limb damping must be >= 0 N.s/m");
+  annotation (Documentation(info="<html>
+<p>The rover body of <code>Chassis</code> set free in the plane: a rigid body of mass M and
+inertias Ixx, Iyy, Izz whose centre of gravity moves in x, y with heading yaw, and which heaves,
+pitches and rolls on six vertical spring-damper limbs (limbs 1-3 front, middle, rear on the left
+at y = +yLimb, 4-6 on the right). Each wheel is steered by <code>steer[i]</code> about its
+vertical axis. In the heading frame (x forward, y left, z up), with the hub at
+p<sub>i</sub> = R<sub>pitch</sub> R<sub>roll</sub> (x<sub>i</sub>, y<sub>i</sub>, -h<sub>CoG</sub>):</p>
+<ul>
+<li>M (dv/dt - r v<sub>y</sub>) = &Sigma; F<sub>x,i</sub><sup>body</sup>,
+M (dv<sub>y</sub>/dt + r v) = &Sigma; F<sub>y,i</sub><sup>body</sup>, with the wheel-frame
+forces turned by the steering: F<sup>body</sup> = R(steer) (F<sub>x</sub>, F<sub>y</sub>);</li>
+<li>Izz dr/dt = &Sigma; (p<sub>x,i</sub> F<sub>y,i</sub><sup>body</sup> - p<sub>y,i</sub>
+F<sub>x,i</sub><sup>body</sup>);</li>
+<li>M dw/dt = &Sigma; W<sub>i</sub> - M g; Iyy dq/dt = &Sigma; (p<sub>x,i</sub> W<sub>i</sub> -
+p<sub>z,i</sub> F<sub>x,i</sub><sup>body</sup> + &tau;<sub>i</sub> cos steer<sub>i</sub>);
+Ixx dp/dt = &Sigma; (p<sub>y,i</sub> W<sub>i</sub> - p<sub>z,i</sub> F<sub>y,i</sub><sup>body</sup> +
+&tau;<sub>i</sub> sin steer<sub>i</sub>): the loads, the hub forces below the centre of gravity
+and the reaction of the wheel motors about their steered axles;</li>
+<li>hub velocity = body velocity + rates &times; p<sub>i</sub>, given to each wheel in its own
+frame (<code>v_hub</code> along, <code>v_lat</code> to its left), which sets its slip and slip
+angle.</li>
+</ul>
+<p>Pitch and roll stay small (a few degrees): their rates are taken as body rates and the
+gyroscopic coupling of yaw with pitch and roll is neglected. Turning and braking move the loads:
+a lateral acceleration rolls the body and loads the outer limbs. With every steering angle
+zero and no lateral force the equations are <code>Chassis</code>'s on level ground. Parameters:
+<code>Parameters.RoverParameters</code>.</p>
+</html>"));
+end SteerableChassis;

@@ -1,0 +1,71 @@
+within RoverTerramechanics;
+model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every wheel driven and steered, with six terramechanics wheels (monolithic)"
+  parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
+  parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
+  parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
+  parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
+  parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
+  parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
+  parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
+  input Real tau[6](each unit="N.m") "Drive torque of each wheel";
+  input Real steer[6](each unit="rad") "Steering angle of each wheel, positive to the left";
+  output Real x(unit="m") "Position of the centre of gravity, world x";
+  output Real y(unit="m") "Position of the centre of gravity, world y";
+  output Real yaw(unit="rad") "Heading against world x, positive to the left";
+  output Real v(unit="m/s") "Forward velocity of the centre of gravity, along the heading";
+  output Real vy(unit="m/s") "Lateral velocity of the centre of gravity, to the left";
+  output Real yawRate(unit="rad/s") "Yaw rate";
+  output Real pitch(unit="rad") "Pitch angle, nose up positive";
+  output Real roll(unit="rad") "Roll angle, left side up positive";
+  output Real Fz[6](each unit="N") "Vertical force of each wheel, Eq. (11) (= its load)";
+  output Real Fx[6](each unit="N") "Longitudinal force of each wheel, along its heading";
+  output Real Fy[6](each unit="N") "Lateral force of each wheel, to its left";
+  output Real Tx[6](each unit="N.m") "Resistance torque of each wheel, Eq. (13)";
+  output Real slip[6](each unit="1") "Slip ratio of each wheel, Eq. (4)";
+  output Real slipAngle[6](each unit="rad") "Slip angle of each wheel's hub velocity";
+  output Real sinkage[6](each unit="m") "Sinkage of each wheel";
+  output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
+  RoverTerramechanics.Components.SteerableChassis body(rover=rover) "Body and limbs";
+  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nPanels=nPanels, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
+equation
+  for i in 1:6 loop
+    wheels[i].tau = tau[i];
+    wheels[i].W = body.W[i];
+    wheels[i].v_hub = body.v_hub[i];
+    wheels[i].v_lat = body.v_lat[i];
+    body.Fx[i] = wheels[i].Fx;
+    body.Fy[i] = wheels[i].Fy;
+    body.tau[i] = tau[i];
+    body.steer[i] = steer[i];
+    Fz[i] = wheels[i].Fz;
+    Fx[i] = wheels[i].Fx;
+    Fy[i] = wheels[i].Fy;
+    Tx[i] = wheels[i].Tx;
+    slip[i] = wheels[i].slip;
+    slipAngle[i] = wheels[i].slipAngle;
+    sinkage[i] = wheels[i].sinkage;
+    omega[i] = wheels[i].omega;
+  end for;
+  x = body.x;
+  y = body.y;
+  yaw = body.yaw;
+  v = body.v;
+  vy = body.vy;
+  yawRate = body.yawRate;
+  pitch = body.pitch;
+  roll = body.roll;
+  annotation (
+    experiment(StartTime=0, StopTime=10, Interval=0.01),
+    Documentation(info="<html>
+<p>The paper's future work: the rover of <code>Rover</code> free in the plane with every wheel
+steered (ATHLETE steers every wheel). Body: <code>Components.SteerableChassis</code> (x, y, yaw;
+heave, pitch, roll on three compliant limbs per side); wheels: <code>Components.RigidWheel</code>,
+each fed its hub's velocity in its own frame, so it gets a slip and a slip angle and gives Fx,
+Fy (Ishigami et al. 2007) and Fz. Inputs <code>tau[1..6]</code> and <code>steer[1..6]</code>;
+limbs 1-3 front, middle, rear on the left, 4-6 on the right. With every steering angle zero it
+is <code>Rover</code> on level ground. The states <code>x</code>, <code>y</code>,
+<code>yaw</code>, <code>v</code>, <code>vy</code>, <code>yawRate</code> and <code>omega[i]</code>
+take start values, so a run can start in motion.</p>
+</html>"));
+end SteerableRover;

@@ -1,0 +1,191 @@
+"""``make simulate`` (after the paper's straight run): the steerable rover following a curved
+path with the identified longitudinal and lateral wheel models, on SteerableRover.fmu and on the
+co-simulated SteerableRoverBody + 6 Wheel (wired by the shipped steerable_rover_cosim.toml),
+and the same paths with kinematic steering (the ablation).
+
+Scenarios: ``turn`` (10 m straight, 90 deg left turn of radius 10 m, 10 m straight, 0.5 m/s);
+``lane_change`` (10 m straight, 3 m to the left over 15 m, 10 m straight, 1.0 m/s). Each starts
+rolling at its speed (wheels at omega = v/r) and ends when the reference reaches the path's end.
+
+results/simulation/
+  path_<scenario>.csv, path_<scenario>_cosim.csv, path_<scenario>_kinematic.csv
+                        time, body pose and rates, s, s_ref, cross_track, heading_error; per wheel
+                        tau, steer, Fx, Fy, Fz, slip, slipAngle, sinkage, omega, Fx_des, Fy_des
+  path_metrics.csv      per scenario and run: cross-track RMS and max, speed error, RMS force errors
+  path_agreement.csv    per scenario: monolithic against co-simulated (speed, loads, path)
+  path_xy.png, path_wheels_<scenario>.png
+  path_following.json   parameters, FMU hashes, versions, wall times, metrics
+"""
+
+from __future__ import annotations
+
+import time
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.control import path_figures
+from rover_cosim.control.path_controller import PATHS
+from rover_cosim.orchestrator.examples import example
+from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.system import system_from_dict
+from rover_cosim.terramechanics import Wheel
+
+STEP = 1e-3  # s
+WHEELS = range(1, 7)
+SCENARIOS = {"turn": 0.5, "lane_change": 1.0}  # path -> target speed [m/s]
+BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
+PER_WHEEL = ("tau", "steer", "Fx", "Fy", "Fz", "slip", "slipAngle", "sinkage", "omega", "Fx_des", "Fy_des")
+FMUS = ("SteerableRover", "SteerableRoverBody", "Wheel")
+
+
+@dataclass
+class PathResult:
+    """What ``run_path_following`` wrote and measured."""
+
+    files: list[Path]
+    tables: dict[tuple[str, str], pd.DataFrame]   # (scenario, run) -> path_*.csv columns
+    metrics: pd.DataFrame                        # path_metrics.csv
+    agreement: pd.DataFrame                      # path_agreement.csv
+    record: dict[str, Any]
+
+
+def stop_time(scenario: str) -> float:
+    """s: until the reference point reaches the end of the path (to the step)."""
+    return float(np.floor(PATHS[scenario]().length / SCENARIOS[scenario] / STEP) * STEP)
+
+
+def controller_block(model: Path, scenario: str, steering: str) -> dict[str, Any]:
+    return {"name": "ctrl", "type": "python", "factory": "rover_cosim.control.path_controller:PathFollowingController",
+            "model": str(model), "path": scenario, "v_target": SCENARIOS[scenario], "steering": steering,
+            "step": STEP}
+
+
+def _controller_connections(body: str, wheel: Any) -> list[dict[str, str]]:
+    """Body state, loads and slip angles to the controller (``wheel(i, name)``: a wheel output)."""
+    connections = [{"from": f"{body}.{name}", "to": f"ctrl.{name}"} for name in BODY]
+    for i in WHEELS:
+        connections += [{"from": wheel(i, "Fz"), "to": f"ctrl.W[{i}]"},
+                        {"from": wheel(i, "slipAngle"), "to": f"ctrl.slipAngle[{i}]"}]
+    return connections
+
+
+def monolithic_system(fmu_dir: Path, model: Path, scenario: str, steering: str = "inverse") -> dict[str, Any]:
+    speed = SCENARIOS[scenario]
+    start = {"v": speed, **{f"omega[{i}]": speed / Wheel().r for i in WHEELS}}
+    connections = _controller_connections("rover", lambda i, name: f"rover.{name}[{i}]")
+    for i in WHEELS:
+        connections += [{"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"},
+                        {"from": f"ctrl.steer[{i}]", "to": f"rover.steer[{i}]"}]
+    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel"},
+            "fmu": [{"name": "rover", "path": str(fmu_dir / "SteerableRover.fmu"), "start": start}],
+            "block": [controller_block(model, scenario, steering)], "connection": connections}
+
+
+def cosim_system(fmu_dir: Path, model: Path, scenario: str) -> dict[str, Any]:
+    """The shipped steerable_rover_cosim.toml's FMUs and hub wiring, its open-loop blocks
+    replaced by the controller, started at the scenario's speed."""
+    shipped = tomllib.loads(example("steerable_rover_cosim").read_text())
+    speed = SCENARIOS[scenario]
+    fmus = []
+    for entry in shipped["fmu"]:
+        start = {"v": speed} if entry["name"] == "body" else {"omega": speed / Wheel().r}
+        fmus.append({"name": entry["name"], "path": str(fmu_dir / entry["path"]), "start": start})
+    names = {entry["name"] for entry in fmus}
+    hubs = [c for c in shipped["connection"] if c["from"].split(".")[0] in names and c["to"].split(".")[0] in names]
+    connections = hubs + _controller_connections("body", lambda i, name: f"wheel{i}.{name}")
+    for i in WHEELS:
+        connections += [{"from": f"ctrl.tau[{i}]", "to": f"wheel{i}.tau"},
+                        {"from": f"ctrl.tau[{i}]", "to": f"body.tau[{i}]"},
+                        {"from": f"ctrl.steer[{i}]", "to": f"body.steer[{i}]"}]
+    order = ["ctrl", "body", *[f"wheel{i}" for i in WHEELS]]
+    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel", "order": order},
+            "fmu": fmus, "block": [controller_block(model, scenario, "inverse")], "connection": connections}
+
+
+def trajectories(data: pd.DataFrame, cosim: bool) -> pd.DataFrame:
+    """The recorded run in the columns of path_*.csv."""
+    body = "body" if cosim else "rover"
+
+    def wheel(i: int, name: str) -> str:
+        if name in ("tau", "steer", "Fx_des", "Fy_des"):
+            return f"ctrl.{name}[{i}]"
+        return f"wheel{i}.{name}" if cosim else f"rover.{name}[{i}]"
+
+    table = {"time": data["time"], **{name: data[f"{body}.{name}"] for name in BODY}}
+    table.update({name: data[f"ctrl.{name}"] for name in ("s", "s_ref", "cross_track", "heading_error")})
+    for i in WHEELS:
+        table.update({f"{name}_{i}": data[wheel(i, name)] for name in PER_WHEEL})
+    return pd.DataFrame(table)
+
+
+def metrics(table: pd.DataFrame, speed: float) -> dict[str, float]:
+    """Cross-track RMS and max [m], largest speed error [%], RMS(Fx - Fx_des), RMS(Fy - Fy_des) per wheel [N]."""
+    row = {"cross_track_rms_m": float(np.sqrt(np.mean(table["cross_track"] ** 2))),
+           "cross_track_max_m": float(np.abs(table["cross_track"]).max()),
+           "speed_error_max_percent": float(100 * np.abs(np.hypot(table["v"], table["vy"]) - speed).max() / speed)}
+    for i in WHEELS:
+        row[f"rms_Fx_{i}_N"] = float(np.sqrt(np.mean((table[f"Fx_{i}"] - table[f"Fx_des_{i}"]) ** 2)))
+    for i in WHEELS:
+        row[f"rms_Fy_{i}_N"] = float(np.sqrt(np.mean((table[f"Fy_{i}"] - table[f"Fy_des_{i}"]) ** 2)))
+    return row
+
+
+def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str, float]:
+    """Monolithic against co-simulated: speed [% of the target], loads [% of the static load],
+    path [m] (largest distance between the two positions at the same time)."""
+    static = float(np.mean([mono[f"Fz_{i}"].iloc[0] for i in WHEELS]))
+    return {"speed_max_difference_percent": float(100 * np.abs(mono["v"] - cosim["v"]).max() / speed),
+            "load_max_difference_percent": float(100 * max(np.abs(mono[f"Fz_{i}"] - cosim[f"Fz_{i}"]).max()
+                                                           for i in WHEELS) / static),
+            "path_max_difference_m": float(np.hypot(mono["x"] - cosim["x"], mono["y"] - cosim["y"]).max())}
+
+
+def run_path_following(fmu_dir: Path, model: Path, out_dir: Path,
+                       scenarios: tuple[str, ...] = tuple(SCENARIOS)) -> PathResult:
+    """Every scenario on both plants and with kinematic steering; writes every file (all or none)."""
+    started = time.perf_counter()
+    fmu_dir = Path(fmu_dir).resolve()
+    tables: dict[tuple[str, str], pd.DataFrame] = {}
+    walls: dict[str, float] = {}
+    builds = {"inverse": lambda s: monolithic_system(fmu_dir, model, s),
+              "cosim": lambda s: cosim_system(fmu_dir, model, s),
+              "kinematic": lambda s: monolithic_system(fmu_dir, model, s, "kinematic")}
+    for scenario in scenarios:
+        for label, build in builds.items():
+            system = system_from_dict(build(scenario), name=f"path {scenario} ({label})", base=fmu_dir)
+            outcome = run(system)
+            tables[scenario, label] = trajectories(outcome.data, cosim=label == "cosim")
+            walls[f"{scenario}/{label}"] = outcome.wall_seconds
+    rows = [{"scenario": s, "run": label, "target_speed_m_s": SCENARIOS[s], **metrics(tables[s, label], SCENARIOS[s])}
+            for s in scenarios for label in builds]
+    metric_table = pd.DataFrame(rows)
+    agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"],
+                                                                SCENARIOS[s])} for s in scenarios])
+    record = run_record("rover-cosim simulate (path following)",
+                        {"scenarios": {s: {"target_speed_m_s": SCENARIOS[s], "stop_time_s": stop_time(s)}
+                                       for s in scenarios}, "step_s": STEP, "model": str(model),
+                         "algorithm": "gauss-seidel"})
+    record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
+                   "model_sha256": file_sha256(model), "run_wall_seconds": walls,
+                   "wall_seconds": time.perf_counter() - started,
+                   "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
+    out = Path(out_dir)
+    suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic"}
+    files = {out / f"path_{s}{suffix[label]}.csv": table.to_csv(index=False, float_format="%.8g").encode()
+             for (s, label), table in tables.items()}
+    files.update({
+        out / "path_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
+        out / "path_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),
+        out / "path_xy.png": path_figures.path_xy({s: PATHS[s]() for s in scenarios}, tables),
+        out / "path_following.json": json_bytes(record),
+    })
+    for s in scenarios:
+        files[out / f"path_wheels_{s}.png"] = path_figures.wheels(tables[s, "inverse"], s)
+    write_all(files)
+    return PathResult(sorted(files), tables, metric_table, agreement_table, record)
