@@ -27,7 +27,7 @@ def _interfaces(root: ET.Element, model_layout: ModelLayout, sources: list[str])
               "canNotUseMemoryManagementFunctions": "false"}
     for element, extra in (("ModelExchange", {"completedIntegratorStepNotNeeded": "true"}),
                            ("CoSimulation", {"canHandleVariableCommunicationStepSize": "true",
-                                             "canInterpolateInputs": "false", "maxOutputDerivativeOrder": "0",
+                                             "canInterpolateInputs": "true", "maxOutputDerivativeOrder": "0",
                                              "canRunAsynchronuously": "false"})):
         node = ET.SubElement(root, element, {**common, **extra})
         files = ET.SubElement(node, "SourceFiles")

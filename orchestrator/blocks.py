@@ -16,6 +16,7 @@ Sources ignore their inputs (they have none). A user block is any class with thi
 from __future__ import annotations
 
 import importlib
+import inspect
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any, Protocol
@@ -135,25 +136,56 @@ BLOCK_TYPES: dict[str, type] = {
 def make_block(name: str, kind: str, params: Mapping[str, Any]) -> Block:
     """A block from its system-file entry; ValueError naming the block for bad entries."""
     if kind == "python":
-        factory = params.get("factory")
-        if not isinstance(factory, str) or ":" not in factory:
-            raise ValueError(f"block {name!r}: type 'python' needs factory = \"module:callable\"")
-        module_name, _, attribute = factory.partition(":")
-        try:
-            constructor = getattr(importlib.import_module(module_name), attribute)
-        except (ImportError, AttributeError) as error:
-            raise ValueError(f"block {name!r}: cannot load factory {factory!r}: {error}") from None
-        options = {k: v for k, v in params.items() if k != "factory"}
-        block = constructor(name=name, **options)
-        for attribute in ("inputs", "outputs", "start", "step"):
-            if not hasattr(block, attribute):
-                raise ValueError(f"block {name!r}: {factory} made an object without {attribute!r}")
-        if not hasattr(block, "units"):
-            block.units = {}
-        return block
+        return _python_block(name, params)
     if kind not in BLOCK_TYPES:
         raise ValueError(f"block {name!r}: type {kind!r}: expected one of {', '.join([*BLOCK_TYPES, 'python'])}")
+    _check_keys(name, f"type {kind!r}", BLOCK_TYPES[kind], params)
     try:
         return BLOCK_TYPES[kind](name=name, **params)
     except TypeError as error:
         raise ValueError(f"block {name!r} (type {kind}): {error}") from None
+
+
+def _python_block(name: str, params: Mapping[str, Any]) -> Block:
+    """A ``type = "python"`` block made by its ``factory = "module:callable"`` with the other keys."""
+    factory = params.get("factory")
+    if not isinstance(factory, str) or ":" not in factory:
+        raise ValueError(f"block {name!r}: type 'python' needs factory = \"module:callable\"")
+    module_name, _, attribute = factory.partition(":")
+    try:
+        constructor = getattr(importlib.import_module(module_name), attribute)
+    except (ImportError, AttributeError) as error:
+        raise ValueError(f"block {name!r}: cannot load factory {factory!r}: {error}") from None
+    options = {k: v for k, v in params.items() if k != "factory"}
+    _check_keys(name, factory, constructor, options)
+    try:
+        block = constructor(name=name, **options)
+    except ValueError:
+        raise
+    except Exception as error:  # noqa: BLE001 - user code: name the block
+        raise ValueError(f"block {name!r}: {factory}(...) failed: {type(error).__name__}: {error}") from None
+    for attribute in ("inputs", "outputs", "start", "step"):
+        if not hasattr(block, attribute):
+            raise ValueError(f"block {name!r}: {factory} made an object without {attribute!r}")
+    if not hasattr(block, "units"):
+        block.units = {}
+    return block
+
+
+def _check_keys(name: str, what: str, constructor: Any, params: Mapping[str, Any]) -> None:
+    """Unknown or missing keys of a block entry, named with the keys the block accepts."""
+    try:
+        signature = inspect.signature(constructor)
+    except (TypeError, ValueError):
+        return
+    accepted = [p for p in signature.parameters.values() if p.name != "name"]
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in accepted):
+        return
+    names = [p.name for p in accepted]
+    needed = [p.name for p in accepted if p.default is inspect.Parameter.empty]
+    unknown = sorted(set(params) - set(names))
+    missing = [key for key in needed if key not in params]
+    if unknown or missing:
+        problem = f"unknown key(s) {unknown}" if unknown else f"missing key(s) {missing}"
+        required = f" (required: {', '.join(needed)})" if needed else ""
+        raise ValueError(f"block {name!r} ({what}): {problem}; it accepts {', '.join(names) or 'no keys'}{required}")

@@ -14,6 +14,7 @@ inputs, and everyone exits initialization.
 
 from __future__ import annotations
 
+import copy
 import ctypes
 from collections.abc import Callable
 from pathlib import Path
@@ -53,9 +54,15 @@ class Participant(Protocol):
 
     def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray: ...
 
-    def do_step(self, t: float, h: float, u: np.ndarray) -> None: ...
+    def do_step(self, t: float, h: float, u: np.ndarray, slopes: np.ndarray | None = None) -> None: ...
 
     def get_outputs(self, t: float) -> np.ndarray: ...
+
+    def get_state(self, t: float) -> Any: ...
+
+    def set_state(self, state: Any, t: float) -> None: ...
+
+    def free_state(self, state: Any) -> None: ...
 
     def close(self) -> None: ...
 
@@ -95,11 +102,36 @@ class BlockParticipant:
     def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray:
         return self.last
 
-    def do_step(self, t: float, h: float, u: np.ndarray) -> None:
+    def do_step(self, t: float, h: float, u: np.ndarray, slopes: np.ndarray | None = None) -> None:
+        """Blocks compute their outputs at t + h from ``u``; ``slopes`` are not used."""
         self.last = self._call("step", lambda: self.block.step(t, h, u), t)
 
     def get_outputs(self, t: float) -> np.ndarray:
         return self.last
+
+    def get_state(self, t: float) -> Any:
+        """The block's state (its ``get_state()``, else a deep copy of its attributes) and its last outputs."""
+        getter = getattr(self.block, "get_state", None)
+        try:
+            state = getter() if getter is not None else copy.deepcopy(vars(self.block))
+        except Exception as error:  # noqa: BLE001 - user code
+            raise RunError(f"{self.name} (block): get_state at t = {t:.6g} s failed: {error}") from error
+        return state, self.last.copy()
+
+    def set_state(self, state: Any, t: float) -> None:
+        block_state, last = state
+        setter = getattr(self.block, "set_state", None)
+        try:
+            if setter is not None:
+                setter(block_state)
+            else:
+                vars(self.block).update(copy.deepcopy(block_state))
+        except Exception as error:  # noqa: BLE001 - user code
+            raise RunError(f"{self.name} (block): set_state at t = {t:.6g} s failed: {error}") from error
+        self.last = last.copy()
+
+    def free_state(self, state: Any) -> None:
+        """Nothing to free: the state is a Python object."""
 
     def close(self) -> None:
         """Blocks hold no external resources."""
@@ -130,6 +162,7 @@ class FmuParticipant:
         self.outputs: list[str] = []
         self.input_values = np.zeros(0)
         self.read_values = np.zeros(0)
+        self.can_interpolate = bool(getattr(md.coSimulation, "canInterpolateInputs", False))
 
     def _log(self, env, instance, status, category, message) -> None:
         if status >= 2:  # discard, error, fatal
@@ -149,6 +182,9 @@ class FmuParticipant:
         self._in_refs = (ctypes.c_uint * max(1, len(inputs)))(*[self.refs[n] for n in inputs])
         self._read_refs = (ctypes.c_uint * max(1, len(reads)))(*[self.refs[n] for n in reads])
         self.input_values = np.zeros(len(inputs))
+        self.input_slopes = np.zeros(len(inputs))
+        self._orders = (ctypes.c_int * max(1, len(inputs)))(*([1] * len(inputs)))
+        self._slope_pointer = self.input_slopes.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self.read_values = np.zeros(len(reads))
         self._in_pointer = self.input_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._read_pointer = self.read_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
@@ -188,10 +224,26 @@ class FmuParticipant:
                                                                    len(self.outputs), self._read_pointer), t)
         return self.read_values
 
-    def do_step(self, t: float, h: float, u: np.ndarray) -> None:
-        """Set the inputs held over the step, then fmi2DoStep from ``t`` to ``t + h``."""
+    def do_step(self, t: float, h: float, u: np.ndarray, slopes: np.ndarray | None = None) -> None:
+        """Set the inputs at ``t`` (held over the step, or interpolated with ``slopes`` [1/s] where
+        the FMU can interpolate inputs), then fmi2DoStep from ``t`` to ``t + h``."""
         self.set_inputs(u, t)
+        if slopes is not None and self.inputs:
+            self.input_slopes[:] = slopes
+            self._call("fmi2SetRealInputDerivatives",
+                       lambda: self.fmu.fmi2SetRealInputDerivatives(self.fmu.component, self._in_refs, len(self.inputs),
+                                                                    self._orders, self._slope_pointer), t)
         self._call("fmi2DoStep", lambda: self.fmu.fmi2DoStep(self.fmu.component, t, h, 1), t)
+
+    def get_state(self, t: float) -> Any:
+        """fmi2GetFMUstate: a copy of the whole instance (integrator memory included)."""
+        return self._call("fmi2GetFMUstate", self.fmu.getFMUstate, t)
+
+    def set_state(self, state: Any, t: float) -> None:
+        self._call("fmi2SetFMUstate", lambda: self.fmu.setFMUstate(state), t)
+
+    def free_state(self, state: Any) -> None:
+        self._call("fmi2FreeFMUstate", lambda: self.fmu.freeFMUstate(state))
 
     def close(self) -> None:
         for what, action in (("fmi2Terminate", self.fmu.terminate), ("fmi2FreeInstance", self.fmu.freeInstance)):

@@ -36,6 +36,7 @@ variables = ["body.v", "wheel1.Fz"]   # default: every output of every participa
 from __future__ import annotations
 
 import json
+import re
 import tomllib
 import zipfile
 from dataclasses import dataclass, field
@@ -48,7 +49,21 @@ from rover_cosim.common.units import base_units
 
 from .blocks import Block, make_block
 
-ALGORITHMS = ("jacobi", "gauss-seidel")
+ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
+#: Instance names: identifiers, so that a name is never a path or a port separator.
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+@dataclass(frozen=True)
+class Iteration:
+    """Settings of the iterative master (``algorithm = "iterative"``): a step is repeated, the
+    participants rolled back, until every exchanged value changes by less than
+    ``tolerance`` x (1 + |value|) between two passes, at most ``max_iterations`` passes; the next
+    guess moves ``relaxation`` (0 < relaxation <= 1) of the way to the new values."""
+
+    tolerance: float = 1e-6
+    max_iterations: int = 20
+    relaxation: float = 1.0
 
 
 class SystemFileError(ValueError):
@@ -102,6 +117,7 @@ class System:
     algorithm: str = "gauss-seidel"
     order: list[str] = field(default_factory=list)
     record: list[Port] = field(default_factory=list)
+    iteration: Iteration = field(default_factory=Iteration)
 
     def participants(self) -> dict[str, FmuEntry | BlockEntry]:
         """Every FMU and block entry by instance name."""
@@ -112,7 +128,8 @@ class System:
 
 #: The keys each section of a system file may have.
 SECTION_KEYS = {
-    "simulation": {"stop_time", "step", "start_time", "algorithm", "order"},
+    "simulation": {"stop_time", "step", "start_time", "algorithm", "order", "tolerance", "max_iterations",
+                   "relaxation"},
     "fmu": {"name", "path", "parameters", "start"},
     "connection": {"from", "to"},
     "record": {"variables"},
@@ -168,8 +185,9 @@ class _Context:
             raise self.error(where, f"unknown key(s) {sorted(unknown)}; expected {sorted(SECTION_KEYS[section])}")
 
     def claim(self, instance: Any, where: str) -> str:
-        if not isinstance(instance, str) or not instance or "." in instance:
-            raise self.error(where, f"name = {instance!r}: expected a non-empty name without dots")
+        if not isinstance(instance, str) or not IDENTIFIER.fullmatch(instance):
+            raise self.error(where, f"name = {instance!r}: expected an identifier (letters, digits and _, not "
+                             "starting with a digit; it names the instance and its folder)")
         if instance in self.names:
             raise self.error(where, f"name {instance!r} is used twice")
         self.names.add(instance)
@@ -208,7 +226,27 @@ def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path 
     check_inputs_driven(fmus, blocks, connections, context)
     order = parse_order(simulation.get("order"), fmus, blocks, context)
     record = parse_record(_table(data.get("record"), f"{name}: [record]"), order, ports, context)
-    return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, order, record)
+    iteration = parse_iteration(simulation, algorithm, context)
+    return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, order, record, iteration)
+
+
+def parse_iteration(simulation: dict[str, Any], algorithm: str, context: _Context) -> Iteration:
+    """[simulation] tolerance, max_iterations, relaxation: only with algorithm = "iterative"."""
+    given = {key: simulation[key] for key in ("tolerance", "max_iterations", "relaxation") if key in simulation}
+    if given and algorithm != "iterative":
+        raise context.error("[simulation]", f"{', '.join(sorted(given))} only apply to algorithm = \"iterative\" "
+                            f"(this system uses {algorithm!r})")
+    default = Iteration()
+    tolerance = context.number(given.get("tolerance", default.tolerance), "[simulation] tolerance")
+    relaxation = context.number(given.get("relaxation", default.relaxation), "[simulation] relaxation")
+    bound = given.get("max_iterations", default.max_iterations)
+    if not tolerance > 0:
+        raise context.error("[simulation] tolerance", f"{tolerance!r}: expected > 0")
+    if not 0 < relaxation <= 1:
+        raise context.error("[simulation] relaxation", f"{relaxation!r}: expected 0 < relaxation <= 1")
+    if isinstance(bound, bool) or not isinstance(bound, int) or bound < 1:
+        raise context.error("[simulation] max_iterations", f"{bound!r}: expected a whole number >= 1")
+    return Iteration(tolerance, bound, relaxation)
 
 
 def parse_simulation(simulation: dict[str, Any], context: _Context) -> tuple[float, float, float, str]:

@@ -148,6 +148,10 @@ BAD_SYSTEMS = {
                                    "wheel1.tau is not a parameter"),
     "unknown block type": (lambda d: d["block"][0].update(type="sine"), "type 'sine'"),
     "duplicate name": (lambda d: d["fmu"][2].update(name="wheel1"), "name 'wheel1' is used twice"),
+    "path as instance name": (lambda d: d["fmu"][0].update(name="/tmp/body"), "expected an identifier"),
+    "unknown block key": (lambda d: d["block"][0].update(slope=20.0),
+                          "unknown key(s) ['slope']; it accepts begin, end, time, width, unit"),
+    "missing block key": (lambda d: d["block"][0].pop("width"), "missing key(s) ['width']"),
 }
 
 

@@ -121,6 +121,10 @@ typedef struct {
     double *holds, *assert_values;         /* the model's asserts, evaluated with the outputs */
     double rtol, max_step;
     int xdot_valid, y_valid;
+    /* Input interpolation over one communication step (fmi2SetRealInputDerivatives, order 1):
+     * u(t) = u + u_der (t - t_step) while interpolating; cleared after each fmi2DoStep. */
+    double *u_der, *u_step, t_step;
+    int interpolating;
     /* CasADi work */
     const double **arg;
     double **res;
@@ -214,8 +218,15 @@ static Instance *enter(fmi2Component component, Function f) {
     if ((n) > 0 && !(array)) return fail(c, F, REJECTED, "%s is NULL (%zu elements expected)", #array, (size_t)(n))
 
 /* ---- model evaluation ------------------------------------------------------------------- */
+/* The inputs at time t: the held values, or their linear interpolation within the step. */
+static const double *inputs_at(Instance *c, double t) {
+    if (!c->interpolating) return c->u;
+    for (int i = 0; i < model_info.nu; i++) c->u_step[i] = c->u[i] + c->u_der[i] * (t - c->t_step);
+    return c->u_step;
+}
+
 static int call4(Instance *c, casadi_eval f, double t, const double *x, double *out0, double *out1) {
-    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = c->u; c->arg[3] = c->p;
+    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = inputs_at(c, t); c->arg[3] = c->p;
     c->res[0] = out0; c->res[1] = out1; c->res[2] = NULL;
     if (f == model_outputs) { c->res[1] = c->holds; c->res[2] = c->assert_values; }
     return f(c->arg, c->res, c->iw, c->w, 0);
@@ -316,6 +327,8 @@ static void invalidate(Instance *c) {
 static void set_defaults(Instance *c) {
     memcpy(c->p, model_info.p_default, sizeof(double) * model_info.np);
     memcpy(c->u, model_info.u_default, sizeof(double) * model_info.nu);
+    for (int i = 0; i < model_info.nu; i++) c->u_der[i] = 0.0;
+    c->interpolating = 0;
     memcpy(c->x, model_info.x_start, sizeof(double) * model_info.nx);
     for (int i = 0; i < model_info.nx; i++) c->x_set[i] = 0.0;
     c->rtol = DEFAULT_RTOL;
@@ -342,7 +355,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn, s
 
 static void free_instance(Instance *c) {
     fmi2CallbackFreeMemory release = c->cb.freeMemory;
-    void *blocks[] = {c->name, c->p, c->x, c->u, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
+    void *blocks[] = {c->name, c->p, c->x, c->u, c->u_der, c->u_step, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
                       (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y};
     for (size_t i = 0; i < sizeof(blocks) / sizeof(blocks[0]); i++) if (blocks[i]) release(blocks[i]);
     ode23s_free(&c->solver, release);
@@ -368,6 +381,8 @@ static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     c->p = alloc(np, sizeof(double));
     c->x = alloc(nx, sizeof(double));
     c->u = alloc(nu, sizeof(double));
+    c->u_der = alloc(nu, sizeof(double));
+    c->u_step = alloc(nu, sizeof(double));
     c->xdot = alloc(nx, sizeof(double));
     c->y = alloc(ny, sizeof(double));
     c->x_set = alloc(nx, sizeof(double));
@@ -383,7 +398,7 @@ static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     c->sens_x = alloc(nx, sizeof(double));
     c->sens_y = alloc(ny, sizeof(double));
     int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
-    return c->p && c->x && c->u && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
+    return c->p && c->x && c->u && c->u_der && c->u_step && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
            c->seed_u && c->sens_x && c->sens_y && !solver_failed;
 }
 
@@ -629,6 +644,8 @@ static void state_read(Instance *c, const unsigned char *payload) {
     const double *v = (const double *)(payload + sizeof head);
     memcpy(c->x, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->u, v, sizeof(double) * model_info.nu); v += model_info.nu;
+    for (int i = 0; i < model_info.nu; i++) c->u_der[i] = 0.0; /* derivatives belong to one step */
+    c->interpolating = 0;
     memcpy(c->p, v, sizeof(double) * model_info.np); v += model_info.np;
     memcpy(c->x_set, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->solver.F0, v, sizeof(double) * model_info.nx); v += model_info.nx;
@@ -861,13 +878,33 @@ fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component component, fmi2Real x
 }
 
 /* ---- Co-Simulation ---------------------------------------------------------------------- */
+/* First derivatives of inputs for the next fmi2DoStep (canInterpolateInputs): the input is
+ * interpolated linearly from its value at the communication point; after the step it holds its
+ * value at the step's end and the derivatives are cleared. */
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
-    (void)vr; (void)order; (void)value;
-    ENTER(F_SetRealInputDerivatives);
-    if (nvr == 0) return fmi2OK;
-    return fail(c, F_SetRealInputDerivatives, REJECTED,
-                "input derivatives are not supported (canInterpolateInputs=false)");
+    const Function F = F_SetRealInputDerivatives;
+    ENTER(F);
+    if (c->type != fmi2CoSimulation && nvr > 0)
+        return fail(c, F, REJECTED, "input derivatives are for Co-Simulation only");
+    NOT_NULL(F, vr, nvr);
+    NOT_NULL(F, order, nvr);
+    NOT_NULL(F, value, nvr);
+    for (size_t i = 0; i < nvr; i++) {
+        int r = real_index(vr[i]);
+        if (r < off_u() || r >= off_y())
+            return fail(c, F, REJECTED, "value reference %u: not an input", vr[i]);
+        if (order[i] != 1)
+            return fail(c, F, REJECTED, "%s: derivative order %d; only order 1 is supported", real_name(vr[i]),
+                        (int)order[i]);
+        if (!isfinite(value[i]))
+            return fail(c, F, REJECTED, "%s: derivative %g: expected a finite value", real_name(vr[i]), value[i]);
+    }
+    for (size_t i = 0; i < nvr; i++) c->u_der[real_index(vr[i]) - off_u()] = value[i];
+    c->interpolating = 0;
+    for (int i = 0; i < model_info.nu; i++) c->interpolating |= c->u_der[i] != 0.0;
+    invalidate(c);
+    return fmi2OK;
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component component, const fmi2ValueReference vr[], size_t nvr,
@@ -897,10 +934,16 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real currentCommunicationPoin
     c->solver.max_step = c->max_step;
     char message[512];
     double t = currentCommunicationPoint;
+    c->t_step = currentCommunicationPoint;
     int status = ode23s_integrate(&c->solver, &t, c->x, t_end, message, sizeof message);
     c->t = t;
     c->xdot_valid = 0;
     c->y_valid = 0;
+    if (c->interpolating) { /* the inputs now hold their values at the step's end */
+        for (int i = 0; i < model_info.nu; i++) { c->u[i] += c->u_der[i] * (t - c->t_step); c->u_der[i] = 0.0; }
+        c->interpolating = 0;
+        c->solver.f0_valid = 0;
+    }
     if (status != 0) return fail(c, F, BROKEN, "integration failed: %s", message);
     c->t = t_end;
     return update(c, F, 0, 1); /* the outputs at t_end, and with them the asserts */

@@ -75,6 +75,13 @@ class InverseModelController:
     def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
         return self._outputs(t0, u0, advance=False)
 
+    def get_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """The filter's state and the last torques (for masters that repeat a step)."""
+        return self.inverse.filter_state.copy(), self.torque.copy()
+
+    def set_state(self, state: tuple[np.ndarray, np.ndarray]) -> None:
+        self.inverse.filter_state, self.torque = state[0].copy(), state[1].copy()
+
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         if abs(h - self.step_size) > 1e-12:
             raise ValueError(f"block {self.name!r}: communication step {h!r} s differs from its step = "

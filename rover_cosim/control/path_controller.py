@@ -162,6 +162,13 @@ class PathFollowingController:
     def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
         return self._outputs(t0, u0, advance=False)
 
+    def get_state(self) -> tuple[np.ndarray, np.ndarray, int | None]:
+        """The filter's state, the last steering and the path index (for masters that repeat a step)."""
+        return self.inverse.filter_state.copy(), self.steer.copy(), self.hint
+
+    def set_state(self, state: tuple[np.ndarray, np.ndarray, int | None]) -> None:
+        self.inverse.filter_state, self.steer, self.hint = state[0].copy(), state[1].copy(), state[2]
+
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         if abs(h - self.step_size) > 1e-12:
             raise ValueError(f"block {self.name!r}: communication step {h!r} s differs from its step = "
