@@ -9,6 +9,8 @@ before it. Recorded values go into a preallocated array (``recorder``).
 
 from __future__ import annotations
 
+import os
+import shutil
 import tempfile
 import time
 from abc import ABC, abstractmethod
@@ -21,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from .participants import BlockParticipant, FmuParticipant, Participant, RunError
-from .recorder import Recorder
+from .recorder import Recorder, communication_points
 from .system import Iteration, System
 from .wiring import Wiring, wire
 
@@ -89,8 +91,10 @@ class JacobiMaster(Master):
 
 class IterativeMaster(Master):
     """Each step repeated from the participants' saved states (fmi2GetFMUstate / the blocks'
-    get_state) until the exchanged values converge: every FMU steps with its inputs interpolated
-    linearly from their values at ``t`` to the current guess of those at ``t + h``
+    get_state) until the exchanged values converge. Each pass steps the participants in order
+    (Gauss-Seidel within the pass: a participant sees the outputs at ``t + h`` of those before it
+    in this pass, of the others from the last pass); every FMU steps with its inputs interpolated
+    linearly from their values at ``t`` to those at ``t + h``
     (fmi2SetRealInputDerivatives; an FMU that cannot interpolate holds their mean), an implicit,
     second-order coupling; blocks get the guess at ``t + h``. The guess moves ``relaxation`` of the way to the new
     outputs, and the step is accepted when no exchanged value changed by more than
@@ -129,15 +133,15 @@ class IterativeMaster(Master):
         states = [p.get_state(t) for p in self.participants]
         try:
             for attempt in range(1, settings.max_iterations + 1):
-                new = guess.copy()
+                new = guess.copy()  # filled in order: later participants see this pass's outputs
                 for participant, inputs, outputs, hold in zip(self.participants, self.inputs, self.outputs, self.holds):
                     begin = clock()
                     if hold == "interpolate":
-                        participant.do_step(t, h, start[inputs], (guess[inputs] - start[inputs]) / h)
+                        participant.do_step(t, h, start[inputs], (new[inputs] - start[inputs]) / h)
                     elif hold == "mean":
-                        participant.do_step(t, h, 0.5 * (start[inputs] + guess[inputs]))
+                        participant.do_step(t, h, 0.5 * (start[inputs] + new[inputs]))
                     else:
-                        participant.do_step(t, h, guess[inputs])
+                        participant.do_step(t, h, new[inputs])
                     new[outputs] = participant.get_outputs(t + h)
                     self.step_seconds[participant.name] += clock() - begin
                 change = np.abs(new[self.exchanged] - guess[self.exchanged])
@@ -192,12 +196,40 @@ def initialize(participants: list[Participant], wiring: Wiring, values: np.ndarr
         values[ports.output_slots] = participant.exit_initialization(t0, values[ports.input_slots])
 
 
+#: The temporary folder of a run's unpacked FMUs: ``<tmp>/rover-cosim-run-<pid>-<random>``.
+UNZIP_PREFIX = "rover-cosim-run-"
+
+
+def remove_stale_folders() -> list[Path]:
+    """Remove the unpacked FMUs of runs whose process is gone (killed with SIGKILL, where no
+    clean-up can run); returns what was removed."""
+    removed = []
+    for folder in Path(tempfile.gettempdir()).glob(f"{UNZIP_PREFIX}*-*"):
+        pid = folder.name[len(UNZIP_PREFIX):].split("-", 1)[0]
+        if not pid.isdigit() or int(pid) == os.getpid() or _alive(int(pid)):
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
+        removed.append(folder)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 @contextmanager
 def participants_of(system: System, wiring: Wiring) -> Iterator[list[Participant]]:
     """The participants of ``system`` in its order, FMUs extracted into a temporary folder;
     every FMU is terminated and freed on leaving, whatever happened."""
+    remove_stale_folders()
     with ExitStack() as stack:
-        unzip_root = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="rover-cosim-run-")))
+        unzip_root = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix=f"{UNZIP_PREFIX}{os.getpid()}-")))
         by_name: dict[str, Participant] = {}
         for entry in system.fmus:
             fmu = FmuParticipant(entry, unzip_root)
@@ -221,23 +253,41 @@ def make_master(system: System, participants: list[Participant], wiring: Wiring)
 
 
 def run(system: System, *, progress: Callable[[float], None] | None = None) -> RunResult:
-    """Run ``system``; raises :class:`RunError` naming the participant, call and time on failure."""
+    """Run ``system``; raises :class:`RunError` naming the participant, call and time on failure,
+    with the rows recorded up to the failure in its ``partial``."""
     started = time.perf_counter()
     wiring = wire(system)
-    t0, h = system.start_time, system.step
-    n_steps = round((system.stop_time - t0) / h)
+    times = communication_points(system.start_time, system.stop_time, system.step)
+    n_steps = len(times) - 1
     with participants_of(system, wiring) as participants:
         values = wiring.initial_values()
-        initialize(participants, wiring, values, t0, system.stop_time)
+        initialize(participants, wiring, values, system.start_time, system.stop_time)
         master = make_master(system, participants, wiring)
-        recorder = Recorder(system.record, wiring.record_slots, t0, h, n_steps)
+        recorder = Recorder(system.record, wiring.record_slots, times)
+        names = {p.name: wiring.participants[p.name].outputs for p in participants}
+        check_finite(names, master, values, system.start_time)
         recorder.sample(0, values)
-        for k in range(n_steps):
-            master.step(values, float(recorder.times[k]), h)
-            recorder.sample(k + 1, values)
-            if progress is not None:
-                progress((k + 1) / n_steps)
+        try:
+            for k in range(n_steps):
+                master.step(values, float(times[k]), float(times[k + 1] - times[k]))
+                check_finite(names, master, values, float(times[k + 1]))
+                recorder.sample(k + 1, values)
+                if progress is not None:
+                    progress((k + 1) / n_steps)
+        except RunError as error:
+            error.partial = recorder.frame()
+            raise
         return RunResult(recorder.frame(), time.perf_counter() - started, n_steps, master.step_seconds)
+
+
+def check_finite(names: dict[str, list[str]], master: Master, values: np.ndarray, t: float) -> None:
+    """A RunError naming the participant, the signal and the time of the first non-finite output."""
+    for participant, outputs in zip(master.participants, master.outputs):
+        produced = values[outputs]
+        if not np.all(np.isfinite(produced)):
+            bad = int(np.nonzero(~np.isfinite(produced))[0][0])
+            raise RunError(f"{participant.name}: output {names[participant.name][bad]} = {produced[bad]} at "
+                           f"t = {t:.6g} s: expected a finite value")
 
 
 __all__ = ["GaussSeidelMaster", "IterativeMaster", "JacobiMaster", "Master", "RunError", "RunResult", "initialize",

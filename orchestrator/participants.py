@@ -36,7 +36,10 @@ T = TypeVar("T")
 
 
 class RunError(RuntimeError):
-    """A co-simulation run that failed; the message names the instance, the call and the time."""
+    """A co-simulation run that failed; the message names the instance, the call and the time.
+    ``partial``: the rows recorded before the failure (a DataFrame), when the run got that far."""
+
+    partial: Any = None
 
 
 class Participant(Protocol):

@@ -8,20 +8,34 @@ import pandas as pd
 from .system import Port
 
 
-class Recorder:
-    """Rows ``0 .. n_steps`` at ``t0 + k h``; :meth:`sample` copies the recorded slots of the
-    value vector into row ``k``; :meth:`frame` gives time [s] and one column per port."""
+def communication_points(t0: float, stop_time: float, h: float) -> np.ndarray:
+    """t0, t0 + h, ... up to stop_time; a stop time that is not a whole number of steps after t0
+    gets one shorter final step (the run ends exactly at stop_time, never early)."""
+    whole = int(np.floor((stop_time - t0) / h + 1e-9))
+    times = t0 + h * np.arange(whole + 1)
+    if stop_time - times[-1] > 1e-9 * h:
+        times = np.append(times, stop_time)
+    times[-1] = min(times[-1], stop_time)
+    return times
 
-    def __init__(self, ports: list[Port], slots: np.ndarray, t0: float, h: float, n_steps: int):
+
+class Recorder:
+    """One row per communication point ``times``; :meth:`sample` copies the recorded slots of the
+    value vector into row ``k``; :meth:`frame` gives time [s] and one column per port (the rows
+    sampled so far, when a run stops early)."""
+
+    def __init__(self, ports: list[Port], slots: np.ndarray, times: np.ndarray):
         self.columns = [str(port) for port in ports]
         self.slots = slots
-        self.times = t0 + h * np.arange(n_steps + 1)
-        self.rows = np.empty((n_steps + 1, slots.size))
+        self.times = times
+        self.rows = np.empty((len(times), slots.size))
+        self.filled = 0
 
     def sample(self, k: int, values: np.ndarray) -> None:
         self.rows[k] = values[self.slots]
+        self.filled = k + 1
 
     def frame(self) -> pd.DataFrame:
-        data = pd.DataFrame(self.rows, columns=self.columns)
-        data.insert(0, "time", self.times)
+        data = pd.DataFrame(self.rows[:self.filled], columns=self.columns)
+        data.insert(0, "time", self.times[:self.filled])
         return data

@@ -118,6 +118,7 @@ class System:
     order: list[str] = field(default_factory=list)
     record: list[Port] = field(default_factory=list)
     iteration: Iteration = field(default_factory=Iteration)
+    algebraic_loop: list[Port] | None = None  # a cycle of direct feedthrough, if there is one
 
     def participants(self) -> dict[str, FmuEntry | BlockEntry]:
         """Every FMU and block entry by instance name."""
@@ -129,7 +130,7 @@ class System:
 #: The keys each section of a system file may have.
 SECTION_KEYS = {
     "simulation": {"stop_time", "step", "start_time", "algorithm", "order", "tolerance", "max_iterations",
-                   "relaxation"},
+                   "relaxation", "allow_algebraic_loops"},
     "fmu": {"name", "path", "parameters", "start"},
     "connection": {"from", "to"},
     "record": {"variables"},
@@ -202,6 +203,8 @@ def load_system(path: Path | str, *, fmu_dir: Path | None = None) -> System:
         data = tomllib.loads(path.read_text())
     except FileNotFoundError:
         raise SystemFileError(f"{path}: no such system file") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as error:
+        raise SystemFileError(f"{path}: cannot be read as a system file ({type(error).__name__})") from None
     except tomllib.TOMLDecodeError as error:
         raise SystemFileError(f"{path}: not valid TOML: {error}") from None
     return system_from_dict(data, name=str(path), base=fmu_dir or path.parent, path=path)
@@ -227,7 +230,27 @@ def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path 
     order = parse_order(simulation.get("order"), fmus, blocks, context)
     record = parse_record(_table(data.get("record"), f"{name}: [record]"), order, ports, context)
     iteration = parse_iteration(simulation, algorithm, context)
-    return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, order, record, iteration)
+    loop = check_loops(fmus, blocks, connections, simulation, algorithm, context)
+    return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, order, record, iteration,
+                  loop)
+
+
+def check_loops(fmus: list[FmuEntry], blocks: list[BlockEntry], connections: list[Connection],
+                simulation: dict[str, Any], algorithm: str, context: _Context) -> list[Port] | None:
+    """A cycle of direct feedthrough is an error for Jacobi and Gauss-Seidel unless
+    ``allow_algebraic_loops = true`` (then the order breaks it with a one-step delay); the
+    iterative master solves it."""
+    from .loops import dependency_graph, describe, find_loop
+
+    allow = simulation.get("allow_algebraic_loops", False)
+    if not isinstance(allow, bool):
+        raise context.error("[simulation] allow_algebraic_loops", f"{allow!r}: expected true or false")
+    loop = find_loop(dependency_graph(fmus, blocks, connections))
+    if loop and algorithm != "iterative" and not allow:
+        raise context.error("connections", f"algebraic loop (direct feedthrough all the way round): {describe(loop)}; "
+                            "use algorithm = \"iterative\" to solve it, or allow_algebraic_loops = true in "
+                            "[simulation] to break it with a one-step delay in the order of the participants")
+    return loop
 
 
 def parse_iteration(simulation: dict[str, Any], algorithm: str, context: _Context) -> Iteration:

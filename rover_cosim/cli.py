@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -97,42 +99,56 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _run(args: argparse.Namespace) -> int:
-    from rover_cosim.orchestrator.master import RunError, run
-    from rover_cosim.orchestrator.runs import write_run
-    from rover_cosim.orchestrator.system import SystemFileError, load_system, system_from_dict
-    from rover_cosim.progress import ProgressBar
+def _load_run_system(args: argparse.Namespace):  # noqa: ANN202 - System, imported lazily
+    """The system of ``rover-cosim run`` with the command line's overrides (SystemFileError if bad)."""
+    from rover_cosim.orchestrator.system import load_system, system_from_dict
 
     path = Path(args.system)
     fmu_dir = args.fmu_dir
-    if not path.exists() and args.system in EXAMPLES:
+    if not path.is_file() and args.system in EXAMPLES:
         path = EXAMPLES[args.system]
         fmu_dir = fmu_dir or Path("fmus")
-    try:
-        system = load_system(path, fmu_dir=fmu_dir)
-        if args.algorithm or args.step is not None or args.stop_time is not None:
-            import tomllib
+    system = load_system(path, fmu_dir=fmu_dir)
+    if args.algorithm or args.step is not None or args.stop_time is not None:
+        import tomllib
 
-            data = tomllib.loads(path.read_text())
-            simulation = data.setdefault("simulation", {})
-            if args.algorithm:
-                simulation["algorithm"] = args.algorithm
-            if args.step is not None:
-                simulation["step"] = args.step
-            if args.stop_time is not None:
-                simulation["stop_time"] = args.stop_time
-            system = system_from_dict(data, name=f"{path} (with command-line overrides)",
-                                      base=fmu_dir or path.parent, path=path)
+        data = tomllib.loads(path.read_text())
+        simulation = data.setdefault("simulation", {})
+        for key, value in (("algorithm", args.algorithm), ("step", args.step), ("stop_time", args.stop_time)):
+            if value is not None:
+                simulation[key] = value
+        system = system_from_dict(data, name=f"{path} (with command-line overrides)",
+                                  base=fmu_dir or path.parent, path=path)
+    return system, path
+
+
+def _run(args: argparse.Namespace) -> int:
+    from rover_cosim.orchestrator.master import RunError, run
+    from rover_cosim.orchestrator.runs import sidecar_path, write_partial, write_run
+    from rover_cosim.orchestrator.system import SystemFileError
+    from rover_cosim.progress import ProgressBar
+
+    try:
+        system, path = _load_run_system(args)
     except SystemFileError as error:
         print(f"rover-cosim run: {error}", file=sys.stderr)
         return 2
     output = args.output or Path("results") / f"{path.stem}.csv"
+    try:
+        sidecar_path(output)
+    except ValueError as error:
+        print(f"rover-cosim run: {error}", file=sys.stderr)
+        return 2
     bar = ProgressBar(path.stem, enabled=not args.quiet)
     try:
         result = run(system, progress=bar)
     except RunError as error:
         bar.close()
-        print(f"rover-cosim run: {error} (nothing written)", file=sys.stderr)
+        kept = ""
+        if error.partial is not None and len(error.partial) > 1:
+            partial = write_partial(system, error.partial, output, str(error))
+            kept = f"; the {len(error.partial)} rows computed before it are in {partial[0]} (partial)"
+        print(f"rover-cosim run: {error} ({output} not written{kept})", file=sys.stderr)
         return 1
     bar.close()
     for written in write_run(system, result, output):
@@ -280,9 +296,24 @@ COMMANDS = {"build-fmus": _build_fmus, "run": _run, "cosim-study": _cosim_study,
             "simulate": _simulate, "report": _report, "fig3": _fig3}
 
 
+def _terminate(signum: int, frame: object) -> None:
+    """SIGTERM ends the command like Ctrl-C: the context managers close the FMUs and remove
+    their temporary folder on the way out."""
+    raise KeyboardInterrupt
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return COMMANDS[args.command](args)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+    try:
+        return COMMANDS[args.command](args)
+    except KeyboardInterrupt:
+        print(f"rover-cosim {args.command}: interrupted; nothing more written", file=sys.stderr)
+        return 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

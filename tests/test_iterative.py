@@ -98,9 +98,9 @@ def test_fmu_interpolates_inputs_over_a_step(fmus):
     assert fmu.getReal(forces[:1]) == [pytest.approx(20.0)]
     fmu.doStep(0.1, 0.1)   # no derivatives set again: held at 20 N
     assert fmu.getReal([refs["v"]])[0] - v == pytest.approx(6 * 20.0 * 0.1 / 1570.0, rel=1e-6)
-    with pytest.raises(Exception):
+    with pytest.raises(fmpy.fmi1.FMICallException):
         fmu.setRealInputDerivatives(forces[:1], [2], [1.0])   # only first derivatives
-    with pytest.raises(Exception):
+    with pytest.raises(fmpy.fmi1.FMICallException):
         fmu.setRealInputDerivatives([refs["v"]], [1], [1.0])  # not an input
     fmu.terminate()
     fmu.freeInstance()

@@ -152,6 +152,12 @@ BAD_SYSTEMS = {
     "unknown block key": (lambda d: d["block"][0].update(slope=20.0),
                           "unknown key(s) ['slope']; it accepts begin, end, time, width, unit"),
     "missing block key": (lambda d: d["block"][0].pop("width"), "missing key(s) ['width']"),
+    "misspelt table": (lambda d: d.update(recrd={"variables": ["body.v"]}), "unknown table(s) ['recrd']"),
+    "unknown record key": (lambda d: d.update(record={"variable": ["body.v"]}),
+                           "unknown key(s) ['variable']; expected ['variables']"),
+    "unknown connection key": (lambda d: set_connection(d, 0, gain="2"), "unknown key(s) ['gain']"),
+    "unknown fmu key": (lambda d: d["fmu"][0].update(parameter={"rover.M": 1.0}), "unknown key(s) ['parameter']"),
+    "unknown simulation key": (lambda d: d["simulation"].update(stoptime=2.0), "unknown key(s) ['stoptime']"),
 }
 
 

@@ -33,13 +33,18 @@ class LongitudinalInverse:
     exactly for the held step ``step`` [s]."""
 
     def __init__(self, model: IdentifiedModel, wheels: int, wn: float, step: float, name: str = "controller"):
-        self.model, self.name = model, name
-        # Eq. (17) as x' = A x + B u, x = (slip_f, slip_f'), discretised exactly for a held input.
+        self.model, self.name, self.wn, self.step = model, name, wn, step
+        self.ad, self.bd = self.discretised(step)
+        self.filter_state = np.zeros((wheels, 2))
+
+    def discretised(self, step: float) -> tuple[np.ndarray, np.ndarray]:
+        """Eq. (17) as x' = A x + B u, x = (slip_f, slip_f'), discretised exactly for an input
+        held over ``step`` [s]."""
+        wn = self.wn
         a = np.array([[0.0, 1.0], [-wn**2, -2.0 * wn]])
         b = np.array([0.0, wn**2])
-        self.ad = expm(a * step)
-        self.bd = np.linalg.solve(a, (self.ad - np.eye(2)) @ b)
-        self.filter_state = np.zeros((wheels, 2))
+        ad = expm(a * step)
+        return ad, np.linalg.solve(a, (ad - np.eye(2)) @ b)
 
     def slips_for_forces(self, loads: np.ndarray, forces: np.ndarray) -> np.ndarray:
         """The slip at which the Fx(W, slip) block gives each force (for the quadratic model, the
@@ -74,12 +79,14 @@ class LongitudinalInverse:
             time_constants[i] = np.interp(torque, torques, constants[i])
         return result, time_constants
 
-    def torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool) -> np.ndarray:
+    def torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
         """The torques for ``forces`` at ``loads``; ``advance`` moves the filter one step on (else
-        it starts settled at the targets)."""
+        it starts settled at the targets); ``step`` [s]: a step other than the one it was made for
+        (the shorter last step of a run)."""
         targets = self.slips_for_forces(loads, forces)
         if advance:
-            self.filter_state = self.filter_state @ self.ad.T + np.outer(targets, self.bd)
+            ad, bd = (self.ad, self.bd) if step is None or abs(step - self.step) <= 1e-12 else self.discretised(step)
+            self.filter_state = self.filter_state @ ad.T + np.outer(targets, bd)
         else:
             self.filter_state = np.column_stack([targets, np.zeros(len(targets))])
         slip, rate = self.filter_state[:, 0], self.filter_state[:, 1]

@@ -144,7 +144,7 @@ class PathFollowingController:
         return delta, share, np.zeros(WHEELS)
 
     # --- the block interface ----------------------------------------------------------------------
-    def _outputs(self, t: float, u: np.ndarray, advance: bool) -> np.ndarray:
+    def _outputs(self, t: float, u: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
         loads = np.clip(np.asarray(u[6:6 + WHEELS], float), 1.0, None)
         slip_angles = np.asarray(u[6 + WHEELS:6 + 2 * WHEELS], float)
         demand, along, signals, (curvature, offset) = self._tracking(t, u)
@@ -155,7 +155,7 @@ class PathFollowingController:
             fx, fy = allocate(demand, self.matrix, loads)
             steer, fx_des, fy_des = self._inverse_steering(loads, slip_angles + self.steer, fx, fy)
         self.steer = steer
-        torque = self.inverse.torques(loads, fx_des, advance)
+        torque = self.inverse.torques(loads, fx_des, advance, step)
         return np.concatenate([torque, steer, fx_des, fy_des,
                                [signals["s"], signals["s_ref"], signals["cross_track"], signals["heading_error"]]])
 
@@ -170,7 +170,7 @@ class PathFollowingController:
         self.inverse.filter_state, self.steer, self.hint = state[0].copy(), state[1].copy(), state[2]
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
-        if abs(h - self.step_size) > 1e-12:
-            raise ValueError(f"block {self.name!r}: communication step {h!r} s differs from its step = "
-                             f"{self.step_size!r} s (the filter is discretised for it)")
-        return self._outputs(t + h, u, advance=True)
+        if not 0 < h <= self.step_size * (1 + 1e-9):
+            raise ValueError(f"block {self.name!r}: communication step {h!r} s: expected at most its step = "
+                             f"{self.step_size!r} s (a shorter last step is fine)")
+        return self._outputs(t + h, u, advance=True, step=h)

@@ -3,6 +3,11 @@ path with the identified longitudinal and lateral wheel models, on SteerableRove
 co-simulated SteerableRoverBody + 6 Wheel (wired by the shipped steerable_rover_cosim.toml),
 and the same paths with kinematic steering (the ablation).
 
+The controller's steering reaches the wheels' slip angles, which it reads, within the same
+instant (SteerableRover's slipAngle depends directly on steer): an algebraic loop, broken as in
+the paper's loop by the controller coming first in the Gauss-Seidel order (it sees the slip
+angles of the step before; ``allow_algebraic_loops``).
+
 Scenarios: ``turn`` (10 m straight, 90 deg left turn of radius 10 m, 10 m straight, 0.5 m/s);
 ``lane_change`` (10 m straight, 3 m to the left over 15 m, 10 m straight, 1.0 m/s). Each starts
 rolling at its speed (wheels at omega = v/r) and ends when the reference reaches the path's end.
@@ -82,7 +87,8 @@ def monolithic_system(fmu_dir: Path, model: Path, scenario: str, steering: str =
     for i in WHEELS:
         connections += [{"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"},
                         {"from": f"ctrl.steer[{i}]", "to": f"rover.steer[{i}]"}]
-    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel"},
+    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel",
+                           "allow_algebraic_loops": True},
             "fmu": [{"name": "rover", "path": str(fmu_dir / "SteerableRover.fmu"), "start": start}],
             "block": [controller_block(model, scenario, steering)], "connection": connections}
 
@@ -104,7 +110,8 @@ def cosim_system(fmu_dir: Path, model: Path, scenario: str) -> dict[str, Any]:
                         {"from": f"ctrl.tau[{i}]", "to": f"body.tau[{i}]"},
                         {"from": f"ctrl.steer[{i}]", "to": f"body.steer[{i}]"}]
     order = ["ctrl", "body", *[f"wheel{i}" for i in WHEELS]]
-    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel", "order": order},
+    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel", "order": order,
+                           "allow_algebraic_loops": True},
             "fmu": fmus, "block": [controller_block(model, scenario, "inverse")], "connection": connections}
 
 

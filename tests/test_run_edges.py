@@ -1,0 +1,141 @@
+"""Runs that must not lose or hide anything: stop times between steps, output paths, non-finite
+values, partial results, algebraic loops, the temporary folder of unpacked FMUs, SIGINT/SIGTERM."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rover_cosim.cli import EXAMPLES, main
+from rover_cosim.orchestrator.master import UNZIP_PREFIX, RunError, remove_stale_folders, run
+from rover_cosim.orchestrator.recorder import communication_points
+from rover_cosim.orchestrator.system import SystemFileError, system_from_dict
+
+
+def example(name: str, **simulation: object) -> dict:
+    data = tomllib.loads(EXAMPLES[name].read_text())
+    data["simulation"].update(simulation)
+    return data
+
+
+class Scale:
+    """y = k u (+ offset), no units; ``feedthrough`` as given."""
+
+    def __init__(self, name: str, k: float, offset: float = 0.0, feedthrough: bool = True, nan_after: float = -1.0):
+        self.name, self.k, self.offset, self.nan_after = name, k, offset, nan_after
+        self.inputs, self.outputs, self.units = ("u",), ("y",), {}
+        self.feedthrough = feedthrough
+
+    def start(self, t0, u0):
+        return self.k * u0 + self.offset
+
+    def step(self, t, h, u):
+        if 0 <= self.nan_after <= t + h:
+            return np.array([np.nan])
+        return self.k * u + self.offset
+
+
+def ring(k1: float, k2: float, **simulation: object) -> dict:
+    """Two Scale blocks in a ring (a -> b -> a) beside the single-wheel test bed."""
+    data = example("single_wheel_step", stop_time=0.05, **simulation)
+    data["block"].append({"name": "a", "type": "python", "factory": "test_run_edges:Scale", "k": k1, "offset": 1.0})
+    data["block"].append({"name": "b", "type": "python", "factory": "test_run_edges:Scale", "k": k2})
+    data["connection"] += [{"from": "a.y", "to": "b.u"}, {"from": "b.y", "to": "a.u"}]
+    data["record"] = {"variables": ["a.y", "b.y", "testbed.v"]}
+    return data
+
+
+def test_stop_time_between_steps_ends_with_one_shorter_step(fmu_dir, fmus):
+    np.testing.assert_allclose(communication_points(0.0, 0.2, 0.06), [0.0, 0.06, 0.12, 0.18, 0.2])
+    long = communication_points(0.0, 200.0, 0.003)
+    assert long[-1] == 200.0 and len(long) == 66668 and long[-2] == pytest.approx(199.998)
+    np.testing.assert_allclose(communication_points(0.0, 1.0, 0.1), np.linspace(0, 1, 11))
+    result = run(system_from_dict(example("single_wheel_step", step=0.06, stop_time=0.2), name="t.toml",
+                                  base=fmu_dir))
+    np.testing.assert_allclose(result.data["time"], [0.0, 0.06, 0.12, 0.18, 0.2])
+
+
+def test_output_that_would_be_its_own_sidecar_is_refused(fmu_dir, fmus, tmp_path, capsys):
+    target = tmp_path / "x.json"
+    code = main(["run", "single_wheel_step", "--fmu-dir", str(fmu_dir), "-o", str(target), "--quiet"])
+    assert code == 2 and "expected a .csv file" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_non_finite_value_names_participant_signal_and_time_and_keeps_the_rows(fmu_dir, fmus, tmp_path, capsys):
+    """A block that turns NaN at 0.2 s (only recorded, nothing reads it): the run stops there with
+    the block, the signal and the time named, and keeps the rows before it in a partial file."""
+    text = EXAMPLES["single_wheel_step"].read_text().replace('stop_time = 2.0', 'stop_time = 0.3')
+    text = text.replace('path = "SingleWheel.fmu"', f'path = "{fmu_dir / "SingleWheel.fmu"}"')
+    text += ('\n[[block]]\nname = "probe"\ntype = "python"\nfactory = "test_run_edges:Scale"\nk = 1.0\n'
+             'nan_after = 0.2\n\n[[connection]]\nfrom = "testbed.v"\nto = "probe.u"\n\n'
+             '[record]\nvariables = ["probe.y", "testbed.v"]\n')
+    system_file = tmp_path / "nan.toml"
+    system_file.write_text(text)
+    out = tmp_path / "out" / "nan.csv"
+    code = main(["run", str(system_file), "-o", str(out), "--quiet"])
+    message = capsys.readouterr().err
+    assert code == 1 and "probe: output y = nan at t = 0.2 s" in message and "partial" in message, message
+    assert not out.exists()
+    partial = out.with_name("nan.partial.csv")
+    rows = np.loadtxt(partial, delimiter=",", skiprows=1)
+    assert rows[-1, 0] == pytest.approx(0.199) and np.all(np.isfinite(rows))
+    assert '"partial": true' in partial.with_suffix(".json").read_text()
+
+
+def test_algebraic_loop_is_named_and_refused_by_the_explicit_masters(fmu_dir, fmus):
+    with pytest.raises(SystemFileError, match=r"algebraic loop .*a\.(u|y) -> .*b\.(u|y)"):
+        system_from_dict(ring(0.5, 1.0), name="ring.toml", base=fmu_dir)
+    no_feedthrough = ring(0.5, 1.0)
+    no_feedthrough["block"][-1]["feedthrough"] = False
+    assert system_from_dict(no_feedthrough, name="ring.toml", base=fmu_dir).algebraic_loop is None
+
+
+def test_allowed_loop_runs_with_a_delay_and_the_iterative_master_solves_it(fmu_dir, fmus):
+    delayed = run(system_from_dict(ring(0.5, 1.0, allow_algebraic_loops=True), name="r", base=fmu_dir)).data
+    solved = run(system_from_dict(ring(0.5, 1.0, algorithm="iterative", tolerance=1e-10, max_iterations=60), name="r",
+                                  base=fmu_dir)).data
+    # The fixed point of y = 0.5 y + 1 is 2; the iterative master meets it at every point.
+    np.testing.assert_allclose(solved["a.y"].iloc[1:], 2.0, rtol=1e-8)
+    assert delayed["a.y"].iloc[1] != pytest.approx(2.0)
+    with pytest.raises(RunError, match=r"did not converge .*still moving: .*(a\.y|b\.y)"):
+        run(system_from_dict(ring(2.0, 1.0, algorithm="iterative"), name="r", base=fmu_dir))
+
+
+def test_stale_unpack_folders_of_dead_runs_are_removed(tmp_path):
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    folder = Path(tempfile.gettempdir()) / f"{UNZIP_PREFIX}{int(dead.stdout)}-stale"
+    (folder / "body").mkdir(parents=True)
+    mine = Path(tempfile.gettempdir()) / f"{UNZIP_PREFIX}{os.getpid()}-mine"
+    mine.mkdir()
+    try:
+        assert folder in remove_stale_folders() and not folder.exists() and mine.exists()
+    finally:
+        mine.rmdir()
+
+
+@pytest.mark.parametrize("sent", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_ends_a_run_with_one_line_and_no_leftovers(fmu_dir, fmus, tmp_path, sent):
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
+    process = subprocess.Popen([sys.executable, "-P", "-m", "rover_cosim", "run", "rover_cosim", "--fmu-dir",
+                                str(fmu_dir), "--stop-time", "600", "-o", str(tmp_path / "out.csv"), "--quiet"],
+                               stderr=subprocess.PIPE, text=True, env=env)
+    deadline = time.time() + 60
+    while not list(tmp_path.glob(f"{UNZIP_PREFIX}*/wheel6")) and time.time() < deadline:
+        time.sleep(0.1)
+    assert list(tmp_path.glob(f"{UNZIP_PREFIX}*")), "the run never unpacked its FMUs"
+    time.sleep(0.5)
+    process.send_signal(sent)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and err.strip().endswith("interrupted; nothing more written"), err
+    assert not list(tmp_path.glob(f"{UNZIP_PREFIX}*")) and not (tmp_path / "out.csv").exists()
