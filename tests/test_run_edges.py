@@ -32,7 +32,8 @@ class Scale:
 
     def __init__(self, name: str, k: float, offset: float = 0.0, feedthrough: bool = True, nan_after: float = -1.0):
         self.name, self.k, self.offset, self.nan_after = name, k, offset, nan_after
-        self.inputs, self.outputs, self.units = ("u",), ("y",), {}
+        self.inputs, self.outputs = ("u",), ("y",)
+        self.units: dict[str, str] = {}
         self.feedthrough = feedthrough
 
     def start(self, t0, u0):
