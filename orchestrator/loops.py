@@ -1,4 +1,5 @@
-"""Algebraic loops: cycles of direct feedthrough through the connections of a system.
+"""Algebraic loops: cycles of direct feedthrough through the connections of a system (the graph
+is built by ``system.dependency_graph``; this module only searches it).
 
 A port depends on another when a connection joins them (source output -> target input) or when
 a participant's output depends directly on one of its inputs: for an FMU as its ModelStructure
@@ -11,45 +12,21 @@ Gauss-Seidel) breaks it with a delay of one step, the iterative master solves it
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Hashable, Sequence
+from typing import TypeVar
 
-from .system import BlockEntry, Connection, FmuEntry, Port
-
-
-def dependency_graph(fmus: Iterable[FmuEntry], blocks: Iterable[BlockEntry],
-                     connections: Iterable[Connection]) -> dict[Port, list[Port]]:
-    """port -> the ports that depend on it directly."""
-    graph: dict[Port, list[Port]] = {}
-
-    def edge(a: Port, b: Port) -> None:
-        graph.setdefault(a, []).append(b)
-
-    for connection in connections:
-        edge(connection.source, connection.target)
-    for fmu in fmus:
-        inputs = [v.name for v in fmu.description.modelVariables if v.causality == "input"]
-        for unknown in fmu.description.outputs:
-            sources = inputs if unknown.dependencies is None else [d.name for d in unknown.dependencies
-                                                                   if d.causality == "input"]
-            for name in sources:
-                edge(Port(fmu.name, name), Port(fmu.name, unknown.variable.name))
-    for entry in blocks:
-        block = entry.block
-        if getattr(block, "feedthrough", bool(block.inputs)):
-            for name in block.inputs:
-                for output in block.outputs:
-                    edge(Port(entry.name, name), Port(entry.name, output))
-    return graph
+Node = TypeVar("Node", bound=Hashable)
 
 
-def find_loop(graph: dict[Port, list[Port]]) -> list[Port] | None:
-    """One cycle of ``graph`` (its ports in order, the first repeated at the end), or None."""
-    state: dict[Port, int] = {}  # 1: on the current path, 2: done
+def find_loop(graph: dict[Node, list[Node]]) -> list[Node] | None:
+    """One cycle of ``graph`` (node -> the nodes that depend on it), its nodes in order with the
+    first repeated at the end, or None."""
+    state: dict[Node, int] = {}  # 1: on the current path, 2: done
     for root in list(graph):
         if state.get(root):
             continue
-        path: list[Port] = []
-        stack: list[tuple[Port, int]] = [(root, 0)]
+        path: list[Node] = []
+        stack: list[tuple[Node, int]] = [(root, 0)]
         while stack:
             node, index = stack.pop()
             if index == 0:
@@ -69,5 +46,5 @@ def find_loop(graph: dict[Port, list[Port]]) -> list[Port] | None:
     return None
 
 
-def describe(loop: list[Port]) -> str:
-    return " -> ".join(str(port) for port in loop)
+def describe(loop: Sequence[object]) -> str:
+    return " -> ".join(str(node) for node in loop)

@@ -48,6 +48,7 @@ import fmpy
 from rover_cosim.common.units import base_units
 
 from .blocks import Block, make_block
+from .loops import describe, find_loop
 
 ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
 #: Instance names: identifiers, so that a name is never a path or a port separator.
@@ -96,6 +97,7 @@ class BlockEntry:
     name: str
     kind: str
     block: Block
+    keys: dict[str, Any] = field(default_factory=dict)  # the entry's own keys, as in the system file
 
 
 @dataclass(frozen=True)
@@ -235,13 +237,34 @@ def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path 
                   loop)
 
 
+def dependency_graph(fmus: list[FmuEntry], blocks: list[BlockEntry],
+                     connections: list[Connection]) -> dict[Port, list[Port]]:
+    """port -> the ports that depend on it directly: connections, and each participant's outputs
+    on its inputs (FMUs: ModelStructure, an output without a dependency list on every input;
+    blocks: their ``feedthrough``, True by default for a block with inputs)."""
+    graph: dict[Port, list[Port]] = {}
+    for connection in connections:
+        graph.setdefault(connection.source, []).append(connection.target)
+    for fmu in fmus:
+        inputs = [v.name for v in fmu.description.modelVariables if v.causality == "input"]
+        for unknown in fmu.description.outputs:
+            sources = inputs if unknown.dependencies is None else [d.name for d in unknown.dependencies
+                                                                   if d.causality == "input"]
+            for name in sources:
+                graph.setdefault(Port(fmu.name, name), []).append(Port(fmu.name, unknown.variable.name))
+    for entry in blocks:
+        block = entry.block
+        if getattr(block, "feedthrough", bool(block.inputs)):
+            for name in block.inputs:
+                graph.setdefault(Port(entry.name, name), []).extend(Port(entry.name, o) for o in block.outputs)
+    return graph
+
+
 def check_loops(fmus: list[FmuEntry], blocks: list[BlockEntry], connections: list[Connection],
                 simulation: dict[str, Any], algorithm: str, context: _Context) -> list[Port] | None:
     """A cycle of direct feedthrough is an error for Jacobi and Gauss-Seidel unless
     ``allow_algebraic_loops = true`` (then the order breaks it with a one-step delay); the
     iterative master solves it."""
-    from .loops import dependency_graph, describe, find_loop
-
     allow = simulation.get("allow_algebraic_loops", False)
     if not isinstance(allow, bool):
         raise context.error("[simulation] allow_algebraic_loops", f"{allow!r}: expected true or false")
@@ -356,7 +379,7 @@ def parse_block(entry: dict[str, Any], number: int, context: _Context) -> BlockE
         block = make_block(instance, kind, params)
     except ValueError as failure:
         raise context.error(f"[[block]] {instance!r}", str(failure)) from None
-    return BlockEntry(instance, kind, block)
+    return BlockEntry(instance, kind, block, params)
 
 
 class _PortTable:

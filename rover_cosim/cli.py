@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import signal
 import sys
+import tempfile
 import threading
 from collections.abc import Sequence
 from pathlib import Path
@@ -48,21 +49,28 @@ def build_parser() -> argparse.ArgumentParser:
                       help="comma-separated wheel loads [N] (default: 100,200,...,800)")
     fig3.add_argument("--slip-step", type=_slip_step, default=0.01,
                       help="slip spacing over 0..0.9, adjusted so that 0.9 is a point (default: 0.01)")
-    run = commands.add_parser("run", help="co-simulate a system file (TOML) with FMPy -> CSV + JSON sidecar")
-    run.add_argument("system", help="system file, or the name of a shipped example: "
+    run = commands.add_parser("run", help="co-simulate a system file (TOML or SSP) -> CSV + JSON sidecar")
+    run.add_argument("system", help="system file (.toml, or an .ssp archive), or the name of a shipped example: "
                      + ", ".join(EXAMPLES))
     run.add_argument("-o", "--output", type=Path, default=None,
                      help="CSV to write (default: results/<system name>.csv); a .json sidecar goes beside it")
     run.add_argument("--fmu-dir", type=Path, default=None,
                      help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
-    run.add_argument("--algorithm", choices=("jacobi", "gauss-seidel"), default=None,
+    run.add_argument("--algorithm", choices=("jacobi", "gauss-seidel", "iterative"), default=None,
                      help="override the system file's master algorithm")
     run.add_argument("--step", type=float, default=None, help="override the communication step [s]")
     run.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
+    ssp = commands.add_parser("export-ssp", help="write a system file (TOML) as an SSP 1.0 archive (.ssp) that "
+                              "FMPy, libcosim and OMSimulator read")
+    ssp.add_argument("system", help="system file, or the name of a shipped example: " + ", ".join(EXAMPLES))
+    ssp.add_argument("-o", "--output", type=Path, required=True, help="the .ssp archive to write")
+    ssp.add_argument("--fmu-dir", type=Path, default=None,
+                     help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
+
     study = commands.add_parser("cosim-study", help="coupling error of the co-simulated rover against the "
-                                "monolithic one, Jacobi and Gauss-Seidel, steps 1-10 ms -> CSV + PNG")
+                                "monolithic one, Jacobi, Gauss-Seidel and iterative, steps 1-10 ms -> CSV + PNG")
     study.add_argument("--out", type=Path, default=Path("results/cosim_study"), help="output folder")
     study.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
 
@@ -99,40 +107,82 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _load_run_system(args: argparse.Namespace):  # noqa: ANN202 - System, imported lazily
-    """The system of ``rover-cosim run`` with the command line's overrides (SystemFileError if bad)."""
-    from rover_cosim.orchestrator.system import load_system, system_from_dict
-
-    path = Path(args.system)
-    fmu_dir = args.fmu_dir
+def _system_path(args: argparse.Namespace) -> tuple[Path, Path | None]:
+    """The system file and FMU folder of ``args`` (a shipped example by name, unless a file of
+    that name exists)."""
+    path, fmu_dir = Path(args.system), args.fmu_dir
     if not path.is_file() and args.system in EXAMPLES:
-        path = EXAMPLES[args.system]
-        fmu_dir = fmu_dir or Path("fmus")
+        path, fmu_dir = EXAMPLES[args.system], fmu_dir or Path("fmus")
+    return path, fmu_dir
+
+
+def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - System, imported lazily
+    """The system of ``rover-cosim run`` with the command line's overrides (SystemFileError if
+    bad); an .ssp archive is unpacked into ``unpack``."""
+    import dataclasses
+
+    from rover_cosim.orchestrator.ssp import SspError, load_ssp
+    from rover_cosim.orchestrator.system import SystemFileError, load_system, system_from_dict
+
+    path, fmu_dir = _system_path(args)
+    overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
+                                               ("stop_time", args.stop_time)) if value is not None}
+    if path.suffix.lower() == ".ssp":
+        try:
+            system = load_ssp(path, unpack)
+        except SspError as error:
+            raise SystemFileError(str(error)) from None
+        if overrides.get("algorithm", "iterative") != "iterative" and system.algebraic_loop is not None:
+            raise SystemFileError(f"{path}: --algorithm {overrides['algorithm']}: the system has an algebraic loop")
+        return dataclasses.replace(system, **overrides), path
     system = load_system(path, fmu_dir=fmu_dir)
-    if args.algorithm or args.step is not None or args.stop_time is not None:
+    if overrides:
         import tomllib
 
         data = tomllib.loads(path.read_text())
-        simulation = data.setdefault("simulation", {})
-        for key, value in (("algorithm", args.algorithm), ("step", args.step), ("stop_time", args.stop_time)):
-            if value is not None:
-                simulation[key] = value
+        data.setdefault("simulation", {}).update(overrides)
         system = system_from_dict(data, name=f"{path} (with command-line overrides)",
                                   base=fmu_dir or path.parent, path=path)
     return system, path
 
 
+def _export_ssp(args: argparse.Namespace) -> int:
+    from rover_cosim.orchestrator.ssp import SspError, export_ssp, validate_ssd
+    from rover_cosim.orchestrator.system import SystemFileError, load_system
+
+    path, fmu_dir = _system_path(args)
+    try:
+        exported = export_ssp(load_system(path, fmu_dir=fmu_dir), args.output)
+        validate_ssd(exported.path)
+    except (SystemFileError, SspError) as error:
+        print(f"rover-cosim export-ssp: {error}", file=sys.stderr)
+        return 2
+    print(f"wrote {exported.path} (SystemStructure.ssd valid against the SSP 1.0 schema)")
+    if exported.folded:
+        print(f"constant blocks {', '.join(exported.folded)}: folded into the start values of the inputs they drive")
+    if exported.external:
+        print(f"blocks {', '.join(exported.external)}: Python, kept in an org.rover-cosim annotation (rover-cosim "
+              "run restores them); other tools see their signals as the system's connectors <block>_<signal>")
+    return 0
+
+
 def _run(args: argparse.Namespace) -> int:
+    from rover_cosim.orchestrator.system import SystemFileError
+
+    with tempfile.TemporaryDirectory(prefix="rover-cosim-ssp-") as unpack:
+        try:
+            system, path = _load_run_system(args, Path(unpack))
+        except SystemFileError as error:
+            print(f"rover-cosim run: {error}", file=sys.stderr)
+            return 2
+        return _run_system(args, system, path)
+
+
+def _run_system(args: argparse.Namespace, system, path: Path) -> int:  # noqa: ANN001 - System, imported lazily
     from rover_cosim.orchestrator.master import RunError, run
     from rover_cosim.orchestrator.runs import sidecar_path, write_partial, write_run
-    from rover_cosim.orchestrator.system import SystemFileError
     from rover_cosim.progress import ProgressBar
 
-    try:
-        system, path = _load_run_system(args)
-    except SystemFileError as error:
-        print(f"rover-cosim run: {error}", file=sys.stderr)
-        return 2
     output = args.output or Path("results") / f"{path.stem}.csv"
     try:
         sidecar_path(output)
@@ -292,7 +342,8 @@ def _fig3(args: argparse.Namespace) -> int:
     return 0
 
 
-COMMANDS = {"build-fmus": _build_fmus, "run": _run, "cosim-study": _cosim_study, "identify": _identify,
+COMMANDS = {"build-fmus": _build_fmus, "run": _run, "export-ssp": _export_ssp, "cosim-study": _cosim_study,
+            "identify": _identify,
             "simulate": _simulate, "report": _report, "fig3": _fig3}
 
 

@@ -205,7 +205,7 @@ def test_a_failing_run_names_the_instance_and_writes_nothing(fmu_dir, fmus, tmp_
     out = tmp_path / "failing.csv"
     assert main(["run", str(path), "-o", str(out), "--quiet"]) == 1
     err = capsys.readouterr().err
-    assert "testbed (SingleWheel.fmu): fmi2DoStep at t = 0 s failed" in err and "nothing written" in err
+    assert "testbed (SingleWheel.fmu): fmi2DoStep at t = 0 s failed" in err and "failing.csv not written" in err
     assert list(tmp_path.iterdir()) == [path]
     with pytest.raises(RunError):
         run(load_system(path))
