@@ -17,7 +17,7 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pandas as pd
-from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
 
 #: What every run records besides time and torque (SingleWheel outputs, SI units).
 RECORDED = ("slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v", "Fy", "beta")
@@ -63,8 +63,19 @@ class WheelTestBed:
             raise ValueError(f"{self.path}: not a SingleWheel FMU (no variables {missing})")
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self._folder.name,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName="testbed")
-        self.fmu.instantiate()
+        # Own callbacks (FMPy's default ones log through a proxy that may point at the logger of
+        # an earlier simulate_fmu call that no longer exists); errors are kept for the messages.
+        self.messages: list[str] = []
+        self._callbacks = fmi2CallbackFunctions()
+        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
+        self._callbacks.freeMemory = defaultCallbacks.freeMemory
+        self.fmu.instantiate(callbacks=self._callbacks)
         self._fresh = True
+
+    def _log(self, env, instance, status, category, message) -> None:  # noqa: ANN001 - ctypes callback
+        if status >= 2:  # discard, error, fatal
+            self.messages.append(message.decode(errors="replace"))
 
     def run(self, load: float, torque: TorqueProfile, stop_time: float, sample_time: float,
             tolerance: float = 1e-8, *, start_speed: float = 0.0, slip_angle: float = 0.0,
