@@ -15,6 +15,11 @@ RESULTS ?= results
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
 BACKEND ?= auto
+# Soil and wheel of fig3, identify and simulate: names of the shipped library
+# (`rover-cosim soils`) or TOML files; e.g. `make run SOIL=lunar_nominal WHEEL=mer`.
+SOIL ?= paper
+WHEEL ?= paper
+SOIL_OPTIONS := --soil $(SOIL) --wheel $(WHEEL)
 FMU_NAMES := SingleWheel Rover RoverBody Wheel SteerableRover SteerableRoverBody
 
 # The virtualenv is (re)installed when pyproject.toml changes; the stamp records success.
@@ -33,7 +38,7 @@ run: fmus fig3 identify simulate
 
 ## fig3: Fx against slip for loads 100..800 N -> results/fig3_fx_vs_slip.{csv,png}
 fig3: $(STAMP)
-	$(VENV)/bin/rover-cosim fig3 --out $(RESULTS)
+	$(VENV)/bin/rover-cosim fig3 --out $(RESULTS) $(SOIL_OPTIONS)
 
 ## fmus: FMI 2.0 FMUs (ME + CS) of the Modelica models -> fmus/*.fmu (skipped when up to date)
 fmus: $(STAMP)
@@ -41,11 +46,11 @@ fmus: $(STAMP)
 
 ## identify: paper Sec. 3 (sweep on SingleWheel.fmu, LUT, Fx fits, Table 1) -> results/identification/
 identify: fmus
-	$(VENV)/bin/rover-cosim identify --out $(RESULTS)/identification --fmu fmus/SingleWheel.fmu
+	$(VENV)/bin/rover-cosim identify --out $(RESULTS)/identification --fmu fmus/SingleWheel.fmu $(SOIL_OPTIONS)
 
 ## simulate: paper Sec. 4, closed loop on Rover.fmu and RoverBody + 6 Wheel -> results/simulation/
 simulate: identify
-	$(VENV)/bin/rover-cosim simulate --out $(RESULTS)/simulation --fmu-dir fmus --model $(RESULTS)/identification/model.json
+	$(VENV)/bin/rover-cosim simulate --out $(RESULTS)/simulation --fmu-dir fmus --model $(RESULTS)/identification/model.json $(SOIL_OPTIONS)
 
 ## report: results/report.html (figures and tables beside the paper's, provenance)
 report: $(STAMP)

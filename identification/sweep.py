@@ -2,9 +2,12 @@
 for every (load, torque, slip angle) of a plan, run on local processes (default: all cores),
 serially (``workers=1``) or on a Dask cluster (``scheduler="tcp://host:port"``).
 
-Each run is cached as one CSV under ``cache_dir/<FMU SHA-256>/<plan digest>/``, written to a
-temporary name and renamed, so an interrupted sweep leaves only complete runs and a re-run
-computes only what is missing. A run that fails is reported with its error; the others go on.
+Each run is cached as one CSV with a checksum under ``cache_dir/<FMU SHA-256>/<plan digest>/``
+(``identification.cache``): a re-run takes only whole files and computes what is missing or
+damaged (with a warning naming the file). A run that fails is reported with its error; the
+others go on. The worker processes end with the sweep: on an error, Ctrl-C or SIGTERM the pool
+is cancelled and its workers terminated, and each worker asks Linux to end it when its parent
+dies (PR_SET_PDEATHSIG), so a killed sweep leaves no workers behind.
 """
 
 from __future__ import annotations
@@ -13,8 +16,8 @@ import hashlib
 import json
 import math
 import os
-import tempfile
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
@@ -27,7 +30,9 @@ from rover_cosim import terramechanics
 from rover_cosim.common.outputs import file_sha256
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.common.paper import TARGET_VELOCITY
+from rover_cosim.terramechanics.library import from_fmu_parameters
 
+from .cache import discard, read_run, remove_partial_files, write_run
 from .testbed import RECORDED, TorqueProfile, shared_test_bed
 
 #: Torque levels [N·m]: 5-80 N·m covers what the rover's wheels get (the open-loop run uses
@@ -55,6 +60,9 @@ class SweepPlan:
     stop_time: float = 0.1      # s; slip and Fx settle within a millisecond on this test bed
     sample_time: float = 1e-4   # s; fixed sample time = communication step
     tolerance: float = 1e-8     # integrator tolerance inside the FMU
+    #: FMU parameters of every run, e.g. a soil and a wheel (terramechanics.library.fmu_parameters),
+    #: as (name, value) pairs; part of the cache key.
+    parameters: tuple[tuple[str, float], ...] = ()
     #: m/s; every run starts rolling at this speed with zero slip (omega = v/r): the regime where
     #: the paper's model applies. From rest a torque below the rolling resistance does not drive
     #: the wheel (it stays in the static regime), which the identified model is not made for.
@@ -75,8 +83,11 @@ class SweepPlan:
                              "expected 0 < sample_time <= stop_time [s]")
 
     def digest(self) -> str:
-        settings = {"stop_time": self.stop_time, "sample_time": self.sample_time, "tolerance": self.tolerance,
-                    "start_speed": self.start_speed, "recorded": list(RECORDED)}
+        settings: dict[str, object] = {"stop_time": self.stop_time, "sample_time": self.sample_time,
+                                       "tolerance": self.tolerance, "start_speed": self.start_speed,
+                                       "recorded": list(RECORDED)}
+        if self.parameters:
+            settings["parameters"] = sorted(self.parameters)
         return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:12]
 
     def cases(self) -> list[Case]:
@@ -92,6 +103,7 @@ class SweepOutcome:
     wall_seconds: float
     cache_folder: Path
     run_seconds: dict[Case, float] = field(default_factory=dict)
+    rejected: dict[Path, str] = field(default_factory=dict)  # cache files not whole, computed again (why)
 
     def at_slip_angle(self, slip_angle_deg: float = 0.0) -> dict[tuple[float, float], pd.DataFrame]:
         """The runs at one slip angle [deg], keyed by (load, torque)."""
@@ -105,7 +117,8 @@ def run_file(folder: Path, load: float, torque: float, slip_angle_deg: float = 0
 
 
 def compute_run(fmu_path: str | None, case: Case, stop_time: float, sample_time: float,
-                tolerance: float, start_speed: float, target: str) -> tuple[Case, str | None, float]:
+                tolerance: float, start_speed: float, target: str,
+                parameters: tuple[tuple[str, float], ...] = ()) -> tuple[Case, str | None, float]:
     """Run one case and write it to ``target`` atomically. Returns (case, error, seconds);
     never raises, so one failing case does not stop the others (runs in worker processes).
     ``fmu_path`` None runs the numpy reference test bed instead of the FMU."""
@@ -117,20 +130,15 @@ def compute_run(fmu_path: str | None, case: Case, stop_time: float, sample_time:
         if fmu_path is None:
             from .reference_plant import StartState, run_reference_test_bed
 
-            start = StartState(v=start_speed, omega=start_speed * math.cos(slip_angle) / terramechanics.Wheel().r)
+            soil, wheel = from_fmu_parameters(dict(parameters))
+            start = StartState(v=start_speed, omega=start_speed * math.cos(slip_angle) / wheel.r)
             data = run_reference_test_bed(case.load, profile, stop_time, sample_time, start=start,
-                                          slip_angle=slip_angle)
+                                          slip_angle=slip_angle, soil=soil, wheel=wheel)
         else:
             data = shared_test_bed(Path(fmu_path)).run(case.load, profile, stop_time, sample_time, tolerance,
-                                                       start_speed=start_speed, slip_angle=slip_angle)
-        target_path = Path(target)
-        handle, temporary = tempfile.mkstemp(prefix=f".{target_path.name}.", suffix=".part", dir=target_path.parent)
-        try:
-            with os.fdopen(handle, "w") as stream:
-                data.to_csv(stream, index=False, float_format="%.12g")
-            os.replace(temporary, target_path)
-        finally:
-            Path(temporary).unlink(missing_ok=True)
+                                                       start_speed=start_speed, slip_angle=slip_angle,
+                                                       parameters=dict(parameters))
+        write_run(Path(target), data)
         return case, None, time.perf_counter() - started
     except Exception as error:  # noqa: BLE001 - reported per run, the sweep goes on
         return case, f"{type(error).__name__}: {error}", time.perf_counter() - started
@@ -146,7 +154,7 @@ def _plant_key(fmu_path: Path | None) -> str:
     return "reference-" + hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:12]
 
 
-Arguments = tuple[str | None, Case, float, float, float, float, str]
+Arguments = tuple[str | None, Case, float, float, float, float, str, tuple[tuple[str, float], ...]]
 Result = tuple[Case, str | None, float]
 
 
@@ -167,9 +175,65 @@ def _results(arguments: list[Arguments], workers: int | None, scheduler: str | N
     if workers == 1 or len(arguments) <= 1:
         yield from (compute_run(*a) for a in arguments)
         return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_end_with_parent)
+    try:
         for future in as_completed([pool.submit(compute_run, *a) for a in arguments]):
             yield future.result()
+    except BaseException:  # Ctrl-C, SIGTERM (raised as KeyboardInterrupt by the CLI), the consumer closing
+        _stop(pool)
+        raise
+    pool.shutdown()
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started and end the workers now."""
+    processes = list(getattr(pool, "_processes", {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join(timeout=5)
+
+
+def _end_with_parent() -> None:
+    """In a worker: ask the kernel for SIGTERM when the parent process dies (Linux only)."""
+    try:
+        import ctypes
+        import signal
+
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        pass
+
+
+def _cached(folder: Path, plan: SweepPlan) -> tuple[dict[Case, pd.DataFrame], dict[Path, str]]:
+    """The plan's runs whose cache files are whole, and the files that are not (removed, why)."""
+    rows = round(plan.stop_time / plan.sample_time) + 1
+    columns = ["time", "tau", *RECORDED]
+    runs: dict[Case, pd.DataFrame] = {}
+    rejected: dict[Path, str] = {}
+    for c in plan.cases():
+        path = run_file(folder, *c)
+        data, problem = read_run(path, rows, columns)
+        if data is not None:
+            runs[c] = data
+        elif problem is not None:
+            rejected[path] = problem
+            warnings.warn(f"sweep cache: {path}: {problem}; computing it again", stacklevel=3)
+            discard(path)
+    return runs, rejected
+
+
+def _read_computed(folder: Path, plan: SweepPlan, cases: list[Case], runs: dict[Case, pd.DataFrame],
+                   failures: dict[Case, str]) -> None:
+    """Read the runs just computed into ``runs`` (a file that is not whole is a failure)."""
+    rows, columns = round(plan.stop_time / plan.sample_time) + 1, ["time", "tau", *RECORDED]
+    for c in cases:
+        data, problem = read_run(run_file(folder, *c), rows, columns)
+        if data is None:
+            failures[c] = f"its file {run_file(folder, *c)} is not whole after writing: {problem}"
+        else:
+            runs[c] = data
 
 
 def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, workers: int | None = None,
@@ -185,15 +249,17 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "plan.json").write_text(json.dumps({**asdict(plan), "plant": str(fmu_path or "numpy reference")},
                                                  indent=2) + "\n")
+    remove_partial_files(folder)
     cases = plan.cases()
-    missing = [c for c in cases if not run_file(folder, *c).exists()]
+    runs, rejected = _cached(folder, plan)
+    missing = [c for c in cases if c not in runs]
     failures: dict[Case, str] = {}
     run_seconds: dict[Case, float] = {}
-    done = len(cases) - len(missing)
+    done = len(runs)
     if progress:
         progress(done / len(cases))
     arguments = [(str(fmu_path) if fmu_path else None, c, plan.stop_time, plan.sample_time, plan.tolerance,
-                  plan.start_speed, str(run_file(folder, *c))) for c in missing]
+                  plan.start_speed, str(run_file(folder, *c)), plan.parameters) for c in missing]
     for case, error, seconds in _results(arguments, workers, scheduler):
         case = Case(*case)
         run_seconds[case] = seconds
@@ -202,6 +268,6 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
         done += 1
         if progress:
             progress(done / len(cases))
-    runs = {c: pd.read_csv(run_file(folder, *c)) for c in cases if c not in failures}
-    return SweepOutcome(runs, failures, len(missing), len(cases) - len(missing), time.perf_counter() - started,
-                        folder, run_seconds)
+    _read_computed(folder, plan, [c for c in missing if c not in failures], runs, failures)
+    return SweepOutcome({c: runs[c] for c in cases if c in runs}, failures, len(missing), len(cases) - len(missing),
+                        time.perf_counter() - started, folder, run_seconds, rejected)

@@ -72,18 +72,43 @@ class WheelTestBed:
         self._callbacks.freeMemory = defaultCallbacks.freeMemory
         self.fmu.instantiate(callbacks=self._callbacks)
         self._fresh = True
+        #: FMU parameters set before every run (e.g. a soil and wheel: terramechanics.library.fmu_parameters)
+        self.parameters: dict[str, float] = {}
 
     def _log(self, env, instance, status, category, message) -> None:  # noqa: ANN001 - ctypes callback
         if status >= 2:  # discard, error, fatal
             self.messages.append(message.decode(errors="replace"))
 
+    def _start(self, load: float, tau: float, turn: float, tolerance: float, start_speed: float, slip_angle: float,
+               parameters: dict[str, float]) -> None:
+        """Reset (after the first run), set up and initialize the FMU for a run."""
+        fmu = self.fmu
+        if not self._fresh:
+            fmu.reset()
+        self._fresh = False
+        fmu.setupExperiment(startTime=0.0)
+        unknown = sorted(set(parameters) - set(self.refs))
+        if unknown:
+            raise ValueError(f"{self.path}: no parameters {unknown}")
+        if parameters:
+            fmu.setReal([self.refs[name] for name in parameters], [float(v) for v in parameters.values()])
+        fmu.setReal([self.refs["W"], self.refs["tau"], self.refs["solver.tolerance"], self.refs["slipAngle"],
+                     self.refs["trackAngle"]], [load, tau, tolerance, slip_angle, turn])
+        if start_speed:
+            radius = float(parameters.get("wheel.r", self.radius))
+            fmu.setReal([self.refs["v"], self.refs["omega"]],
+                        [start_speed, start_speed * math.cos(slip_angle + turn) / radius])
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+
     def run(self, load: float, torque: TorqueProfile, stop_time: float, sample_time: float,
             tolerance: float = 1e-8, *, start_speed: float = 0.0, slip_angle: float = 0.0,
-            track_angle: Staircase | None = None) -> pd.DataFrame:
+            track_angle: Staircase | None = None, parameters: dict[str, float] | None = None) -> pd.DataFrame:
         """Columns time, tau, then :data:`RECORDED`; rows at 0, sample_time, ..., stop_time. The
         carriage starts at ``start_speed`` [m/s] along its track, which runs at ``slip_angle``
         [rad] to the wheel plane, with the wheel rolling without slip (omega = v cos(slip_angle)/r).
-        ``track_angle`` [rad] turns the track during the run (the slip angle is recorded as beta)."""
+        ``track_angle`` [rad] turns the track during the run (the slip angle is recorded as beta).
+        ``parameters``: FMU parameters for this run (default: the bed's ``parameters``)."""
         if not load > 0:
             raise ValueError(f"load = {load!r} N: expected > 0")
         if not abs(slip_angle) < math.pi / 2:
@@ -91,24 +116,15 @@ class WheelTestBed:
         if not 0 < sample_time <= stop_time:
             raise ValueError(f"sample_time = {sample_time!r} s: "
                              f"expected 0 < sample_time <= stop_time = {stop_time!r} s")
-        fmu = self.fmu
-        if not self._fresh:
-            fmu.reset()
-        self._fresh = False
         n = round(stop_time / sample_time)
         times = sample_time * np.arange(n + 1)
         taus = torque(times)
         turns = track_angle(times) if track_angle is not None else np.zeros(n + 1)
         if not np.all(np.abs(slip_angle + turns) < math.pi / 2):
             raise ValueError(f"track_angle = {track_angle!r}: the slip angle must stay in (-pi/2, pi/2) rad")
-        fmu.setupExperiment(startTime=0.0)
-        fmu.setReal([self.refs["W"], self.refs["tau"], self.refs["solver.tolerance"], self.refs["slipAngle"],
-                      self.refs["trackAngle"]], [load, taus[0], tolerance, slip_angle, turns[0]])
-        if start_speed:
-            fmu.setReal([self.refs["v"], self.refs["omega"]],
-                        [start_speed, start_speed * math.cos(slip_angle + turns[0]) / self.radius])
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
+        self._start(load, float(taus[0]), float(turns[0]), tolerance, start_speed, slip_angle,
+                    self.parameters if parameters is None else parameters)
+        fmu = self.fmu
         outputs = [self.refs[name] for name in RECORDED]
         tau_ref, turn_ref = [self.refs["tau"]], [self.refs["trackAngle"]]
         rows = np.empty((n + 1, len(RECORDED)))

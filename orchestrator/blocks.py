@@ -18,7 +18,9 @@ from __future__ import annotations
 import importlib
 import inspect
 import math
+import sys
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
@@ -133,10 +135,11 @@ BLOCK_TYPES: dict[str, type] = {
 }
 
 
-def make_block(name: str, kind: str, params: Mapping[str, Any]) -> Block:
-    """A block from its system-file entry; ValueError naming the block for bad entries."""
+def make_block(name: str, kind: str, params: Mapping[str, Any], folder: Path | None = None) -> Block:
+    """A block from its system-file entry; ValueError naming the block for bad entries. A
+    ``type = "python"`` block's module is looked up in ``folder`` (the system file's) first."""
     if kind == "python":
-        return _python_block(name, params)
+        return _python_block(name, params, folder)
     if kind not in BLOCK_TYPES:
         raise ValueError(f"block {name!r}: type {kind!r}: expected one of {', '.join([*BLOCK_TYPES, 'python'])}")
     _check_keys(name, f"type {kind!r}", BLOCK_TYPES[kind], params)
@@ -146,16 +149,28 @@ def make_block(name: str, kind: str, params: Mapping[str, Any]) -> Block:
         raise ValueError(f"block {name!r} (type {kind}): {error}") from None
 
 
-def _python_block(name: str, params: Mapping[str, Any]) -> Block:
+def _import(module_name: str, folder: Path | None) -> Any:
+    """The module, looked up in ``folder`` first (a module beside the system file), then on sys.path."""
+    if folder is not None and (folder / f"{module_name.split('.')[0]}.py").is_file():
+        sys.path.insert(0, str(folder))
+        try:
+            return importlib.import_module(module_name)
+        finally:
+            sys.path.remove(str(folder))
+    return importlib.import_module(module_name)
+
+
+def _python_block(name: str, params: Mapping[str, Any], folder: Path | None = None) -> Block:
     """A ``type = "python"`` block made by its ``factory = "module:callable"`` with the other keys."""
     factory = params.get("factory")
     if not isinstance(factory, str) or ":" not in factory:
         raise ValueError(f"block {name!r}: type 'python' needs factory = \"module:callable\"")
     module_name, _, attribute = factory.partition(":")
     try:
-        constructor = getattr(importlib.import_module(module_name), attribute)
+        constructor = getattr(_import(module_name, folder), attribute)
     except (ImportError, AttributeError) as error:
-        raise ValueError(f"block {name!r}: cannot load factory {factory!r}: {error}") from None
+        where = f" (looked up beside the system file in {folder} and on sys.path)" if folder else ""
+        raise ValueError(f"block {name!r}: cannot load factory {factory!r}: {error}{where}") from None
     options = {k: v for k, v in params.items() if k != "factory"}
     _check_keys(name, factory, constructor, options)
     try:
@@ -189,3 +204,37 @@ def _check_keys(name: str, what: str, constructor: Any, params: Mapping[str, Any
         problem = f"unknown key(s) {unknown}" if unknown else f"missing key(s) {missing}"
         required = f" (required: {', '.join(needed)})" if needed else ""
         raise ValueError(f"block {name!r} ({what}): {problem}; it accepts {', '.join(names) or 'no keys'}{required}")
+
+
+def describe_blocks() -> str:
+    """A plain-text table of the block types: each key with its default (from the constructors'
+    signatures and docstrings), for ``rover-cosim blocks`` and the README."""
+    lines = []
+    for kind, constructor in BLOCK_TYPES.items():
+        doc = " ".join((constructor.__doc__ or "").split()).replace("``", "")
+        lines.append(f"type = \"{kind}\": {doc}")
+        for parameter in inspect.signature(constructor).parameters.values():
+            if parameter.name == "name":
+                continue
+            default = "required" if parameter.default is inspect.Parameter.empty else f"default {parameter.default!r}"
+            meaning = KEY_MEANINGS.get(f"{kind}.{parameter.name}", KEY_MEANINGS.get(parameter.name, ""))
+            lines.append(f"    {parameter.name:9s} {default:16s} {meaning}")
+    lines.append('type = "python": your own block, factory = "module:callable" (the module is looked up beside '
+                 "the system file first); every other key goes to the callable")
+    return "\n".join(lines)
+
+
+#: What each block key means, with its unit.
+KEY_MEANINGS = {
+    "value": "the constant output [unit of y]",
+    "height": "size of the step or ramp [unit of y]",
+    "time": "when it starts [s]",
+    "offset": "output before it starts [unit of y]",
+    "duration": "how long the ramp takes [s]",
+    "begin": "output long before `time` [unit of y]",
+    "end": "output long after `time` [unit of y]",
+    "width": "time scale of the tanh blend [s]",
+    "values": "output values at the table's times [unit of y] (linear between them, held beyond)",
+    "table.time": "the table's times [s], increasing",
+    "unit": "unit of the output y, checked against what it drives (e.g. \"N.m\")",
+}

@@ -222,7 +222,8 @@ def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path 
     simulation = _table(data.get("simulation"), f"{name}: [simulation]")
     step, stop_time, start_time, algorithm = parse_simulation(simulation, context)
     fmus = [parse_fmu(entry, i, context) for i, entry in enumerate(_tables(data.get("fmu"), f"{name}: [[fmu]]"), 1)]
-    blocks = [parse_block(entry, i, context)
+    folder = path.parent if path is not None else None
+    blocks = [parse_block(entry, i, context, folder)
               for i, entry in enumerate(_tables(data.get("block"), f"{name}: [[block]]"), 1)]
     if not fmus and not blocks:
         raise context.error("[[fmu]]", "the system has no FMU and no block")
@@ -368,15 +369,16 @@ def parse_fmu(entry: dict[str, Any], number: int, context: _Context) -> FmuEntry
     return fmu
 
 
-def parse_block(entry: dict[str, Any], number: int, context: _Context) -> BlockEntry:
-    """One [[block]] entry: name, type and the block's own keys."""
+def parse_block(entry: dict[str, Any], number: int, context: _Context, folder: Path | None = None) -> BlockEntry:
+    """One [[block]] entry: name, type and the block's own keys (a python block's module is
+    looked up in ``folder``, the system file's, first)."""
     instance = context.claim(entry.get("name"), f"[[block]] {number}")
     kind = entry.get("type")
     if not isinstance(kind, str):
         raise context.error(f"[[block]] {instance!r}", f"type = {kind!r}: expected a block type name")
     params = {k: v for k, v in entry.items() if k not in ("name", "type")}
     try:
-        block = make_block(instance, kind, params)
+        block = make_block(instance, kind, params, folder)
     except ValueError as failure:
         raise context.error(f"[[block]] {instance!r}", str(failure)) from None
     return BlockEntry(instance, kind, block, params)

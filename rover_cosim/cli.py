@@ -39,16 +39,51 @@ def _slip_step(text: str) -> float:
     return step
 
 
+def _add_soil_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--soil", default=None, help="soil: a name of the shipped library "
+                        "(rover-cosim soils lists them), a TOML file, or FILE:NAME (default: paper)")
+    parser.add_argument("--wheel", default=None, help="wheel: a name of the shipped library, a TOML file, or "
+                        "FILE:NAME (default: paper)")
+    parser.add_argument("--set", dest="assignments", action="append", default=[], metavar="KIND.NAME=VALUE",
+                        help="change one value, SI units or *_deg for angles: --set soil.c=500 "
+                        "--set soil.phi_deg=30 --set wheel.b=0.2 (repeatable)")
+
+
+def _choice(args: argparse.Namespace, command: str):  # noqa: ANN202 - Choice, imported lazily
+    """The soil and wheel of the command line, or None after printing why not."""
+    from rover_cosim.terramechanics.library import choose
+
+    try:
+        return choose(args.soil, args.wheel, args.assignments)
+    except (ValueError, TypeError) as error:
+        print(f"rover-cosim {command}: {error}", file=sys.stderr)
+        return None
+
+
+class _Help(argparse.RawDescriptionHelpFormatter):
+    """Every option's default in its help, unless the help already states it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if ("default" in text or action.default in (None, argparse.SUPPRESS, False, []) or action.nargs == 0
+                or action.option_strings == []):
+            return text
+        return f"{text} (default: {action.default})"
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rover-cosim", description=__doc__)
+    parser = argparse.ArgumentParser(prog="rover-cosim", description=__doc__, formatter_class=_Help)
     parser.add_argument("--version", action="version", version=f"rover-cosim {__version__}")
     commands = parser.add_subparsers(dest="command", required=True)
+    original = commands.add_parser
+    commands.add_parser = lambda *a, **k: original(*a, formatter_class=_Help, **k)  # type: ignore[method-assign]
     fig3 = commands.add_parser("fig3", help="paper Fig. 3: Fx against slip for loads 100..800 N (numpy reference)")
     fig3.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
     fig3.add_argument("--loads", type=_positive_loads, default=None,
                       help="comma-separated wheel loads [N] (default: 100,200,...,800)")
     fig3.add_argument("--slip-step", type=_slip_step, default=0.01,
                       help="slip spacing over 0..0.9, adjusted so that 0.9 is a point (default: 0.01)")
+    _add_soil_options(fig3)
     run = commands.add_parser("run", help="co-simulate a system file (TOML or SSP) -> CSV + JSON sidecar")
     run.add_argument("system", help="system file (.toml, or an .ssp archive), or the name of a shipped example: "
                      + ", ".join(EXAMPLES))
@@ -61,6 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--step", type=float, default=None, help="override the communication step [s]")
     run.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    _add_soil_options(run)
 
     ssp = commands.add_parser("export-ssp", help="write a system file (TOML) as an SSP 1.0 archive (.ssp) that "
                               "FMPy, libcosim and OMSimulator read")
@@ -81,6 +117,7 @@ def build_parser() -> argparse.ArgumentParser:
     ident.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
     ident.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
     ident.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    _add_soil_options(ident)
     ident.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
     simulate = commands.add_parser("simulate", help="paper Sec. 4: closed-loop rover, 20 s, on Rover.fmu and on "
@@ -92,6 +129,10 @@ def build_parser() -> argparse.ArgumentParser:
                           help="identified model (from `rover-cosim identify`)")
     simulate.add_argument("--only", choices=("straight", "path"), default=None,
                           help="only the paper's straight run, or only the path following (default: both)")
+    _add_soil_options(simulate)
+
+    commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources")
+    commands.add_parser("blocks", help="the block types of system files, with their keys, units and defaults")
 
     report = commands.add_parser("report", help="results/report.html: figures and tables beside the paper's")
     report.add_argument("--results", type=Path, default=Path("results"), help="the results folder")
@@ -167,14 +208,22 @@ def _export_ssp(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from rover_cosim.jobs.soil import soil_parameters
     from rover_cosim.orchestrator.system import SystemFileError
 
+    choice = None
+    if args.soil or args.wheel or args.assignments:
+        choice = _choice(args, "run")
+        if choice is None:
+            return 2
     with tempfile.TemporaryDirectory(prefix="rover-cosim-ssp-") as unpack:
         try:
             system, path = _load_run_system(args, Path(unpack))
         except SystemFileError as error:
             print(f"rover-cosim run: {error}", file=sys.stderr)
             return 2
+        for fmu in system.fmus:  # the chosen soil and wheel go to every FMU that has them
+            fmu.parameters.update(soil_parameters(fmu.path, choice))
         return _run_system(args, system, path)
 
 
@@ -233,10 +282,13 @@ def _identify(args: argparse.Namespace) -> int:
     if not args.fmu.is_file():
         print(f"rover-cosim identify: FMU {args.fmu} not found (run `make fmus`)", file=sys.stderr)
         return 2
+    choice = _choice(args, "identify")
+    if choice is None:
+        return 2
     bar = ProgressBar("sweep", enabled=not args.quiet)
     try:
         outcome = run_identification(args.fmu, args.out, workers=args.workers, scheduler=args.scheduler,
-                                     cache_dir=args.cache, progress=bar)
+                                     cache_dir=args.cache, progress=bar, choice=choice)
     except (OSError, RuntimeError, ValueError) as error:
         bar.close()
         print(f"rover-cosim identify: {error} (nothing written)", file=sys.stderr)
@@ -263,11 +315,14 @@ def _simulate(args: argparse.Namespace) -> int:
     if not args.model.is_file():
         print(f"rover-cosim simulate: identified model {args.model} not found (run `make identify`)", file=sys.stderr)
         return 2
+    choice = _choice(args, "simulate")
+    if choice is None:
+        return 2
     try:
         if args.only != "path":
-            _print_straight(run_simulation(args.fmu_dir, args.model, args.out))
+            _print_straight(run_simulation(args.fmu_dir, args.model, args.out, choice))
         if args.only != "straight":
-            _print_path(run_path_following(args.fmu_dir, args.model, args.out))
+            _print_path(run_path_following(args.fmu_dir, args.model, args.out, choice=choice))
     except (SystemFileError, RunError, ValueError) as error:
         print(f"rover-cosim simulate: {error} (nothing written)", file=sys.stderr)
         return 1
@@ -324,16 +379,45 @@ def _report(args: argparse.Namespace) -> int:
     from rover_cosim.report import build_report
 
     target = args.out or args.results / "report.html"
+    produced = [p for p in ("fig3_fx_vs_slip.csv", "identification/fit_models.csv", "simulation/rms.csv",
+                            "simulation/path_metrics.csv") if (args.results / p).exists()]
+    if not produced:
+        print(f"rover-cosim report: nothing to report in {args.results} (no results of fig3, identify or "
+              "simulate; run `make run`)", file=sys.stderr)
+        return 1
     write_all({target: build_report(args.results).encode()})
     print(f"wrote {target}")
+    return 0
+
+
+def _blocks(args: argparse.Namespace) -> int:
+    from rover_cosim.orchestrator.blocks import describe_blocks
+
+    print(describe_blocks())
+    return 0
+
+
+def _soils(args: argparse.Namespace) -> int:
+    from rover_cosim.terramechanics import library
+
+    for kind in ("soil", "wheel"):
+        print(f"{kind}s (--{kind} NAME):")
+        for name in library.names(kind):
+            _, table = library.entry(kind, name)
+            print(f"  {name:15s} {table.get('title', '')}")
+            print(f"  {'':15s} source: {table.get('source', '')}")
+    print(f"files: {library.SOILS}, {library.WHEELS}")
     return 0
 
 
 def _fig3(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.fig3 import PAPER_LOADS, slip_grid, write_fig3
 
+    choice = _choice(args, "fig3")
+    if choice is None:
+        return 2
     try:
-        written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step))
+        written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step), choice)
     except ValueError as error:
         print(f"rover-cosim fig3: {error}", file=sys.stderr)
         return 2
@@ -344,7 +428,8 @@ def _fig3(args: argparse.Namespace) -> int:
 
 COMMANDS = {"build-fmus": _build_fmus, "run": _run, "export-ssp": _export_ssp, "cosim-study": _cosim_study,
             "identify": _identify,
-            "simulate": _simulate, "report": _report, "fig3": _fig3}
+            "simulate": _simulate, "report": _report, "fig3": _fig3, "soils": _soils,
+            "blocks": _blocks}
 
 
 def _terminate(signum: int, frame: object) -> None:
@@ -362,6 +447,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"rover-cosim {args.command}: interrupted; nothing more written", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader went away (`rover-cosim soils | head`)
+        sys.stderr.close()
+        return 0
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.terramechanics import Soil, Wheel, wheel_state
+from rover_cosim.terramechanics.library import Choice, choose, describe
 
 CSV_NAME = "fig3_fx_vs_slip.csv"
 PNG_NAME = "fig3_fx_vs_slip.png"
@@ -65,13 +66,16 @@ def fig3_figure(table: pd.DataFrame) -> Figure:
 
 
 def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
-               slips: tuple[float, ...] = PAPER_SLIPS) -> list[Path]:
-    """Compute, draw and write Fig. 3 (CSV, PNG and a JSON run record) into ``out_dir``."""
-    wheel, soil = Wheel(), Soil()
+               slips: tuple[float, ...] = PAPER_SLIPS, choice: Choice | None = None) -> list[Path]:
+    """Compute, draw and write Fig. 3 (CSV, PNG and a JSON run record) into ``out_dir``, on the
+    soil and wheel of ``choice`` (default: the paper's)."""
+    choice = choice or choose()
+    wheel, soil = choice.wheel, choice.soil
     table = fig3_table(loads, slips, wheel, soil)
     png = io.BytesIO()
     fig3_figure(table).savefig(png, format="png")
-    parameters = {"loads_N": list(loads), "slips": list(slips), "wheel": asdict(wheel), "soil": asdict(soil)}
+    parameters = {"loads_N": list(loads), "slips": list(slips), "wheel": asdict(wheel), "soil": asdict(soil),
+                  "choice": describe(choice)}
     files = {
         out_dir / CSV_NAME: table.to_csv(index=False, float_format="%.10g").encode(),
         out_dir / PNG_NAME: png.getvalue(),

@@ -24,7 +24,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +48,7 @@ from rover_cosim.identification.lateral_validation import LateralValidation, val
 from rover_cosim.identification.sweep import SweepOutcome, SweepPlan, run_sweep
 from rover_cosim.identification.testbed import RECORDED, shared_test_bed
 from rover_cosim.identification.validate import validate
+from rover_cosim.terramechanics.library import Choice, choose, describe, fmu_parameters
 
 MODELS = {"quadratic": 2, "linear": 1}  # label -> degree in slip; the first is recommended
 RECOMMENDED = "quadratic"
@@ -119,11 +120,16 @@ def _lateral_files(out: Path, sweep: SweepOutcome, models: dict[str, LateralMode
 def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None = None,
                        lateral_plan: SweepPlan | None = None, workers: int | None = None,
                        scheduler: str | None = None, cache_dir: Path | None = None,
-                       progress: Callable[[float], None] | None = None) -> IdentificationResult:
+                       progress: Callable[[float], None] | None = None,
+                       choice: Choice | None = None) -> IdentificationResult:
     """Sweep, fit, validate and write every file of ``results/identification/`` (all or none):
-    the paper's longitudinal model (``plan``) and the lateral model (``lateral_plan``)."""
+    the paper's longitudinal model (``plan``) and the lateral model (``lateral_plan``), on the
+    soil and wheel of ``choice`` (default: the paper's)."""
     started = time.perf_counter()
-    plan, lateral_plan = plan or SweepPlan(), lateral_plan or LATERAL_PLAN
+    choice = choice or choose()
+    parameters = tuple(sorted(fmu_parameters(choice.soil, choice.wheel).items()))
+    plan = replace(plan or SweepPlan(), parameters=parameters)
+    lateral_plan = replace(lateral_plan or LATERAL_PLAN, parameters=parameters)
     cache_dir = cache_dir or out_dir / "cache"
     first, second = len(plan.cases()), len(lateral_plan.cases())
 
@@ -138,6 +144,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     models = {label: identify(table, degree) for label, degree in MODELS.items()}
     per_load = fx_per_load(table, 1)
     bed = shared_test_bed(Path(fmu_path))
+    bed.parameters = dict(parameters)
     validation = validate(bed, models)
     lateral_table_ = lateral_table(lateral_sweep.runs)
     lateral_models = {form.name: identify_lateral(lateral_table_, form) for form in FORMS}
@@ -157,6 +164,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
         "fx_fit": {"torque_max_N_m": FIT_TORQUE_MAX, "slip_range": list(SLIP_FIT_RANGE)},
         "plan": asdict(plan),
         "fmu": {"path": str(fmu_path), "sha256": fmu_sha},
+        **describe(choice),
         "failures": len(sweep.failures),
         "lateral": {**recommended_lateral.to_dict(), "plan": asdict(lateral_plan),
                     "inputs": "load W [N], slip angle beta [rad], slip ratio (fit rule as fx_fit)",
@@ -165,7 +173,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     fit_models = validation.fit.drop(columns=["fit_percent"])
     record = run_record("rover-cosim identify", {"plan": asdict(plan), "lateral_plan": asdict(lateral_plan),
                                                  "workers": workers, "scheduler": scheduler})
-    record.update({"fmu_sha256": fmu_sha, "runs_computed": sweep.computed + lateral_sweep.computed,
+    record.update({**describe(choice), "fmu_sha256": fmu_sha, "runs_computed": sweep.computed + lateral_sweep.computed,
                    "runs_cached": sweep.cached + lateral_sweep.cached,
                    "runs_failed": len(failed), "sweep_wall_seconds": sweep.wall_seconds + lateral_sweep.wall_seconds,
                    "wall_seconds": time.perf_counter() - started, "cache_folder": str(sweep.cache_folder)})

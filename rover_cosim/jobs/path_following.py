@@ -40,6 +40,9 @@ from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.system import system_from_dict
 from rover_cosim.terramechanics import Wheel
+from rover_cosim.terramechanics.library import Choice, choose, describe
+
+from .soil import soil_parameters
 
 STEP = 1e-3  # s
 WHEELS = range(1, 7)
@@ -80,28 +83,36 @@ def _controller_connections(body: str, wheel: Any) -> list[dict[str, str]]:
     return connections
 
 
-def monolithic_system(fmu_dir: Path, model: Path, scenario: str, steering: str = "inverse") -> dict[str, Any]:
+def monolithic_system(fmu_dir: Path, model: Path, scenario: str, steering: str = "inverse",
+                      choice: Choice | None = None) -> dict[str, Any]:
     speed = SCENARIOS[scenario]
-    start = {"v": speed, **{f"omega[{i}]": speed / Wheel().r for i in WHEELS}}
+    start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
     connections = _controller_connections("rover", lambda i, name: f"rover.{name}[{i}]")
     for i in WHEELS:
         connections += [{"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"},
                         {"from": f"ctrl.steer[{i}]", "to": f"rover.steer[{i}]"}]
     return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel",
                            "allow_algebraic_loops": True},
-            "fmu": [{"name": "rover", "path": str(fmu_dir / "SteerableRover.fmu"), "start": start}],
+            "fmu": [{"name": "rover", "path": str(fmu_dir / "SteerableRover.fmu"), "start": start,
+                     "parameters": soil_parameters(fmu_dir / "SteerableRover.fmu", choice)}],
             "block": [controller_block(model, scenario, steering)], "connection": connections}
 
 
-def cosim_system(fmu_dir: Path, model: Path, scenario: str) -> dict[str, Any]:
+def _radius(choice: Choice | None) -> float:
+    return (choice.wheel if choice else Wheel()).r
+
+
+def cosim_system(fmu_dir: Path, model: Path, scenario: str, choice: Choice | None = None) -> dict[str, Any]:
     """The shipped steerable_rover_cosim.toml's FMUs and hub wiring, its open-loop blocks
     replaced by the controller, started at the scenario's speed."""
     shipped = tomllib.loads(example("steerable_rover_cosim").read_text())
     speed = SCENARIOS[scenario]
     fmus = []
     for entry in shipped["fmu"]:
-        start = {"v": speed} if entry["name"] == "body" else {"omega": speed / Wheel().r}
-        fmus.append({"name": entry["name"], "path": str(fmu_dir / entry["path"]), "start": start})
+        path = fmu_dir / entry["path"]
+        start = {"v": speed} if entry["name"] == "body" else {"omega": speed / _radius(choice)}
+        fmus.append({"name": entry["name"], "path": str(path), "start": start,
+                     "parameters": soil_parameters(path, choice)})
     names = {entry["name"] for entry in fmus}
     hubs = [c for c in shipped["connection"] if c["from"].split(".")[0] in names and c["to"].split(".")[0] in names]
     connections = hubs + _controller_connections("body", lambda i, name: f"wheel{i}.{name}")
@@ -153,16 +164,17 @@ def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str
             "path_max_difference_m": float(np.hypot(mono["x"] - cosim["x"], mono["y"] - cosim["y"]).max())}
 
 
-def run_path_following(fmu_dir: Path, model: Path, out_dir: Path,
-                       scenarios: tuple[str, ...] = tuple(SCENARIOS)) -> PathResult:
-    """Every scenario on both plants and with kinematic steering; writes every file (all or none)."""
+def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SCENARIOS),
+                       choice: Choice | None = None) -> PathResult:
+    """Every scenario on both plants and with kinematic steering, on the soil and wheel of
+    ``choice`` (default: the paper's); writes every file (all or none)."""
     started = time.perf_counter()
     fmu_dir = Path(fmu_dir).resolve()
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     walls: dict[str, float] = {}
-    builds = {"inverse": lambda s: monolithic_system(fmu_dir, model, s),
-              "cosim": lambda s: cosim_system(fmu_dir, model, s),
-              "kinematic": lambda s: monolithic_system(fmu_dir, model, s, "kinematic")}
+    builds = {"inverse": lambda s: monolithic_system(fmu_dir, model, s, choice=choice),
+              "cosim": lambda s: cosim_system(fmu_dir, model, s, choice),
+              "kinematic": lambda s: monolithic_system(fmu_dir, model, s, "kinematic", choice)}
     for scenario in scenarios:
         for label, build in builds.items():
             system = system_from_dict(build(scenario), name=f"path {scenario} ({label})", base=fmu_dir)
@@ -179,7 +191,7 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path,
                                        for s in scenarios}, "step_s": STEP, "model": str(model),
                          "algorithm": "gauss-seidel"})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
-                   "model_sha256": file_sha256(model), "run_wall_seconds": walls,
+                   "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
                    "wall_seconds": time.perf_counter() - started,
                    "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
     out = Path(out_dir)

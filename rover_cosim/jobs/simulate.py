@@ -25,6 +25,9 @@ from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
 from rover_cosim.control.figures import fig10
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.system import system_from_dict
+from rover_cosim.terramechanics.library import Choice, choose, describe
+
+from .soil import soil_parameters
 
 STOP_TIME = 20.0  # s
 STEP = 1e-3       # s
@@ -48,21 +51,23 @@ def controller_block(model: Path, **options: Any) -> dict[str, Any]:
             "model": str(model), "step": STEP, **options}
 
 
-def monolithic_system(fmu_dir: Path, model: Path, **options: Any) -> dict[str, Any]:
+def monolithic_system(fmu_dir: Path, model: Path, choice: Choice | None = None, **options: Any) -> dict[str, Any]:
     connections = [{"from": "rover.x", "to": "ctrl.x"}, {"from": "rover.v", "to": "ctrl.v"}]
     for i in LIMBS:
         connections += [{"from": f"rover.Fz[{i}]", "to": f"ctrl.W[{i}]"},
                         {"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"}]
     return {"simulation": {"stop_time": STOP_TIME, "step": STEP, "algorithm": "gauss-seidel"},
-            "fmu": [{"name": "rover", "path": str(fmu_dir / "Rover.fmu")}],
+            "fmu": [{"name": "rover", "path": str(fmu_dir / "Rover.fmu"),
+                     "parameters": soil_parameters(fmu_dir / "Rover.fmu", choice)}],
             "block": [controller_block(model, **options)], "connection": connections}
 
 
-def cosim_system(fmu_dir: Path, model: Path, **options: Any) -> dict[str, Any]:
-    fmus = [{"name": "body", "path": str(fmu_dir / "RoverBody.fmu")}]
+def cosim_system(fmu_dir: Path, model: Path, choice: Choice | None = None, **options: Any) -> dict[str, Any]:
+    fmus: list[dict[str, Any]] = [{"name": "body", "path": str(fmu_dir / "RoverBody.fmu")}]
     connections = [{"from": "body.x", "to": "ctrl.x"}, {"from": "body.v", "to": "ctrl.v"}]
     for i in LIMBS:
-        fmus.append({"name": f"wheel{i}", "path": str(fmu_dir / "Wheel.fmu")})
+        fmus.append({"name": f"wheel{i}", "path": str(fmu_dir / "Wheel.fmu"),
+                     "parameters": soil_parameters(fmu_dir / "Wheel.fmu", choice)})
         connections += [
             {"from": f"body.W[{i}]", "to": f"wheel{i}.W"}, {"from": f"body.v_hub[{i}]", "to": f"wheel{i}.v_hub"},
             {"from": f"wheel{i}.Fx", "to": f"body.Fx[{i}]"}, {"from": f"body.W[{i}]", "to": f"ctrl.W[{i}]"},
@@ -106,20 +111,21 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
             "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
 
 
-def run_simulation(fmu_dir: Path, model: Path, out_dir: Path) -> SimulationResult:
-    """The closed loop on both plants and the ablation; writes every file (all or none)."""
+def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None) -> SimulationResult:
+    """The closed loop on both plants and the ablation; writes every file (all or none). The
+    FMUs run on the soil and wheel of ``choice`` (default: the paper's)."""
     started = time.perf_counter()
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
     walls: dict[str, float] = {}
     fmu_dir = Path(fmu_dir).resolve()
     for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
-        system = system_from_dict(build(fmu_dir, model), name=f"closed loop ({plant})", base=fmu_dir)
+        system = system_from_dict(build(fmu_dir, model, choice), name=f"closed loop ({plant})", base=fmu_dir)
         outcome = run(system)
         tables[plant] = trajectories(outcome.data, plant)
         walls[plant] = outcome.wall_seconds
         results[plant] = checks(tables[plant])
-    ablation_system = system_from_dict(monolithic_system(fmu_dir, model, fixed_load=STATIC_LOAD),
+    ablation_system = system_from_dict(monolithic_system(fmu_dir, model, choice, fixed_load=STATIC_LOAD),
                                        name="closed loop, fixed-load model", base=fmu_dir)
     ablation = rms(trajectories(run(ablation_system).data, "monolithic"))
     rms_mono, rms_cosim = rms(tables["monolithic"]), rms(tables["cosim"])
@@ -129,6 +135,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path) -> SimulationResul
                                                   "algorithm": "gauss-seidel", "fixed_load_ablation_N": STATIC_LOAD})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in ("Rover", "RoverBody", "Wheel")},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls,
+                   **describe(choice or choose()),
                    "wall_seconds": time.perf_counter() - started, "checks": results,
                    "rms_N": {"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
                              "fixed_load_ablation": ablation["rms_N"].tolist()}})

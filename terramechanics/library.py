@@ -1,0 +1,175 @@
+"""The soil and wheel library shipped with the package (``library/soils.toml``,
+``library/wheels.toml``) and the choice of a soil and a wheel from the command line.
+
+A soil or wheel is given by name (a table of the shipped files) or by a TOML file of the same
+form (one table; or several, then ``FILE:NAME``), then changed by ``--set`` assignments
+(``soil.c=500``, ``soil.phi_deg=30``, ``wheel.b=0.2``). Angles may be given in degrees with an
+explicit key (``phi_deg``, ``xc_deg``); every other value is SI. A soil that leaves out ``xc``
+gets 45 deg - phi/2 (Hegedus's destructive angle, as Ishigami et al. 2007 use it).
+
+:func:`fmu_parameters` turns a soil and a wheel into the FMUs' parameter names (``soil.kxBeta``
+...), so the FMUs take them without a rebuild; :func:`describe` gives the record a results folder
+keeps.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+from typing import Any
+
+from .parameters import Soil, Wheel
+
+LIBRARY = Path(__file__).with_name("library")
+SOILS, WHEELS = LIBRARY / "soils.toml", LIBRARY / "wheels.toml"
+DEFAULT = "paper"
+METADATA = ("title", "source", "notes")
+DEGREES = {"phi_deg": "phi", "xc_deg": "xc"}
+#: numpy field -> Modelica record field, where they differ.
+MODELICA_NAMES = {"kx_beta": "kxBeta", "ky_beta": "kyBeta"}
+
+
+@dataclass(frozen=True)
+class Choice:
+    """A soil and a wheel, with where they came from (for the results' record)."""
+
+    soil: Soil
+    wheel: Wheel
+    soil_name: str
+    wheel_name: str
+    soil_entry: dict[str, Any]
+    wheel_entry: dict[str, Any]
+    overrides: tuple[str, ...] = ()
+
+
+def _tables(path: Path) -> dict[str, Any]:
+    try:
+        return tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise ValueError(f"{path}: no such file") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError, IsADirectoryError) as error:
+        raise ValueError(f"{path}: not a readable TOML file ({error})") from None
+
+
+def names(kind: str) -> list[str]:
+    """The shipped soils (``kind = "soil"``) or wheels."""
+    return list(_tables(SOILS if kind == "soil" else WHEELS))
+
+
+def entry(kind: str, spec: str) -> tuple[str, dict[str, Any]]:
+    """(name, table) of a shipped name, a TOML file (one soil, or one table of them), or ``FILE:NAME``."""
+    library = _tables(SOILS if kind == "soil" else WHEELS)
+    if spec in library:
+        return spec, dict(library[spec])
+    path, name = spec, ""
+    if not Path(spec).is_file() and ":" in spec:
+        path, name = spec.rsplit(":", 1)
+    if not Path(path).is_file():
+        raise ValueError(f"{kind} {spec!r}: expected one of {', '.join(library)}, a TOML file or FILE:NAME")
+    tables = _tables(Path(path))
+    if any(isinstance(v, (int, float)) for v in tables.values()):
+        return Path(path).stem, dict(tables)   # the file is one soil (or wheel)
+    if name or len(tables) == 1:
+        name = name or next(iter(tables))
+        if name not in tables:
+            raise ValueError(f"{kind} {spec!r}: {path} has no table {name!r} (has {', '.join(tables)})")
+        return name, dict(tables[name])
+    raise ValueError(f"{kind} {spec!r}: {path} has several tables ({', '.join(tables)}); name one as FILE:NAME")
+
+
+def _values(kind: str, name: str, table: dict[str, Any]) -> dict[str, float]:
+    """The table's parameter values in SI (degrees converted), unknown keys refused."""
+    target = Soil if kind == "soil" else Wheel
+    known = {f.name for f in fields(target)}
+    accepted = known | (set(DEGREES) if kind == "soil" else set()) | set(METADATA)
+    unknown = sorted(set(table) - accepted)
+    if unknown:
+        raise ValueError(f"{kind} {name!r}: unknown key(s) {unknown}; expected {', '.join(sorted(accepted))}")
+    values: dict[str, float] = {}
+    for key, value in table.items():
+        if key in METADATA:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f"{kind} {name!r}: {key} = {value!r}: expected a number")
+        if key in DEGREES:
+            if DEGREES[key] in table:
+                raise ValueError(f"{kind} {name!r}: both {key} and {DEGREES[key]} given")
+            values[DEGREES[key]] = math.radians(float(value))
+        else:
+            values[key] = float(value)
+    return values
+
+
+def build(kind: str, name: str, table: dict[str, Any]) -> Soil | Wheel:
+    """The Soil or Wheel of a table: the paper's values for what it leaves out, xc = 45 deg - phi/2."""
+    values = _values(kind, name, table)
+    if kind == "wheel":
+        base_wheel = Wheel(**_values("wheel", DEFAULT, _tables(WHEELS)[DEFAULT]))
+        return replace(base_wheel, **values)
+    base = _values("soil", DEFAULT, _tables(SOILS)[DEFAULT])
+    if "phi" in values and "xc" not in values:
+        base["xc"] = math.radians(45.0) - values["phi"] / 2
+    try:
+        return Soil(**{**base, **values})
+    except ValueError as error:
+        raise ValueError(f"soil {name!r}: {error}") from None
+
+
+def parse_set(assignments: list[str] | tuple[str, ...]) -> dict[str, dict[str, float]]:
+    """``["soil.c=500", "wheel.b=0.2"]`` -> {"soil": {"c": 500.0}, "wheel": {"b": 0.2}}."""
+    result: dict[str, dict[str, float]] = {"soil": {}, "wheel": {}}
+    for text in assignments:
+        key, equals, value = text.partition("=")
+        kind, _, field = key.strip().partition(".")
+        if not equals or kind not in result or not field:
+            raise ValueError(f"--set {text!r}: expected soil.NAME=VALUE or wheel.NAME=VALUE")
+        try:
+            result[kind][field] = float(value)
+        except ValueError:
+            raise ValueError(f"--set {text!r}: {value!r} is not a number") from None
+    return result
+
+
+def choose(soil: str | None = None, wheel: str | None = None, assignments: list[str] | tuple[str, ...] = ()) -> Choice:
+    """The soil and wheel of the command line (defaults: the paper's), with ``--set`` applied."""
+    changes = parse_set(assignments)
+    soil_name, soil_table = entry("soil", soil or DEFAULT)
+    wheel_name, wheel_table = entry("wheel", wheel or DEFAULT)
+    for field in changes["soil"]:
+        if field in DEGREES:
+            soil_table.pop(DEGREES[field], None)
+        elif field in DEGREES.values():
+            soil_table.pop(f"{field}_deg", None)
+    soil_table.update(changes["soil"])
+    wheel_table.update(changes["wheel"])
+    chosen_soil = build("soil", soil_name, soil_table)
+    chosen_wheel = build("wheel", wheel_name, wheel_table)
+    assert isinstance(chosen_soil, Soil) and isinstance(chosen_wheel, Wheel)
+    return Choice(chosen_soil, chosen_wheel, soil_name, wheel_name, soil_table, wheel_table, tuple(assignments))
+
+
+def fmu_parameters(soil: Soil, wheel: Wheel) -> dict[str, float]:
+    """The soil and wheel as the FMUs' parameters (``soil.c``, ``soil.kxBeta``, ``wheel.r`` ...)."""
+    values = {f"soil.{MODELICA_NAMES.get(k, k)}": v for k, v in asdict(soil).items()}
+    values.update({f"wheel.{k}": v for k, v in asdict(wheel).items()})
+    return values
+
+
+def from_fmu_parameters(values: dict[str, float]) -> tuple[Soil, Wheel]:
+    """The inverse of fmu_parameters (the paper's values for what ``values`` leaves out)."""
+    modelica = {v: k for k, v in MODELICA_NAMES.items()}
+    soil = {modelica.get(k[5:], k[5:]): v for k, v in values.items() if k.startswith("soil.")}
+    wheel = {k[6:]: v for k, v in values.items() if k.startswith("wheel.")}
+    return Soil(**soil), Wheel(**wheel)
+
+
+def describe(choice: Choice) -> dict[str, Any]:
+    """What a results folder records: names, titles, sources and every value (SI)."""
+    return {"soil": {"name": choice.soil_name, "title": choice.soil_entry.get("title"),
+                     "source": choice.soil_entry.get("source"), "values": asdict(choice.soil),
+                     "phi_deg": math.degrees(choice.soil.phi)},
+            "wheel": {"name": choice.wheel_name, "title": choice.wheel_entry.get("title"),
+                      "source": choice.wheel_entry.get("source"), "values": asdict(choice.wheel)},
+            "set": list(choice.overrides)}

@@ -1,0 +1,63 @@
+"""The command line as a new user meets it: --version, help with every default and no markup,
+`report` with nothing to report, `blocks`, a Python block's module beside its system file."""
+
+from __future__ import annotations
+
+import pytest
+
+from rover_cosim import __version__
+from rover_cosim.cli import build_parser, main
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0 and capsys.readouterr().out.strip() == f"rover-cosim {__version__}"
+
+
+@pytest.mark.parametrize("command", ["fig3", "run", "identify", "simulate", "cosim-study", "export-ssp", "report",
+                                     "build-fmus"])
+def test_help_shows_every_default_without_markup(command, capsys):
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = capsys.readouterr().out
+    assert "``" not in text and ":func:" not in text and ":class:" not in text
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    for action in sub._actions:
+        if action.option_strings and action.default not in (None, False, [], "==SUPPRESS==") and action.nargs != 0:
+            assert "default" in (sub.formatter_class(prog="x")._get_help_string(action) or ""), action.dest
+
+
+def test_report_with_nothing_to_report_fails(tmp_path, capsys):
+    assert main(["report", "--results", str(tmp_path)]) == 1
+    assert "nothing to report" in capsys.readouterr().err
+    assert not (tmp_path / "report.html").exists()
+
+
+def test_blocks_lists_types_keys_and_defaults(capsys):
+    assert main(["blocks"]) == 0
+    text = capsys.readouterr().out
+    for expected in ('type = "ramp"', "duration  required", "time      default 0.0", 'type = "python"', "[s]"):
+        assert expected in text
+
+
+def test_a_python_block_beside_its_system_file_is_found(fmu_dir, fmus, tmp_path, capsys):
+    (tmp_path / "my_brake.py").write_text(
+        "import numpy as np\n"
+        "class Brake:\n"
+        "    def __init__(self, name, k):\n"
+        "        self.name, self.k = name, k\n"
+        "        self.inputs, self.outputs, self.units = ('u',), ('y',), {'u': 'rad/s', 'y': 'N.m'}\n"
+        "    def start(self, t0, u0):\n"
+        "        return -self.k * u0\n"
+        "    def step(self, t, h, u):\n"
+        "        return -self.k * u\n")
+    (tmp_path / "brake.toml").write_text(
+        '[simulation]\nstop_time = 0.1\nstep = 1e-3\n\n'
+        f'[[fmu]]\nname = "testbed"\npath = "{fmu_dir / "SingleWheel.fmu"}"\nstart = {{ omega = 5.0 }}\n\n'
+        '[[block]]\nname = "brake"\ntype = "python"\nfactory = "my_brake:Brake"\nk = 100.0\n\n'
+        '[[connection]]\nfrom = "testbed.omega"\nto = "brake.u"\n\n'
+        '[[connection]]\nfrom = "brake.y"\nto = "testbed.tau"\n')
+    assert main(["run", str(tmp_path / "brake.toml"), "-o", str(tmp_path / "brake.csv"), "--quiet"]) == 0
+    assert (tmp_path / "brake.csv").exists()
