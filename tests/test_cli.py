@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import pytest
 
 from rover_cosim import __version__
@@ -23,7 +25,8 @@ def test_help_shows_every_default_without_markup(command, capsys):
     text = capsys.readouterr().out
     assert "``" not in text and ":func:" not in text and ":class:" not in text
     parser = build_parser()
-    sub = next(a for a in parser._actions if a.dest == "command").choices[command]
+    choices: Any = next(a for a in parser._actions if a.dest == "command").choices
+    sub = choices[command]
     for action in sub._actions:
         if action.option_strings and action.default not in (None, False, [], "==SUPPRESS==") and action.nargs != 0:
             assert "default" in (sub.formatter_class(prog="x")._get_help_string(action) or ""), action.dest
