@@ -10,6 +10,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import pandas as pd
 
+#: Line styles of limbs 1-3: curves that coincide (the limbs share one Fx_des, and their forces
+#: follow it closely) stay visible as dashes and dots over the solid line.
+STYLES = {1: dict(ls="-", lw=2.2), 2: dict(ls="--", lw=1.6), 3: dict(ls=":", lw=1.6)}
 PANELS = (("tau", "(a) wheel torque [N·m]"), ("Tx", "(b) resistance torque [N·m]"), ("Fz", "(c) vertical force [N]"),
           ("sinkage", "(d) sinkage [m]"), ("slip", "(e) slip ratio [-]"), ("Fx", "(f) longitudinal force [N]"))
 
@@ -19,7 +22,7 @@ def fig10(table: pd.DataFrame, plant: str) -> bytes:
     flat = axes.ravel()
     for ax, (name, title) in zip(flat, PANELS):
         for i in (1, 2, 3):
-            ax.plot(table["time"], table[f"{name}_{i}"], label=f"limb {i}")
+            ax.plot(table["time"], table[f"{name}_{i}"], label=f"limb {i}", **STYLES[i])
         ax.set_title(title)
         ax.legend(fontsize=8)
     flat[6].plot(table["time"], table["v"], "k-")
@@ -33,7 +36,40 @@ def fig10(table: pd.DataFrame, plant: str) -> bytes:
         ax.grid(alpha=0.3)
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
-    fig.suptitle(f"Fig. 10: closed-loop rover ({plant}), inverse identified model per wheel")
+    fig.suptitle(f"Fig. 10: closed-loop rover ({plant}), inverse identified model per wheel "
+                 "(limbs 1-3; 4-6 mirror them)")
+    return _png(fig)
+
+
+def tracking(mono: pd.DataFrame, cosim: pd.DataFrame) -> bytes:
+    """(a) position x against the target x_t = t; (b) x - x_t; (c) Fx - Fx_des per limb;
+    (d) the co-simulated plant minus the monolithic one (velocity and loads)."""
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8), sharex=True)
+    time = mono["time"]
+    axes[0][0].plot(time, mono["x"], label="x, Rover.fmu", lw=2)
+    axes[0][0].plot(time, cosim["x"], "--", label="x, RoverBody + 6 Wheel")
+    axes[0][0].plot(time, time * 1.0, ":", color="k", label="target x_t = 1.0 m/s · t")
+    axes[0][0].set_title("(a) position [m]")
+    axes[0][1].plot(time, mono["x"] - time, label="Rover.fmu", lw=2)
+    axes[0][1].plot(time, cosim["x"] - time, "--", label="RoverBody + 6 Wheel")
+    axes[0][1].set_title("(b) position lag x - x_t [m]")
+    for i in (1, 2, 3):
+        axes[1][0].plot(time, mono[f"Fx_{i}"] - mono[f"Fx_des_{i}"], label=f"limb {i}", **STYLES[i])
+    axes[1][0].set_title("(c) force error Fx - Fx_des, Rover.fmu [N]")
+    axes[1][1].plot(time, 1000 * (cosim["v"] - mono["v"]), label="velocity [mm/s]", lw=2)
+    for i in (1, 3):
+        axes[1][1].plot(time, cosim[f"Fz_{i}"] - mono[f"Fz_{i}"], label=f"load, limb {i} [N]", **STYLES[i])
+    axes[1][1].set_title("(d) co-simulated minus monolithic")
+    for ax in axes.ravel():
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    fig.suptitle("Closed loop: position tracking, force error, and the two plants against each other")
+    return _png(fig)
+
+
+def _png(fig) -> bytes:  # noqa: ANN001 - a matplotlib Figure
     fig.tight_layout()
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=100)

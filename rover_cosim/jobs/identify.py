@@ -8,7 +8,8 @@ results/identification/
   fit_models.csv   Fit of the linear (Eq. 14) and the quadratic model beside the paper's Table 1
   fit_detail.csv   per load and torque level: settled Fx and slip of plant and models
   failures.csv     runs that failed, with their error (empty when none did)
-  fig5_fx_vs_slip.png, fig6_a_of_W.png, fig7_b_of_W.png, fig8_validation_575N.png
+  fig5_fx_vs_slip.png, fig6_a_of_W.png, fig7_b_of_W.png, fig8_validation_575N.png,
+  fig_model_coefficients.png (the recommended model's c_k(W))
   lateral_runs.csv       every run of the lateral sweep (slip angles 0-30 deg), long format
   lateral_steps.csv      per lateral run: settled slip, Fx, Fy, whether it still rolls
   lateral_fit_table.csv  load_N, slip_angle_deg, fit_percent (Eq. 15) of the lateral model at 275,
@@ -193,6 +194,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
         out / "fig7_b_of_W.png": figures.fig_coefficient(per_load, models["linear"], 0, "b(W)", "N",
                                                           "Fig. 7: offset b of Fx = a slip + b against load"),
         out / "fig8_validation_575N.png": figures.fig8_validation(validation.runs[575.0], 575.0, list(MODELS)),
+        out / "fig_model_coefficients.png":
+            figures.fig_model_coefficients(fx_per_load(table, MODELS[RECOMMENDED]), models[RECOMMENDED]),
         out / "identification.json": json_bytes(record),
     }
     lateral_files, lateral_fit = _lateral_files(out, lateral_sweep, lateral_models, lateral_validation)

@@ -22,7 +22,7 @@ import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
-from rover_cosim.control.figures import fig10
+from rover_cosim.control.figures import fig10, tracking
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.system import system_from_dict
 from rover_cosim.terramechanics.library import Choice, choose, describe
@@ -148,6 +148,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
         out / "ablation_fixed_load.csv": ablation_table.to_csv(index=False, float_format="%.4f").encode(),
         out / "fig10_closed_loop.png": fig10(tables["monolithic"], "Rover.fmu"),
         out / "fig10_closed_loop_cosim.png": fig10(tables["cosim"], "RoverBody + 6 Wheel"),
+        out / "fig_tracking.png": tracking(tables["monolithic"], tables["cosim"]),
         out / "simulation.json": json_bytes(record),
     }
     write_all(files)

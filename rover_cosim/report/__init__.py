@@ -1,0 +1,31 @@
+"""``make report``: results/report.html, one self-contained page (figures embedded, no network):
+our figures and tables beside the paper's values, the soil and wheel in use, and the provenance
+of every run. ``page``: HTML building blocks; ``sections``: one function per part of the page."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from . import sections
+from .page import document
+
+
+def build_report(results: Path) -> str:
+    results = Path(results)
+    identification, simulation = results / "identification", results / "simulation"
+    parts = ["<h1>rover-cosim: reproduction of Yoshikawa et al.</h1>",
+             ("<p>Every number below is read from the files under <code>results/</code> written by "
+              "<code>make run</code>; the paper's values are quoted beside ours.</p>")]
+    parts += sections.soil_section(results)
+    parts += sections.fig3_section(results)
+    parts += sections.identification_section(identification)
+    parts += sections.lateral_section(identification)
+    parts += sections.closed_loop_section(simulation)
+    parts += sections.path_section(simulation)
+    parts += sections.coupling_section(results)
+    parts += sections.scope_section(results)
+    parts += sections.provenance_section(results)
+    return document("rover-cosim report", parts)
+
+
+__all__ = ["build_report"]

@@ -1,0 +1,255 @@
+"""The sections of the report, each from the files one job wrote (a section whose files are
+missing says so): soil and wheel (Table 2), Fig. 3, identification (Table 1), the lateral force,
+the closed loop (Table 3, Fig. 10, tracking), path following, the coupling study, behaviour
+outside the paper's scope, provenance."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from rover_cosim.common.paper import TABLE_3_RMS as PAPER_RMS
+from rover_cosim.terramechanics import Soil, Wheel
+
+from .page import image, missing, provenance, table
+
+#: Units and names of the soil and wheel parameters (Table 2).
+PARAMETERS = {"c": ("cohesion c", "Pa"), "phi": ("friction angle φ", "deg"), "kc": ("k_c", "N/m^(n+1)"),
+              "kphi": ("k_φ", "N/m^(n+2)"), "n": ("sinkage exponent n", "-"), "kx": ("shear modulus k_x", "m"),
+              "a0": ("a0", "-"), "a1": ("a1", "-"), "lam": ("exit-angle ratio λ", "-"),
+              "kx_beta": ("k_x growth with β", "m/rad"), "ky": ("lateral shear modulus k_y", "m"),
+              "ky_beta": ("k_y growth with β", "m/rad"), "rho": ("dry density ρ", "kg/m³"),
+              "gravity": ("gravity on the soil", "m/s²"), "xc": ("destructive angle X_c", "deg"),
+              "r": ("wheel radius r", "m"), "b": ("wheel width b", "m"), "J": ("wheel inertia J", "kg·m²")}
+ANGLES = {"phi", "xc"}
+
+
+def _record(*paths: Path) -> dict[str, Any]:
+    """The first of the records that exists (soil and wheel are in every job's record)."""
+    for path in paths:
+        if path.exists():
+            record = json.loads(path.read_text())
+            if "soil" in record:
+                return record
+            choice = record.get("parameters", {}).get("choice")
+            if choice:
+                return choice
+    return {}
+
+
+def soil_section(results: Path) -> list[str]:
+    """Table 2: the soil and wheel in use beside the paper's."""
+    record = _record(results / "identification" / "identification.json", results / "simulation" / "simulation.json",
+                     results / "fig3_fx_vs_slip.json")
+    soil, wheel = record.get("soil", {}), record.get("wheel", {})
+    used = {**soil.get("values", asdict(Soil())), **wheel.get("values", asdict(Wheel()))}
+    paper = {**asdict(Soil()), **asdict(Wheel())}
+    rows = []
+    for key, (label, unit) in PARAMETERS.items():
+        convert = math.degrees if key in ANGLES else float
+        rows.append({"parameter": label, "unit": unit, "paper (Table 2, Ishigami 2007)": convert(paper[key]),
+                     "in use": convert(used.get(key, paper[key]))})
+    name = f"{soil.get('name', 'paper')}: {soil.get('title') or 'the paper’s soil'}"
+    wheel_name = f"{wheel.get('name', 'paper')}: {wheel.get('title') or 'the paper’s wheel'}"
+    return ["<h2>Soil and wheel in use (Table 2)</h2>",
+            f"<p>Soil <b>{name}</b>; wheel <b>{wheel_name}</b>"
+            + (f"; changed with {', '.join(record['set'])}" if record.get("set") else "") + ". Source: "
+            + f"{soil.get('source') or 'paper Table 2'}.</p>",
+            table(pd.DataFrame(rows), default="{:.4g}")]
+
+
+def fig3_section(results: Path) -> list[str]:
+    return ["<h2>Fig. 3: Fx against slip (numpy reference wheel)</h2>",
+            image(results / "fig3_fx_vs_slip.png", "Fx(slip) for loads 100-800 N, the soil in use")]
+
+
+def identification_section(identification: Path) -> list[str]:
+    sections = ["<h2>Identification (Sec. 3): Table 1</h2>"]
+    models = identification / "fit_models.csv"
+    if not models.exists():
+        return [*sections, missing(models)]
+    fits = pd.read_csv(models)
+    shown = pd.DataFrame({"load [N]": fits["load_N"], "paper Fit [%]": fits["paper_fit_percent"],
+                          "ours, linear Eq. (14) [%]": fits["fit_percent_linear"],
+                          "ours, quadratic (recommended) [%]": fits["fit_percent_quadratic"]})
+    sections.append(table(shown, {"load [N]": "{:.0f}"}, default="{:.1f}"))
+    model_file = identification / "model.json"
+    if model_file.exists():
+        model = json.loads(model_file.read_text())
+        recommended = model["recommended"]
+        coefficients = model["models"][recommended]["fx_coefficients_N"]
+        rows = [{"term": f"slip^{k}", "p0 [N]": c[0], "p1 [-]": c[1], "p2 [1/N]": c[2]}
+                for k, c in enumerate(coefficients)]
+        sections += [f"<p>The recommended ({recommended}) model, Fx = Σ c<sub>k</sub>(W) slip<sup>k</sup> with "
+                     "c<sub>k</sub>(W) = p0 + p1 W + p2 W<sup>2</sup> (W in N):</p>",
+                     table(pd.DataFrame(rows), default="{:.5g}")]
+    for name, caption in (("fig5_fx_vs_slip.png", "Fig. 5: settled Fx against slip over the fitted range, with "
+                           "Fx = a(W) slip + b(W)"),
+                          ("fig6_a_of_W.png", "Fig. 6: a(W)"), ("fig7_b_of_W.png", "Fig. 7: b(W)"),
+                          ("fig_model_coefficients.png", "the recommended model's coefficients c_k(W)"),
+                          ("fig8_validation_575N.png", "Fig. 8: identified model against the FMU at 575 N")):
+        sections.append(image(identification / name, caption))
+    return sections
+
+
+def lateral_section(identification: Path) -> list[str]:
+    """The identified lateral model: Fits off the grid, the forms tried, Ishigami's trends."""
+    sections = ["<h2>Lateral force (the paper's future work): Fy(W, β, slip)</h2>",
+                ("<p>Ishigami et al. (2007)'s side force of the wheel (lateral shear and sidewall bulldozing), "
+                 "identified like Sec. 3 from torque steps on the test bed with its carriage at slip angles "
+                 "0-30°. Model: Fy = Σ c<sub>ik</sub>(W) φ<sub>i</sub>(β) slip<sup>k</sup>, "
+                 "φ<sub>i</sub> = β/(|β| + β<sub>i</sub>), c<sub>ik</sub> quadratic in W. "
+                 "Validation (Eq. 15) at loads and slip angles off the sweep's grid, the track turning "
+                 "between +β and -β while the torque steps 5-40 N·m.</p>")]
+    fits, forms, trends = (identification / f"lateral_{name}.csv" for name in ("fit_table", "forms", "trends"))
+    if not fits.exists():
+        return [*sections, missing(fits)]
+    shown = pd.read_csv(fits).rename(columns={
+        "load_N": "load [N]", "slip_angle_deg": "slip angle [deg]", "fit_percent": "Fit [%]",
+        "max_settled_error_N": "largest settled error [N]", "max_settled_error_percent": "largest settled error [%]"})
+    sections.append(table(shown, {"load [N]": "{:.0f}", "slip angle [deg]": "{:.1f}"}, default="{:.2f}"))
+    if forms.exists():
+        tried = pd.read_csv(forms)[["form", "coefficients", "training_rms_N", "min_fit_percent"]]
+        sections += ["<p>Forms tried (the first is used):</p>", table(tried.rename(columns={
+            "coefficients": "coefficients [-]", "training_rms_N": "RMS on the sweep [N]",
+            "min_fit_percent": "lowest Fit [%]"}), {"coefficients [-]": "{:.0f}"}, default="{:.2f}")]
+    if trends.exists():
+        measured = pd.read_csv(trends).rename(columns={"trend": "Ishigami et al. 2007 report", "holds": "ours",
+                                                       "measured": "measured on our sweep"})
+        sections += ["<p>The trends Ishigami et al. report from their single-wheel experiments:</p>", table(measured)]
+    for name, caption in (("fig_lateral_fy.png", "Fy against slip angle and slip, sweep and model"),
+                          ("fig_lateral_coefficients.png", "coefficients c_ik(W) of the lateral model"),
+                          ("fig_lateral_validation_575N.png", "lateral validation at 575 N, ±12.5°")):
+        sections.append(image(identification / name, caption))
+    return sections
+
+
+CHECKS = {"time_to_98_percent_s": ("time to reach 0.98 m/s [s]", "{:.2f}"),
+          "max_abs_v_error_after_m_s": ("largest |v - 1 m/s| afterwards [m/s]", "{:.4f}"),
+          "final_v_m_s": ("final velocity [m/s]", "{:.4f}"),
+          "Fz1_min_while_accelerating_N": ("least load, limb 1, accelerating [N]", "{:.1f}"),
+          "Fz3_max_while_accelerating_N": ("largest load, limb 3, accelerating [N]", "{:.1f}"),
+          "Fz_at_start_N": ("load at the start [N]", "{:.1f}")}
+
+
+def closed_loop_section(simulation: Path) -> list[str]:
+    sections = ["<h2>Closed loop (Sec. 4): Table 3 and Fig. 10</h2>"]
+    rms_path, cosim_path = simulation / "rms.csv", simulation / "rms_cosim.csv"
+    if not (rms_path.exists() and cosim_path.exists()):
+        return [*sections, missing(rms_path)]
+    ours, cosim = pd.read_csv(rms_path), pd.read_csv(cosim_path)
+    paper = [f"{PAPER_RMS[i]:.1f}" if i in PAPER_RMS else f"— (mirror of limb {i - 3})" for i in ours["limb"]]
+    sections.append(table(pd.DataFrame({"limb": [str(i) for i in ours["limb"]], "paper RMS [N]": paper,
+                                        "ours, Rover.fmu [N]": ours["rms_N"],
+                                        "ours, RoverBody + 6 Wheel [N]": cosim["rms_N"]}), default="{:.2f}"))
+    sections.append("<p>RMS(Fx - Fx_des) per limb; limbs 4-6 mirror 1-3 (the paper reports 1-3).</p>")
+    ablation = simulation / "ablation_fixed_load.csv"
+    if ablation.exists():
+        shown = pd.read_csv(ablation).rename(columns={"rms_lut_N": "RMS, per-load look-up tables [N]",
+                                                      "rms_fixed_load_N": "RMS, one model at 424 N [N]"})
+        shown["limb"] = shown["limb"].astype(str)
+        sections += ["<p>Ablation: the same controller with one model at a fixed 424 N instead of the per-load "
+                     "look-up tables:</p>", table(shown, default="{:.2f}")]
+    record_path = simulation / "simulation.json"
+    if record_path.exists():
+        checks = json.loads(record_path.read_text()).get("checks", {})
+        rows = [{"plant": {"monolithic": "Rover.fmu", "cosim": "RoverBody + 6 Wheel"}.get(p, p),
+                 **{CHECKS[k][0]: v for k, v in values.items() if k in CHECKS}} for p, values in checks.items()]
+        formats = {label: fmt for label, fmt in CHECKS.values()}
+        sections += ["<p>Velocity and loads (paper: the rover reaches 1.0 m/s, Fig. 10 g; limb 1 unloads and "
+                     "limb 3 loads while accelerating, Fig. 10 c):</p>", table(pd.DataFrame(rows), formats)]
+    sections += [image(simulation / "fig10_closed_loop.png", "Fig. 10 (a)-(h), Rover.fmu; limbs drawn solid, "
+                       "dashed and dotted, so that curves that coincide stay visible"),
+                 image(simulation / "fig_tracking.png", "position x against x_t, the force error Fx - Fx_des, and "
+                       "the co-simulated plant minus the monolithic one"),
+                 image(simulation / "fig10_closed_loop_cosim.png", "Fig. 10 (a)-(h), RoverBody + 6 Wheel")]
+    return sections
+
+
+def path_section(simulation: Path) -> list[str]:
+    """The steerable rover following the turn and the lane change."""
+    sections = ["<h2>Path following: the steerable rover with the identified Fx and Fy models</h2>",
+                ("<p>SteerableRover (body in x, y, yaw with heave, pitch, roll; every wheel driven and "
+                 "steered). Path tracking at the body gives a force and yaw-moment demand, allocated to the "
+                 "wheels by least squares weighted by their loads; per wheel the inverse identified lateral "
+                 "model gives the steering angle and the inverse longitudinal model the torque. Turn: 10 m, "
+                 "90° of radius 10 m, 10 m at 0.5 m/s; lane change: 3 m over 15 m at 1.0 m/s. Ablation: "
+                 "kinematic steering (wheels along the commanded hub velocities, no slip-angle "
+                 "compensation).</p>")]
+    metrics, agreement = simulation / "path_metrics.csv", simulation / "path_agreement.csv"
+    if not metrics.exists():
+        return [*sections, missing(metrics)]
+    data = pd.read_csv(metrics)
+    shown = pd.DataFrame({
+        "scenario": data["scenario"].str.replace("_", " "),
+        "run": data["run"].map({"inverse": "identified models, SteerableRover.fmu",
+                                "cosim": "identified models, co-simulated", "kinematic": "kinematic steering"}),
+        "cross-track RMS [mm]": 1000 * data["cross_track_rms_m"],
+        "cross-track max [mm]": 1000 * data["cross_track_max_m"],
+        "speed error max [%]": data["speed_error_max_percent"],
+        "RMS(Fx - Fx_des), worst wheel [N]": data.filter(like="rms_Fx").max(axis=1),
+        "RMS(Fy - Fy_des), worst wheel [N]": data.filter(like="rms_Fy").max(axis=1)})
+    sections += ["<p>Floors of the issue: cross-track RMS &lt; 100 mm, max &lt; 300 mm, speed within 5 %, "
+                 "force errors &lt; 2 N per wheel (every wheel's value in <code>path_metrics.csv</code>).</p>",
+                 table(shown, default="{:.2f}")]
+    if agreement.exists():
+        agree = pd.read_csv(agreement).rename(columns={
+            "speed_max_difference_percent": "speed, largest difference [% of target]",
+            "load_max_difference_percent": "loads, largest difference [% of static]",
+            "path_max_difference_m": "path, largest distance [m]"})
+        sections += ["<p>Monolithic against co-simulated (SteerableRoverBody + 6 Wheel):</p>",
+                     table(agree, default="{:.2g}")]
+    sections += [image(simulation / "path_xy.png", "paths in the plane and cross-track error; the co-simulated "
+                       "run is dashed over the monolithic one (they coincide)"),
+                 image(simulation / "path_wheels_turn.png", "turn: wheel forces, slip angles, steering, loads"),
+                 image(simulation / "path_wheels_lane_change.png", "lane change: wheel forces, slip angles, loads")]
+    return sections
+
+
+def coupling_section(results: Path) -> list[str]:
+    study = results / "cosim_study" / "coupling_error.csv"
+    if not study.exists():
+        return ["<h2>Co-simulation coupling error</h2>",
+                "<p>Not run here (<code>make cosim-study</code> writes it).</p>"]
+    data = pd.read_csv(study)
+    shown = pd.DataFrame({"master": data["algorithm"], "step [ms]": 1000 * data["step_s"],
+                          "largest velocity error [mm/s]": 1000 * data["max_abs_v_error_m_s"],
+                          "largest load error [N]": data["max_abs_Fz_error_N"],
+                          "wall time [s]": data["cosim_wall_s"]})
+    return ["<h2>Co-simulation coupling error</h2>",
+            "<p>RoverBody + 6 Wheel against Rover.fmu run by the same master at the same step, 6 s open loop.</p>",
+            table(shown, {"step [ms]": "{:.0f}"}, default="{:.3g}"),
+            image(results / "cosim_study" / "coupling_error.png", "co-simulated against monolithic rover")]
+
+
+def scope_section(results: Path) -> list[str]:
+    """What the wheel does outside the paper's scenario, with numbers from the results."""
+    lines = ["<h2>Behaviour outside the paper's scope</h2>", "<div class='note'><ul>"]
+    fig3 = results / "fig3_fx_vs_slip.csv"
+    if fig3.exists():
+        data = pd.read_csv(fig3)
+        zero = data[data["slip"].abs() < 1e-12].sort_values("load_N")
+        if len(zero):
+            lightest, heaviest = zero.iloc[0], zero.iloc[-1]
+            lines.append(f"<li>At zero slip Fx is the rolling resistance: {lightest['Fx_N']:.1f} N at "
+                         f"{lightest['load_N']:.0f} N and {heaviest['Fx_N']:.1f} N at {heaviest['load_N']:.0f} N "
+                         "(Fig. 3): a rolling wheel needs some slip to pull.</li>")
+    lines += ["<li>Standstill: below 1 mm/s the forces blend into a static regime (a wheel at rest with no torque "
+              "stays at rest; on a slope a holding torque holds it), where the identified model, made from "
+              "rolling runs, does not apply.</li>",
+              "<li>Reverse mirrors forward (equal and opposite forces); braking gives negative slip and Fx.</li>",
+              "<li>Beyond the sweep: the look-up tables extend linearly beyond 100-800 N and the torques "
+              "5-80 N·m; light wheels under large torques spin out (slip near 1) and are left out of the "
+              "fits.</li></ul></div>"]
+    return lines
+
+
+def provenance_section(results: Path) -> list[str]:
+    return ["<h2>Provenance</h2>", *(provenance(path) for path in (
+        results / "fig3_fx_vs_slip.json", results / "identification" / "identification.json",
+        results / "simulation" / "simulation.json", results / "simulation" / "path_following.json"))]
