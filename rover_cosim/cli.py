@@ -342,11 +342,21 @@ def _print_path(outcome) -> None:  # noqa: ANN001 - PathResult, imported lazily
 
 
 def _print_straight(outcome) -> None:  # noqa: ANN001 - SimulationResult, imported lazily
-    for plant, checks in outcome.record["checks"].items():
-        print(f"{plant}: " + ", ".join(f"{k} {v:.4g}" for k, v in checks.items() if v is not None))
-    for plant, table in outcome.rms.items():
-        print(f"RMS(Fx - Fx_des) [N], {plant}: " + ", ".join(f"{r:.3f}" for r in table["rms_N"]))
-    print("fixed-load ablation RMS [N]: " + ", ".join(f"{r:.3f}" for r in outcome.ablation["rms_fixed_load_N"]))
+    import pandas as pd
+
+    from rover_cosim.report.sections import CHECKS
+
+    plants = {"monolithic": "Rover.fmu", "cosim": "RoverBody + 6 Wheel"}
+    checks = pd.DataFrame({plants.get(p, p): {CHECKS[k][0]: v for k, v in values.items() if k in CHECKS}
+                           for p, values in outcome.record["checks"].items()})
+    print("Velocity and loads:")
+    print(checks.to_string(float_format=lambda v: f"{v:.4g}"))
+    table = pd.DataFrame({"limb": outcome.rms["monolithic"]["limb"],
+                          "RMS(Fx - Fx_des), Rover.fmu [N]": outcome.rms["monolithic"]["rms_N"],
+                          "RMS, RoverBody + 6 Wheel [N]": outcome.rms["cosim"]["rms_N"],
+                          "RMS, one model at 424 N [N]": outcome.ablation["rms_fixed_load_N"]})
+    print("Table 3 (limbs 4-6 mirror 1-3):")
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
     for path in outcome.files:
         print(f"wrote {path}")
 

@@ -64,3 +64,13 @@ def test_a_python_block_beside_its_system_file_is_found(fmu_dir, fmus, tmp_path,
         '[[connection]]\nfrom = "brake.y"\nto = "testbed.tau"\n')
     assert main(["run", str(tmp_path / "brake.toml"), "-o", str(tmp_path / "brake.csv"), "--quiet"]) == 0
     assert (tmp_path / "brake.csv").exists()
+
+
+def test_simulate_labels_what_it_prints(simulated, capsys):
+    from rover_cosim.cli import _print_straight
+
+    _print_straight(simulated)
+    out = capsys.readouterr().out
+    for label in ("time to reach 0.98 m/s [s]", "final velocity [m/s]", "Rover.fmu", "RoverBody + 6 Wheel",
+                  "RMS(Fx - Fx_des), Rover.fmu [N]", "limb"):
+        assert label in out, label
