@@ -76,6 +76,7 @@ bench: $(STAMP)
 	$(PY) -P benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
 	$(PY) -P benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
 	$(PY) -P benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
+	$(PY) -P benchmarks/bench_controller.py --out $(RESULTS)/bench/controller.json --model $(RESULTS)/identification/model.json
 
 clean:
 	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

@@ -91,3 +91,18 @@ def test_report_is_self_contained(results):
     assert "0.7" in cells and "82.1" in cells  # the paper's values beside ours, as table cells
     assert "Lateral force" in page and "Ishigami et al. 2007 report" in page
     assert page.count("data:image/png;base64,") >= 9  # with the three lateral figures
+
+
+def test_plain_float_inverse_equals_the_numpy_reference(controller):
+    """The per-step path in plain floats (what the block uses, issue 18) gives the torques of the
+    whole-array numpy implementation to round-off, over a run with changing loads and forces."""
+    rng = np.random.default_rng(3)
+    fast, reference = controller.inverse, type(controller.inverse)(controller.model, 6, 342.0, 1e-3)
+    for k in range(300):
+        loads = 424.0 + 120.0 * rng.standard_normal(6)
+        forces = 30.0 * rng.standard_normal(6)
+        advance = k > 0
+        np.testing.assert_allclose(fast.torques(loads, forces, advance), reference.reference_torques(loads, forces,
+                                                                                                     advance),
+                                   rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(fast.filter_state, reference.filter_state, rtol=1e-12, atol=1e-15)

@@ -4,7 +4,9 @@ of the first-order tau -> slip block at the wheel's load, tau = (slip_f + T slip
 
 from __future__ import annotations
 
+import bisect
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +38,14 @@ class LongitudinalInverse:
         self.model, self.name, self.wn, self.step = model, name, wn, step
         self.ad, self.bd = self.discretised(step)
         self.filter_state = np.zeros((wheels, 2))
+        # The tables as plain Python floats for the per-step path (``torques``): on six wheels,
+        # list arithmetic is several times faster than numpy's per-call overhead.
+        self._inverse = [float(v) for v in 1.0 / np.asarray(model.loads, float)]   # decreasing
+        self._negated_inverse = [-v for v in self._inverse]                          # increasing, for bisect
+        self._torques = [float(v) for v in model.torques]
+        self._settled = [[float(v) for v in row] for row in np.asarray(model.gain) * model.torques[None, :]]
+        self._log_t = [[float(v) for v in row] for row in np.log(np.asarray(model.time_constant, float))]
+        self._coefficients = [[float(v) for v in row] for row in model.fx_coefficients]
 
     def discretised(self, step: float) -> tuple[np.ndarray, np.ndarray]:
         """Eq. (17) as x' = A x + B u, x = (slip_f, slip_f'), discretised exactly for an input
@@ -79,19 +89,86 @@ class LongitudinalInverse:
             time_constants[i] = np.interp(torque, torques, constants[i])
         return result, time_constants
 
-    def torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
-        """The torques for ``forces`` at ``loads``; ``advance`` moves the filter one step on (else
-        it starts settled at the targets); ``step`` [s]: a step other than the one it was made for
-        (the shorter last step of a run)."""
+    def reference_torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool) -> np.ndarray:
+        """``torques`` by whole-array numpy operations (the first implementation; kept as the
+        reference the plain-float path is tested and benchmarked against)."""
         targets = self.slips_for_forces(loads, forces)
         if advance:
-            ad, bd = (self.ad, self.bd) if step is None or abs(step - self.step) <= 1e-12 else self.discretised(step)
-            self.filter_state = self.filter_state @ ad.T + np.outer(targets, bd)
+            self.filter_state = self.filter_state @ self.ad.T + np.outer(targets, self.bd)
         else:
             self.filter_state = np.column_stack([targets, np.zeros(len(targets))])
         slip, rate = self.filter_state[:, 0], self.filter_state[:, 1]
-        # The inverse of K/(T s + 1): tau = (slip + T slip') / K, with T at the torque for slip.
         rows = self.model.rows_at(loads)
         _, constants = self.torques_for_slips(loads, slip, rows)
         torque, _ = self.torques_for_slips(loads, slip + constants * rate, rows)
         return torque
+
+    def torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
+        """The torques for ``forces`` at ``loads``; ``advance`` moves the filter one step on (else
+        it starts settled at the targets); ``step`` [s]: a step other than the one it was made for
+        (the shorter last step of a run). The same arithmetic as slips_for_forces,
+        model.rows_at and torques_for_slips, wheel by wheel in plain floats."""
+        ad, bd = self.ad, self.bd
+        if advance and step is not None and abs(step - self.step) > 1e-12:
+            ad, bd = self.discretised(step)
+        a00, a01, a10, a11 = float(ad[0, 0]), float(ad[0, 1]), float(ad[1, 0]), float(ad[1, 1])
+        b0, b1 = float(bd[0]), float(bd[1])
+        state = self.filter_state
+        result = np.empty(len(loads))
+        for i, (load, force) in enumerate(zip(loads.tolist(), forces.tolist())):
+            target = self._slip_for_force(load, force)
+            if advance:
+                slip_f, rate_f = float(state[i, 0]), float(state[i, 1])
+                slip, rate = a00 * slip_f + a01 * rate_f + b0 * target, a10 * slip_f + a11 * rate_f + b1 * target
+            else:
+                slip, rate = target, 0.0
+            state[i, 0], state[i, 1] = slip, rate
+            # The inverse of K/(T s + 1): tau = (slip + T slip') / K, with T at the torque for slip.
+            settled, log_t = self._rows(load)
+            constant = self._time_constant(self._torque_for(settled, slip), log_t)
+            result[i] = self._torque_for(settled, slip + constant * rate)
+        return result
+
+    def _slip_for_force(self, load: float, force: float) -> float:
+        """slips_for_forces for one wheel."""
+        c = [row[0] + row[1] * load + row[2] * load * load for row in self._coefficients]
+        linear = (force - c[0]) / c[1]
+        if self.model.degree == 1:
+            return linear
+        if self.model.degree != 2:
+            raise ValueError(f"block {self.name!r}: inverse of a degree-{self.model.degree} Fx model not implemented")
+        discriminant = c[1] ** 2 - 4.0 * c[2] * (c[0] - force)
+        if c[2] == 0 or discriminant < 0:
+            return linear
+        root = math.sqrt(discriminant)
+        plus, minus = (-c[1] + root) / (2.0 * c[2]), (-c[1] - root) / (2.0 * c[2])
+        return plus if abs(plus - linear) <= abs(minus - linear) else minus
+
+    def _rows(self, load: float) -> tuple[list[float], list[float]]:
+        """model.rows_at for one load: the settled-slip row and the log T row (interpolated in 1/W)."""
+        if not load > 0:
+            raise ValueError(f"loads = {load!r} N: expected > 0")
+        inverse, x = self._inverse, 1.0 / load
+        j = min(max(bisect.bisect_left(self._negated_inverse, -x), 1), len(inverse) - 1)
+        weight = (x - inverse[j - 1]) / (inverse[j] - inverse[j - 1])
+        low, high = self._settled[j - 1], self._settled[j]
+        settled = [(1 - weight) * a + weight * b for a, b in zip(low, high)]
+        low_t, high_t = self._log_t[j - 1], self._log_t[j]
+        return settled, [(1 - weight) * a + weight * b for a, b in zip(low_t, high_t)]
+
+    def _torque_for(self, row: list[float], slip: float) -> float:
+        """torques_for_slips for one wheel: the torque whose settled slip is ``slip``."""
+        torques = self._torques
+        j = min(max(bisect.bisect_left(row, slip), 1), len(torques) - 1)
+        return torques[j - 1] + (slip - row[j - 1]) * (torques[j] - torques[j - 1]) / (row[j] - row[j - 1])
+
+    def _time_constant(self, torque: float, log_t: list[float]) -> float:
+        """T at ``torque`` (np.interp of the row's T over the torques, held beyond its ends)."""
+        torques = self._torques
+        if torque <= torques[0]:
+            return math.exp(log_t[0])
+        if torque >= torques[-1]:
+            return math.exp(log_t[-1])
+        j = bisect.bisect_right(torques, torque)
+        low, high = math.exp(log_t[j - 1]), math.exp(log_t[j])
+        return low + (torque - torques[j - 1]) * (high - low) / (torques[j] - torques[j - 1])
