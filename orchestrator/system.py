@@ -36,6 +36,7 @@ variables = ["body.v", "wheel1.Fz"]   # default: every output of every participa
 from __future__ import annotations
 
 import json
+import os
 import re
 import tomllib
 import zipfile
@@ -121,6 +122,7 @@ class System:
     record: list[Port] = field(default_factory=list)
     iteration: Iteration = field(default_factory=Iteration)
     algebraic_loop: list[Port] | None = None  # a cycle of direct feedthrough, if there is one
+    threads: int = 1  # FMUs stepped at the same time where the algorithm allows (Jacobi, Gauss-Seidel)
 
     def participants(self) -> dict[str, FmuEntry | BlockEntry]:
         """Every FMU and block entry by instance name."""
@@ -132,7 +134,7 @@ class System:
 #: The keys each section of a system file may have.
 SECTION_KEYS = {
     "simulation": {"stop_time", "step", "start_time", "algorithm", "order", "tolerance", "max_iterations",
-                   "relaxation", "allow_algebraic_loops"},
+                   "relaxation", "allow_algebraic_loops", "threads"},
     "fmu": {"name", "path", "parameters", "start"},
     "connection": {"from", "to"},
     "record": {"variables"},
@@ -234,8 +236,12 @@ def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path 
     record = parse_record(_table(data.get("record"), f"{name}: [record]"), order, ports, context)
     iteration = parse_iteration(simulation, algorithm, context)
     loop = check_loops(fmus, blocks, connections, simulation, algorithm, context)
+    threads = simulation.get("threads", os.cpu_count() or 1)
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise context.error("[simulation] threads", f"{threads!r}: expected a whole number >= 1 (FMUs stepped "
+                            "at the same time)")
     return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, order, record, iteration,
-                  loop)
+                  loop, threads)
 
 
 def dependency_graph(fmus: list[FmuEntry], blocks: list[BlockEntry],

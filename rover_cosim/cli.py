@@ -95,6 +95,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="override the system file's master algorithm")
     run.add_argument("--step", type=float, default=None, help="override the communication step [s]")
     run.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
+    run.add_argument("--threads", type=int, default=None,
+                     help="FMUs stepped at the same time (Jacobi; Gauss-Seidel where inputs are ready); "
+                     "default: the system file's, else the number of cores")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     _add_soil_options(run)
 
@@ -167,7 +170,8 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
 
     path, fmu_dir = _system_path(args)
     overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
-                                               ("stop_time", args.stop_time)) if value is not None}
+                                               ("stop_time", args.stop_time), ("threads", args.threads))
+                 if value is not None}
     if path.suffix.lower() == ".ssp":
         try:
             system = load_ssp(path, unpack)
