@@ -15,6 +15,14 @@ from matplotlib.lines import Line2D
 from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, IdentifiedModel
 
 
+def finish(axes, legend: bool = True) -> None:  # noqa: ANN001 - matplotlib Axes
+    """Grid (and legend) on every axis of a figure."""
+    for ax in np.atleast_1d(axes).ravel():
+        if legend:
+            ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+
+
 def png_bytes(fig) -> bytes:
     buffer = io.BytesIO()
     fig.tight_layout()
@@ -94,7 +102,5 @@ def fig8_validation(run: pd.DataFrame, load: float, labels: list[str]) -> bytes:
     axes[1].set_ylabel("slip [-]")
     axes[1].set_xlabel("time [s]")
     axes[0].set_title(f"Fig. 8: torque staircase 5-40 N·m at W = {load:.0f} N")
-    for ax in axes:
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
+    finish(axes)
     return png_bytes(fig)

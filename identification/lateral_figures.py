@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from .figures import png_bytes
+from .figures import finish, png_bytes
 from .lateral import LateralModel, fit_points
 
 #: N·m: the torque level of the runs drawn against beta (inside the fits at every load).
@@ -85,7 +85,5 @@ def validation_run(run: pd.DataFrame, load: float, angle: float, label: str) -> 
     axes[1].set_ylabel("slip, slip angle / 100")
     axes[1].set_xlabel("time [s]")
     axes[0].set_title(f"Lateral validation at W = {load:.0f} N, beta = ±{angle:g} deg, torque 5-40 N·m")
-    for ax in axes:
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
+    finish(axes)
     return png_bytes(fig)
