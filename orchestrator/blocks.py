@@ -9,8 +9,14 @@ The interface is small and mirrors an FMU slave at a fixed communication step:
   master algorithm makes available: at ``t`` for Jacobi, possibly at ``t + h`` for upstream
   participants under Gauss-Seidel) and return the outputs at ``t + h``.
 
+Optional: ``feedthrough`` (bool; default True for a block with inputs: its outputs depend on
+its inputs at the same instant, which the algebraic-loop check follows); ``get_state() -> state``
+and ``set_state(state)`` for the iterative master, which repeats a step (without them the
+master keeps a deep copy of the block's attributes).
+
 Sources ignore their inputs (they have none). A user block is any class with this interface;
-``type = "python"`` in a system file loads it from ``factory = "module:callable"``.
+``type = "python"`` in a system file loads it from ``factory = "module:callable"`` (the module
+is looked up beside the system file first); ``rover-cosim blocks`` lists the built-in types.
 """
 
 from __future__ import annotations
