@@ -85,10 +85,9 @@ def _long(runs: dict, columns: list[str]) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)[columns]
 
 
-def _lateral_files(out: Path, sweep: SweepOutcome, models: dict[str, LateralModel],
+def _lateral_files(out: Path, sweep: SweepOutcome, table: pd.DataFrame, models: dict[str, LateralModel],
                    validation: LateralValidation) -> tuple[dict[Path, bytes], pd.DataFrame]:
-    """lateral_*.csv and the lateral figures, and the fit table."""
-    table = lateral_table(sweep.runs)
+    """lateral_*.csv and the lateral figures (``table``: the sweep's lateral_table), and the fit table."""
     recommended = next(iter(models.values()))
     detail = validation.detail
     error = (detail[f"Fy_{recommended.form.name}_N"] - detail["Fy_plant_N"]).abs()
@@ -198,7 +197,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
             figures.fig_model_coefficients(fx_per_load(table, MODELS[RECOMMENDED]), models[RECOMMENDED]),
         out / "identification.json": json_bytes(record),
     }
-    lateral_files, lateral_fit = _lateral_files(out, lateral_sweep, lateral_models, lateral_validation)
+    lateral_files, lateral_fit = _lateral_files(out, lateral_sweep, lateral_table_, lateral_models,
+                                                lateral_validation)
     files.update(lateral_files)
     write_all(files)
     return IdentificationResult(sorted(files), validation.fit, sweep, record, json.loads(files[out / "model.json"]),
