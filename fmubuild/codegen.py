@@ -2,8 +2,10 @@
 
 Generated per model (the runtime in ``fmubuild/runtime`` is the same for all):
 
-- ``model_casadi.c``: CasADi's C code of ``model_ode``, ``model_outputs`` (with the model's
-  ``assert`` conditions and the values they read), ``model_initial``,
+- ``model_casadi.c``: CasADi's C code (its SX functions rewritten by :mod:`fmubuild.guards` so
+  that a branch of a run-time ``if`` is computed only when taken) of ``model_evaluate``
+  (derivatives, outputs, the model's ``assert`` conditions and the values they read, in one
+  evaluation), ``model_initial``,
   ``model_ode_jacobian`` (dense df/dx and df/dt, for the Co-Simulation integrator) and
   ``model_directional`` (forward directional derivatives of derivatives and observed variables,
   for ``fmi2GetDirectionalDerivative``);
@@ -22,6 +24,7 @@ from pathlib import Path
 
 import casadi as ca
 
+from .guards import guard_generated_code
 from .ode import OdeModel
 
 #: Solver parameters appended after the model's variables (Co-Simulation only).
@@ -73,13 +76,14 @@ def _functions(model: OdeModel) -> list[ca.Function]:
         model.xdot.numel() + model.y.numel(), 1)
     nx = x.numel()
     return [
-        ca.Function("model_ode", [t, x, u, p], [model.xdot], ["t", "x", "u", "p"], ["xdot"]),
-        # The asserts are evaluated with the outputs: an importer reading outputs after each step
-        # gets them checked at no extra cost.
-        ca.Function("model_outputs", [t, x, u, p],
-                    [model.y, _column([a.condition for a in model.asserts]),
+        # Derivatives and outputs in one function, so that they share one evaluation of the
+        # model (e.g. one sinkage solve per wheel); the runtime keeps the last one with the
+        # point it was made at. The asserts come with it: an importer reading outputs after
+        # each step gets them checked at no extra cost.
+        ca.Function("model_evaluate", [t, x, u, p],
+                    [model.xdot, model.y, _column([a.condition for a in model.asserts]),
                      _column([value for a in model.asserts for value in a.values])],
-                    ["t", "x", "u", "p"], ["y", "holds", "values"]),
+                    ["t", "x", "u", "p"], ["xdot", "y", "holds", "values"]),
         ca.Function("model_initial", [p], [model.x0], ["p"], ["x0"]),
         ca.Function("model_ode_jacobian", [t, x, u, p],
                     [ca.densify(ca.jacobian(model.xdot, x)), ca.densify(ca.jacobian(model.xdot, t))],
@@ -195,7 +199,8 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path) -
                                                      "casadi_int": "long long int", "casadi_real": "double"})
     for function in _functions(model):
         generator.add(function)
-    code = generator.dump()
+    # Each branch of a run-time if computed only when taken (fmubuild.guards).
+    code, _ = guard_generated_code(generator.dump())
     digest = hashlib.sha256(code.encode())
     variables = [(v.name, v.kind, v.causality, v.start, v.unit) for v in model_layout.variables]
     assert_texts = [(a.message, a.level, a.names) for a in model.asserts]

@@ -66,6 +66,8 @@ class FunctionLibrary:
             if declared["default"] is None:
                 raise UnsupportedConstruct(f"missing argument {declared['name']} without default", name)
             values.append(Evaluator(lambda n: _no_lookup(n, name), self.call, name)(declared["default"]))
+        if not any(is_symbolic(v) for v in values):
+            return self._evaluate(definition, values)
         structural = tuple(v if decl["type_name"] in ("Integer", "Boolean") else None
                            for v, decl in zip(values, inputs))
         for v, decl in zip(values, inputs):
@@ -83,6 +85,22 @@ class FunctionLibrary:
         elif isinstance(result, dict):
             result = list(result.values())
         return tuple(result)
+
+    def _evaluate(self, definition: Mapping[str, Any], values: list[Value]) -> tuple[Value, ...]:
+        """A call whose arguments are all known at translation time (e.g. the nodes of a
+        quadrature rule from loop indices) is executed at once: its outputs are numbers, which
+        fold into the caller's expressions instead of becoming a call in the generated code."""
+        name = definition["name"]
+        self._check_supported(definition)
+        env: dict[str, Value] = {d["name"]: v for d, v in zip(definition["inputs"], values)}
+        for declared in list(definition["outputs"]) + list(definition["locals"]):
+            if declared["default"] is not None:
+                env[declared["name"]] = Evaluator(env.__getitem__, self.call, name)(declared["default"])
+        self._execute(definition["body"], env, name)
+        for declared in definition["outputs"]:
+            if declared["name"] not in env:
+                raise UnsupportedConstruct(f"output {declared['name']} of {name} is never assigned", name)
+        return tuple(env[d["name"]] for d in definition["outputs"])
 
     @staticmethod
     def _check_supported(definition: Mapping[str, Any]) -> None:

@@ -149,18 +149,18 @@ model ForceProbe
   Real slip(unit="1");
 """ + PROBE_COMMON + """  h = h0*(h1/h0)^time;
   slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*cycles*time));
-  (Fx, Fz, Tx, Fy, FySidewall) = RoverTerramechanics.Functions.contactForces(h, slip, soil, wheel, PANELS);
+  (Fx, Fz, Tx, Fy, FySidewall) = RoverTerramechanics.Functions.contactForces(h, slip, soil, wheel, NODES);
 end ForceProbe;
 """
 
 
-def probe_forces(panels: int) -> pd.DataFrame:
-    return simulate_inline(PROBE.replace("PANELS", str(panels)), "ForceProbe", 0.0005)
+def probe_forces(nodes: int) -> pd.DataFrame:
+    return simulate_inline(PROBE.replace("NODES", str(nodes)), "ForceProbe", 0.0005)
 
 
 @pytest.fixture(scope="module")
 def probes() -> dict[int, pd.DataFrame]:
-    return {panels: probe_forces(panels) for panels in (8, 16)}
+    return {nodes: probe_forces(nodes) for nodes in (16, 32)}
 
 
 def quadrature_errors(df: pd.DataFrame) -> dict[str, np.ndarray]:
@@ -170,21 +170,23 @@ def quadrature_errors(df: pd.DataFrame) -> dict[str, np.ndarray]:
 
 
 def test_contact_forces_match_the_reference_quadrature_for_driving_slips(probes):
-    """Simpson with 8 panels per piece against the reference's Gauss-Legendre: sinkage 1 mm to
-    0.3 m, slip 0..1, pointwise relative error below 1e-4."""
-    df = probes[8]
+    """Gauss-Legendre with 16 nodes per piece (the models' default) against the reference:
+    sinkage 1 mm to 0.3 m, slip 0..1, pointwise relative error below 1e-6 (composite Simpson
+    with 17 nodes per piece, used before, reached 1e-4)."""
+    df = probes[16]
     driving = df["slip"].to_numpy() >= 0
     for name, error in quadrature_errors(df).items():
-        assert np.max(error[driving]) < 1e-4, name
+        assert np.max(error[driving]) < 1e-6, name
 
 
 def test_contact_forces_while_skidding_within_a_thousandth_of_the_load(probes):
     """Skidding, jx changes sign inside the patch and the shear stress has a kink there, which
-    Simpson does not split at: the error stays below 1e-3 of Fz and shrinks with more panels."""
-    errors = {panels: quadrature_errors(df)["scaled"] for panels, df in probes.items()}
-    skidding = probes[8]["slip"].to_numpy() < 0
-    assert np.max(errors[8][skidding]) < 1e-3
-    assert np.max(errors[16][skidding]) < np.max(errors[8][skidding]) / 4
+    the model's quadrature does not split at (the reference does): the error stays below 1e-3
+    of Fz and shrinks with more nodes."""
+    errors = {nodes: quadrature_errors(df)["scaled"] for nodes, df in probes.items()}
+    skidding = probes[16]["slip"].to_numpy() < 0
+    assert np.max(errors[16][skidding]) < 1e-3
+    assert np.max(errors[32][skidding]) < np.max(errors[16][skidding]) / 2
 
 
 SINKAGE_PROBE = """

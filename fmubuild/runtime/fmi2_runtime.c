@@ -109,6 +109,15 @@ typedef struct {
     /* followed by x[nx], u[nu], p[np], x_set[nx], F0[nx], J[nx*nx] (doubles) */
 } StateHeader;
 
+/* The last evaluation of the model (model_evaluate) and the exact point (t, x, u) it was made
+ * at: asking again at the same point reuses it. */
+typedef struct {
+    int valid;
+    double t;
+    double *x, *u, *xdot, *y, *holds, *values;
+    unsigned long long evaluations, reused;
+} Evaluation;
+
 typedef struct {
     fmi2CallbackFunctions cb;
     char *name;
@@ -131,6 +140,7 @@ typedef struct {
     casadi_int *iw;
     double *w;
     double *seed_x, *seed_u, *sens_x, *sens_y;
+    Evaluation eval;
     Ode23s solver;
 } Instance;
 
@@ -225,12 +235,35 @@ static const double *inputs_at(Instance *c, double t) {
     return c->u_step;
 }
 
-static int call4(Instance *c, casadi_eval f, double t, const double *x, double *out0, double *out1) {
-    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = inputs_at(c, t); c->arg[3] = c->p;
-    c->res[0] = out0; c->res[1] = out1; c->res[2] = NULL;
-    if (f == model_outputs) { c->res[1] = c->holds; c->res[2] = c->assert_values; }
-    return f(c->arg, c->res, c->iw, c->w, 0);
+static int same(const double *a, const double *b, int n) {
+    return n == 0 || memcmp(a, b, sizeof(double) * (size_t)n) == 0;
 }
+
+/* Derivatives, outputs and asserts at (t, x) with the inputs at t, into c->eval. The derivatives
+ * and outputs share one evaluation of the model (one sinkage solve per wheel), and the last one
+ * is reused at the same point, bit for bit: the outputs right after a step are those of its
+ * last stage, and the next step starts from them when the inputs did not change. Parameters
+ * change only through calls that clear it (forget_evaluation). */
+static int evaluate(Instance *c, double t, const double *x) {
+    const double *u = inputs_at(c, t);
+    Evaluation *e = &c->eval;
+    if (e->valid && e->t == t && same(e->x, x, model_info.nx) && same(e->u, u, model_info.nu)) {
+        e->reused++;
+        return 0;
+    }
+    e->valid = 0;
+    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = u; c->arg[3] = c->p;
+    c->res[0] = e->xdot; c->res[1] = e->y; c->res[2] = e->holds; c->res[3] = e->values;
+    e->evaluations++;
+    if (model_evaluate(c->arg, c->res, c->iw, c->w, 0)) return -1;
+    e->t = t;
+    if (model_info.nx) memcpy(e->x, x, sizeof(double) * (size_t)model_info.nx);
+    if (model_info.nu) memcpy(e->u, u, sizeof(double) * (size_t)model_info.nu);
+    e->valid = 1;
+    return 0;
+}
+
+static void forget_evaluation(Instance *c) { c->eval.valid = 0; }
 
 static int all_finite(const double *v, int n) {
     for (int i = 0; i < n; i++) if (!isfinite(v[i])) return 0;
@@ -239,12 +272,16 @@ static int all_finite(const double *v, int n) {
 
 static int rhs(void *ctx, double t, const double *x, double *xdot) {
     Instance *c = ctx;
-    return call4(c, model_ode, t, x, xdot, NULL);
+    if (evaluate(c, t, x)) return -1;
+    if (model_info.nx) memcpy(xdot, c->eval.xdot, sizeof(double) * (size_t)model_info.nx);
+    return 0;
 }
 
 static int jacobian(void *ctx, double t, const double *x, double *dfdx, double *dfdt) {
     Instance *c = ctx;
-    return call4(c, model_ode_jacobian, t, x, dfdx, dfdt);
+    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = inputs_at(c, t); c->arg[3] = c->p;
+    c->res[0] = dfdx; c->res[1] = dfdt;
+    return model_ode_jacobian(c->arg, c->res, c->iw, c->w, 0);
 }
 
 /* States whose start value is an expression of the parameters, unless the user set them. */
@@ -299,21 +336,27 @@ static fmi2Status update(Instance *c, Function f, int need_xdot, int need_y) {
         if (check_parameters(c, f) != fmi2OK || initial_states(c, f) != fmi2OK) return fmi2Error;
     }
     fmi2Status status = fmi2OK;
-    if (need_y && !c->y_valid) {
-        int failed = call4(c, model_outputs, c->t, c->x, c->y, NULL);
+    if ((need_y && !c->y_valid) || (need_xdot && !c->xdot_valid)) {
+        int failed = evaluate(c, c->t, c->x);
+        Evaluation *e = &c->eval;
+        size_t n_values = (size_t)model_info.assert_value_start[model_info.n_asserts];
+        if (!failed) {
+            if (model_info.ny) memcpy(c->y, e->y, sizeof(double) * (size_t)model_info.ny);
+            if (model_info.nx) memcpy(c->xdot, e->xdot, sizeof(double) * (size_t)model_info.nx);
+            if (model_info.n_asserts) memcpy(c->holds, e->holds, sizeof(double) * (size_t)model_info.n_asserts);
+            if (n_values) memcpy(c->assert_values, e->values, sizeof(double) * n_values);
+        }
         fmi2Status checked = failed ? fmi2OK : check_asserts(c, f);
         if (checked == fmi2Error) return fmi2Error;
         if (failed || !all_finite(c->y, model_info.ny))
             return fail(c, f, BROKEN, "the outputs are not finite at t = %.17g", c->t);
-        c->y_valid = 1;
-        status = checked;
-    }
-    /* After the outputs: a parameter out of range is reported by its assert, not as a non-finite
-     * derivative. */
-    if (need_xdot && !c->xdot_valid) {
-        if (call4(c, model_ode, c->t, c->x, c->xdot, NULL) || !all_finite(c->xdot, model_info.nx))
+        /* After the outputs: a parameter out of range is reported by its assert, not as a
+         * non-finite derivative. */
+        if (need_xdot && !all_finite(c->xdot, model_info.nx))
             return fail(c, f, BROKEN, "the derivatives are not finite at t = %.17g", c->t);
+        c->y_valid = 1;
         c->xdot_valid = 1;
+        status = checked;
     }
     return status;
 }
@@ -338,6 +381,7 @@ static void set_defaults(Instance *c) {
     c->mode = MODE_INSTANTIATED;
     c->solver.h = 0.0;
     c->solver.jac_valid = 0;
+    forget_evaluation(c);
     invalidate(c);
 }
 
@@ -356,17 +400,18 @@ fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn, s
 static void free_instance(Instance *c) {
     fmi2CallbackFreeMemory release = c->cb.freeMemory;
     void *blocks[] = {c->name, c->p, c->x, c->u, c->u_der, c->u_step, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
-                      (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y};
+                      (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y,
+                      c->eval.x, c->eval.u, c->eval.xdot, c->eval.y, c->eval.holds, c->eval.values};
     for (size_t i = 0; i < sizeof(blocks) / sizeof(blocks[0]); i++) if (blocks[i]) release(blocks[i]);
     ode23s_free(&c->solver, release);
     release(c);
 }
 
-static casadi_work const WORKS[] = {model_ode_work, model_outputs_work, model_initial_work,
+static casadi_work const WORKS[] = {model_evaluate_work, model_initial_work,
                                     model_ode_jacobian_work, model_directional_work};
 
 static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
-    casadi_int sz_arg = 6, sz_res = 3, sz_iw = 0, sz_w = 0;
+    casadi_int sz_arg = 6, sz_res = 4, sz_iw = 0, sz_w = 0;
     for (size_t i = 0; i < sizeof(WORKS) / sizeof(WORKS[0]); i++) {
         casadi_int a = 0, r = 0, iw = 0, w = 0;
         WORKS[i](&a, &r, &iw, &w);
@@ -397,9 +442,17 @@ static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     c->seed_u = alloc(nu, sizeof(double));
     c->sens_x = alloc(nx, sizeof(double));
     c->sens_y = alloc(ny, sizeof(double));
+    Evaluation *e = &c->eval;
+    e->x = alloc(nx, sizeof(double));
+    e->u = alloc(nu, sizeof(double));
+    e->xdot = alloc(nx, sizeof(double));
+    e->y = alloc(ny, sizeof(double));
+    e->holds = alloc(model_info.n_asserts ? (size_t)model_info.n_asserts : 1, sizeof(double));
+    e->values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
     int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
     return c->p && c->x && c->u && c->u_der && c->u_step && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
-           c->seed_u && c->sens_x && c->sens_y && !solver_failed;
+           c->seed_u && c->sens_x && c->sens_y && e->x && e->u && e->xdot && e->y && e->holds && e->values &&
+           !solver_failed;
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
@@ -554,7 +607,7 @@ fmi2Status fmi2SetReal(fmi2Component component, const fmi2ValueReference vr[], s
     }
     for (size_t i = 0; i < nvr; i++) {
         int r = real_index(vr[i]);
-        if (r < off_x()) c->p[r] = value[i];
+        if (r < off_x()) { c->p[r] = value[i]; forget_evaluation(c); }
         else if (r < off_dx()) { c->x[r - off_x()] = value[i]; c->x_set[r - off_x()] = 1.0; }
         else if (r >= off_u() && r < off_y()) c->u[r - off_u()] = value[i];
         else if (r == vr_rtol()) c->rtol = value[i];
@@ -654,6 +707,7 @@ static void state_read(Instance *c, const unsigned char *payload) {
     c->t = head.t;
     c->rtol = head.rtol;
     c->max_step = head.max_step;
+    forget_evaluation(c);
     invalidate(c);
     c->solver.f0_valid = head.f0_valid != 0;
     c->solver.jac_valid = head.jac_valid != 0;

@@ -25,7 +25,7 @@ typedef struct {
     int n_asserts;                    /* Modelica asserts, checked by the runtime */
     const char *const *assert_messages;    /* [n_asserts] */
     const int *assert_is_error;            /* [n_asserts] 1: error, 0: warning */
-    const int *assert_value_start;         /* [n_asserts + 1] offsets into the values of model_outputs */
+    const int *assert_value_start;         /* [n_asserts + 1] offsets into the values of model_evaluate */
     const char *const *assert_value_names; /* names of those values, for the message */
 } ModelInfo;
 
@@ -35,13 +35,10 @@ extern const ModelInfo model_info;
 typedef int (*casadi_eval)(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 typedef int (*casadi_work)(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
 
-/* model_ode(t, x, u, p) -> xdot */
-int model_ode(const double **arg, double **res, casadi_int *iw, double *w, int mem);
-int model_ode_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-/* model_outputs(t, x, u, p) -> (y: observed variables, holds [n_asserts]: nonzero where an assert's
- * condition holds, values: the variables each condition reads, for the message) */
-int model_outputs(const double **arg, double **res, casadi_int *iw, double *w, int mem);
-int model_outputs_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+/* model_evaluate(t, x, u, p) -> (xdot, y: observed variables, holds [n_asserts]: nonzero where an
+ * assert's condition holds, values: the variables each condition reads, for the message) */
+int model_evaluate(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+int model_evaluate_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
 /* model_initial(p) -> x0 */
 int model_initial(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 int model_initial_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);

@@ -129,6 +129,9 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
         double remaining = t_end - *t;
         double h_try = h;
         if (h >= remaining || remaining - h < h_min) h = remaining;
+        /* The last stage lands on t_end exactly: the model evaluated there is the one the
+         * outputs after the step ask for. */
+        const double t_new = (h == remaining) ? t_end : *t + h;
         if (++attempts > s->max_steps) {
             snprintf(msg, msg_len, "more than %ld steps between t = %.17g and %.17g (last step size %.3g s)",
                      s->max_steps, *t, t_end, h);
@@ -150,7 +153,7 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
             for (int i = 0; i < n; i++) s->k2[i] = s->F1[i] - s->k1[i];
             lu_solve(s->W, n, s->pivot, s->k2);
             for (int i = 0; i < n; i++) { s->k2[i] += s->k1[i]; s->xn[i] = x[i] + h * s->k2[i]; }
-            ok = s->rhs(s->ctx, *t + h, s->xn, s->F2) == 0 && all_finite(s->F2, n);
+            ok = s->rhs(s->ctx, t_new, s->xn, s->F2) == 0 && all_finite(s->F2, n);
             s->rhs_calls++;
         }
         if (ok) {
@@ -166,7 +169,7 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
             if (!isfinite(err)) err = INFINITY;
         }
         if (err <= 1.0) {
-            *t = (h == remaining) ? t_end : *t + h;
+            *t = t_new;
             for (int i = 0; i < n; i++) { x[i] = s->xn[i]; s->F0[i] = s->F2[i]; }
             s->steps++;
             double grow = err > 0.0 ? fmin(5.0, 0.8 * pow(err, -1.0 / 3.0)) : 5.0;

@@ -4,7 +4,7 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
-  parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
@@ -20,7 +20,7 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   output Real sinkage[6](each unit="m") "Sinkage of each wheel";
   output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
   RoverTerramechanics.Components.Chassis body(rover=rover, slope=slope) "Body and limbs";
-  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nPanels=nPanels, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
+  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
   for i in 1:6 loop
     wheels[i].tau = tau[i];

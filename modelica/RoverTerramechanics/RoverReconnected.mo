@@ -3,7 +3,7 @@ model RoverReconnected "RoverBody and six Wheel models reconnected at the hubs: 
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
-  parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
@@ -20,12 +20,12 @@ model RoverReconnected "RoverBody and six Wheel models reconnected at the hubs: 
   output Real sinkage[6](each unit="m") "Sinkage of each wheel";
   output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
   RoverTerramechanics.RoverBody body(rover=rover, slope=slope) "The body FMU's model";
-  RoverTerramechanics.Wheel wheel1(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel2(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel3(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel4(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel5(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel6(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.Wheel wheel1(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.Wheel wheel2(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.Wheel wheel3(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.Wheel wheel4(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.Wheel wheel5(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.Wheel wheel6(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
 equation
   // The connections of the co-simulated rover, one wheel instance per FMU instance:
   // body.W[i] -> wheel_i.W, body.v_hub[i] -> wheel_i.v_hub, wheel_i.Fx -> body.Fx[i],

@@ -6,7 +6,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   parameter Real g(unit="m/s2") = 1.62 "Gravity (lunar)";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   parameter Real slipAngle(unit="rad") = 0 "Angle of the carriage's track to the wheel plane (Ishigami's test bed), positive: the hub slides to the wheel's left";
-  parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
@@ -24,7 +24,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   output Real beta(unit="rad") "Slip angle of the hub velocity in the wheel frame: slipAngle + trackAngle";
   output Real v(unit="m/s", start=0, fixed=true) "Carriage (hub) velocity along the ground";
   output Real x(unit="m", start=0, fixed=true) "Carriage position along the ground";
-  RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, wheel=wheel, nPanels=nPanels, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick) "The wheel";
+  RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick) "The wheel";
 equation
   rigidWheel.tau = tau;
   rigidWheel.W = W*cos(slope);

@@ -2,7 +2,7 @@ within RoverTerramechanics.Components;
 model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, drive torque in, contact forces, slip and sinkage out, in every motion regime"
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
-  parameter Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
@@ -21,7 +21,7 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left (Ishigami et al. 2007)";
   output Real slipAngle(unit="rad") "Slip angle of the hub velocity, seen from the direction of travel";
 equation
-  (slip, sinkage, Fx, Fz, Tx, entryAngle, Fy, slipAngle) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub, soil, wheel, vEps, vHold, vStick, nPanels, nIterations, v_lat);
+  (slip, sinkage, Fx, Fz, Tx, entryAngle, Fy, slipAngle) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub, soil, wheel, vEps, vHold, vStick, nNodes, nIterations, v_lat);
   wheel.J*der(omega) = tau - Tx;
   assert(soil.c >= 0, "soil.c: the cohesion must be >= 0 Pa");
   assert(soil.phi > 0 and soil.phi < 1.5707963267948966, "soil.phi: the internal friction angle must be in (0, pi/2) rad");

@@ -4,7 +4,7 @@ function contactForces "Contact forces Fx, Fz and torque Tx of a rigid wheel at 
   input Real slip(unit="1") "Slip ratio";
   input RoverTerramechanics.Parameters.SoilParameters soil "Soil";
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
-  input Integer nPanels = 8 "Simpson panels on each side of thetaM (2 intervals, 3 nodes each)";
+  input Integer nNodes = 16 "Gauss-Legendre nodes on each side of thetaM";
   input Real slipAngle(unit="rad") = 0 "Slip angle beta of the hub velocity (Ishigami et al. 2007), |beta| < pi/2";
   output Real Fx(unit="N") "Longitudinal force (drawbar pull), Eq. (12)";
   output Real Fz(unit="N") "Vertical force, Eq. (11)";
@@ -16,16 +16,18 @@ protected
   Real thetaF(unit="rad") "Entry angle, Eq. (1)";
   Real thetaR(unit="rad") "Exit angle, Eq. (2), negative";
   Real thetaM(unit="rad") "Angle of maximum normal stress, Eq. (3)";
-  Real u "Position along a piece, 0..1";
-  Real w "Simpson weight of a node, without the interval width";
+  Real u "Gauss-Legendre node on [0, 1]";
+  Real w "Its weight";
+  Real s "Position of the node along a piece, u^2, from the end where the stress vanishes";
+  Real ds "Weight of the node in s: 2 u w";
   Real theta(unit="rad");
   Real sigma(unit="Pa");
   Real tau(unit="Pa");
   Real sumFz(unit="Pa");
   Real sumFx(unit="Pa");
   Real sumTau(unit="Pa");
-  Real dFront(unit="rad") "Front interval width";
-  Real dRear(unit="rad") "Rear interval width";
+  Real dFront(unit="rad") "Front piece, thetaF - thetaM";
+  Real dRear(unit="rad") "Rear piece, thetaM - thetaR";
   Real kx(unit="m") "Shear deformation modulus at this slip angle";
   Real ky(unit="m") "Lateral shear deformation modulus at this slip angle";
   Real tanBeta(unit="1") "tan of the slip angle";
@@ -46,35 +48,38 @@ algorithm
   thetaF := acos(1 - hc/wheel.r);
   thetaR := -acos(1 - soil.lam*hc/wheel.r);
   thetaM := (soil.a0 + soil.a1*slip)*thetaF;
-  dFront := (thetaF - thetaM)/(2*nPanels);
-  dRear := (thetaM - thetaR)/(2*nPanels);
+  dFront := thetaF - thetaM;
+  dRear := thetaM - thetaR;
   Fx := 0;
   Fz := 0;
   Tx := 0;
-  for i in 0:2*nPanels loop
-    u := i/(2*nPanels);
-    w := (if i == 0 or i == 2*nPanels then 1.0 else if mod(i, 2) == 1 then 4.0 else 2.0)/3.0;
-    // Front piece [thetaM, thetaF], Eq. (5).
-    theta := thetaM + (thetaF - thetaM)*u;
+  u := 0;
+  w := 0;
+  for i in 1:nNodes loop
+    (u, w) := gaussLegendre(nNodes, i);
+    s := u*u;
+    ds := 2*u*w;
+    // Front piece [thetaM, thetaF], Eq. (5), nodes crowding at thetaF.
+    theta := thetaF - dFront*s;
     sigma := normalStress(theta, thetaF, soil, wheel);
     tau := shearStress(sigma, theta, thetaF, slip, soil, wheel, kx);
-    Fz := Fz + w*dFront*(sigma*cos(theta) + tau*sin(theta));
-    Fx := Fx + w*dFront*(tau*cos(theta) - sigma*sin(theta));
-    Tx := Tx + w*dFront*tau;
-    sumFy := sumFy + w*dFront*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
+    Fz := Fz + ds*dFront*(sigma*cos(theta) + tau*sin(theta));
+    Fx := Fx + ds*dFront*(tau*cos(theta) - sigma*sin(theta));
+    Tx := Tx + ds*dFront*tau;
+    sumFy := sumFy + ds*dFront*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
     depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
-    sumPile := sumPile + w*dFront*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
-    // Rear piece [thetaR, thetaM], Eq. (6): the equivalent front angle of this node is the
-    // front node thetaF - (thetaF - thetaM)*u.
-    theta := thetaR + (thetaM - thetaR)*u;
-    sigma := normalStress(thetaF - (thetaF - thetaM)*u, thetaF, soil, wheel);
+    sumPile := sumPile + ds*dFront*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
+    // Rear piece [thetaR, thetaM], Eq. (6), nodes crowding at thetaR: the equivalent front
+    // angle of this node, thetaF - (theta - thetaR)/dRear*dFront, is the front node's, so the
+    // normal stress is the one just computed.
+    theta := thetaR + dRear*s;
     tau := shearStress(sigma, theta, thetaF, slip, soil, wheel, kx);
-    Fz := Fz + w*dRear*(sigma*cos(theta) + tau*sin(theta));
-    Fx := Fx + w*dRear*(tau*cos(theta) - sigma*sin(theta));
-    Tx := Tx + w*dRear*tau;
-    sumFy := sumFy + w*dRear*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
+    Fz := Fz + ds*dRear*(sigma*cos(theta) + tau*sin(theta));
+    Fx := Fx + ds*dRear*(tau*cos(theta) - sigma*sin(theta));
+    Tx := Tx + ds*dRear*tau;
+    sumFy := sumFy + ds*dRear*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
     depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
-    sumPile := sumPile + w*dRear*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
+    sumPile := sumPile + ds*dRear*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
   end for;
   Fz := wheel.r*wheel.b*Fz;
   Fx := wheel.r*wheel.b*Fx;
@@ -95,10 +100,17 @@ algorithm
 </ul>
 <p>over &theta;<sub>r</sub> &le; &theta; &le; &theta;<sub>f</sub>. The normal stress has a kink at
 &theta;<sub>m</sub>, so [&theta;<sub>r</sub>, &theta;<sub>m</sub>] and [&theta;<sub>m</sub>,
-&theta;<sub>f</sub>] are integrated separately, each by composite Simpson with
-<code>nPanels</code> panels (2 nPanels + 1 nodes). With n = 1 and 8 panels the error against the
-Python reference (Gauss-Legendre) is below 1e-4 relative for driving slips; the test suite
-measures it.</p>
+&theta;<sub>f</sub>] are integrated separately, each by Gauss-Legendre with <code>nNodes</code>
+nodes (<code>gaussLegendre</code>) in s = u<sup>2</sup>, measured from the end of the piece where
+&sigma; vanishes (&theta;<sub>f</sub> in front, &theta;<sub>r</sub> behind), as the Python
+reference does: the substitution turns the end-point behaviour (&theta;<sub>f</sub> -
+&theta;)<sup>n</sup> of &sigma; into a smooth integrand for n = 1 and a milder singularity for
+other n. With the same s on both pieces the rear node's equivalent front angle of Eq. (6) is the
+front node's, so &sigma; is evaluated once per pair. Measured on the Table 2 soil against 2000
+nodes (sinkage 3 mm to 0.3 m): with 16 nodes the error is below 3e-10 of F<sub>z</sub> for
+driving slips (composite Simpson with 17 nodes per piece, used before: 1e-4); while skidding,
+where &tau; has a kink at j<sub>x</sub> = 0 inside the patch, 4e-6 of F<sub>z</sub> up to
+h = 0.1 m and 6e-4 for a wheel sunk deeper (Simpson-17: 4e-6 and 7e-4). The test suite measures it against the Python reference.</p>
 <p>Lateral force (Ishigami, Miwa, Nagatani, Yoshida, J. Field Robotics 24(3), 2007) at the slip
 angle &beta;: k<sub>x</sub> and k<sub>y</sub> grow with |&beta;|; lateral shear from
 j<sub>y</sub> = r(1 - s)(&theta;<sub>f</sub> - &theta;) tan &beta; (<code>lateralShear</code>);

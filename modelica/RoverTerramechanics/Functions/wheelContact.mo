@@ -4,7 +4,7 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   input Real slip(unit="1") "Slip ratio";
   input RoverTerramechanics.Parameters.SoilParameters soil "Soil";
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
-  input Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  input Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   input Integer nIterations = 12 "Bound on the number of force evaluations";
   input Real tolerance(unit="1") = 1e-10 "Relative tolerance on Fz/W - 1";
   input Real WMin(unit="N") = 1e-3 "Smallest load considered (a lifted wheel)";
@@ -50,7 +50,7 @@ algorithm
   for k in 1:nIterations loop
     if not done then
       h := exp(x);
-      (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nPanels, slipAngle);
+      (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nNodes, slipAngle);
       // A skidding wheel that has barely sunk can have Fz <= 0: treat it as "too shallow".
       f := if noEvent(Fz > 0) then log(Fz/load) else -1e3;
       if noEvent(abs(f) <= tolerance) then
@@ -88,7 +88,7 @@ is replaced by bisection. The loop is bounded by <code>nIterations</code> evalua
 Table 2 soil it converges to 1e-10 in at most 5 for loads 1 N to 5 kN and slips -1 to 1
 (measured with the same algorithm on the Python reference). If the soil cannot carry W even at h = r the result is h = r
 with F<sub>z</sub> &lt; W.</p>
-<p>Same method as the Python reference <code>terramechanics.wheel_state</code> (which uses
-Gauss-Legendre quadrature instead of Simpson).</p>
+<p>Same method as the Python reference <code>terramechanics.wheel_state</code> (which also splits
+the patch where a skidding wheel's shear displacement changes sign).</p>
 </html>"));
 end wheelContact;

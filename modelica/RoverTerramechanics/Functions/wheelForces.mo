@@ -8,7 +8,7 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   input Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   input Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   input Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
-  input Integer nPanels = 8 "Simpson panels (2 intervals each) per piece of the contact patch";
+  input Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   input Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   input Real vLat(unit="m/s") = 0 "Speed of the hub to the wheel's left (lateral, in the wheel frame)";
   output Real slip(unit="1") "Slip ratio, Eq. (4)";
@@ -35,7 +35,7 @@ algorithm
   slip := slipRatio(wheel.r*omega, v, vEps);
   direction := if noEvent(v > 0) then 1.0 else if noEvent(v < 0) then -1.0 else if noEvent(omega < 0) then -1.0 else 1.0;
   slipAngle := atan2(direction*vLat, noEvent(max(abs(v), vEps)));
-  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall) := wheelContact(W, direction*slip, soil, wheel, nPanels, nIterations,
+  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall) := wheelContact(W, direction*slip, soil, wheel, nNodes, nIterations,
     1e-10, 1e-3, slipAngle);
   thetaF := acos(1 - h/wheel.r);
   thetaR := -acos(1 - soil.lam*h/wheel.r);
