@@ -12,7 +12,7 @@ Generated per model (the runtime in ``fmubuild/runtime`` is the same for all):
 - ``model_data.c``: the ``ModelInfo`` of ``runtime/model.h`` (sizes, defaults, names, GUID).
 
 Real value references follow ``runtime/model.h``: parameters, states, derivatives, inputs, observed
-variables (outputs and locals), then the two solver parameters.
+variables (outputs and locals), then the two solver parameters and the runtime's statistics.
 """
 
 from __future__ import annotations
@@ -35,6 +35,16 @@ SOLVER_PARAMETERS = (
      "Largest internal step of the Co-Simulation integrator; 0: only the communication step limits it"),
 )
 
+#: Counters of the runtime, since the instance was made (read-only locals after the solver
+#: parameters): what a benchmark or a curious user reads to see where the time goes.
+STATISTICS = (
+    ("statistics.evaluations", "Evaluations of the model (derivatives and outputs together)"),
+    ("statistics.reusedEvaluations", "Requests answered by the last evaluation (same time, states and inputs)"),
+    ("statistics.jacobians", "Evaluations of the Jacobian by the Co-Simulation integrator"),
+    ("statistics.steps", "Accepted steps of the Co-Simulation integrator"),
+    ("statistics.rejectedSteps", "Rejected steps of the Co-Simulation integrator"),
+)
+
 
 @dataclass(frozen=True)
 class FmuVariable:
@@ -42,7 +52,7 @@ class FmuVariable:
 
     name: str
     value_reference: int
-    kind: str  # "parameter", "state", "derivative", "input", "observed", "solver"
+    kind: str  # "parameter", "state", "derivative", "input", "observed", "solver", "statistic"
     causality: str
     variability: str
     initial: str | None
@@ -145,6 +155,9 @@ def _variables(model: OdeModel, starts: list[float], calculated: list[bool]) -> 
     for name, value, unit, description in SOLVER_PARAMETERS:
         add(name=name, kind="solver", causality="parameter", variability="tunable", initial="exact", start=value,
             unit=unit, description=description)
+    for name, description in STATISTICS:
+        add(name=name, kind="statistic", causality="local", variability="continuous", initial="calculated",
+            start=None, unit="1", description=description)
     return variables
 
 

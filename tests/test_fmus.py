@@ -326,6 +326,42 @@ def test_fmu_state_get_set_and_serialize_reproduce_the_trajectory(fmus, tmp_path
     fmu.freeInstance()
 
 
+STATISTICS = ["statistics.evaluations", "statistics.reusedEvaluations", "statistics.jacobians", "statistics.steps",
+              "statistics.rejectedSteps"]
+
+
+def test_outputs_after_a_step_reuse_its_last_evaluation_and_match_a_fresh_one(fmus, tmp_path):
+    """The runtime keeps the model's last evaluation with its exact (t, x, u): the outputs right
+    after a step are those of the step's last stage (no new evaluation), a new input value makes
+    the next step evaluate again, and the values equal those of a fresh instance restored to the
+    same state (which has nothing to reuse)."""
+    fmu, vr = started(fmus, "Wheel", tmp_path, {"W": 575.0, "tau": 40.0, "v_hub": 0.3})
+    stats = [vr[n] for n in STATISTICS]
+    outputs = [vr[n] for n in ("Fx", "sinkage", "slip", "Tx")]
+    fmu.doStep(0.0, 1e-3)
+    before = fmu.getReal(stats)
+    first = fmu.getReal(outputs)
+    fmu.getReal(outputs)
+    assert fmu.getReal(stats) == before  # nothing evaluated for the outputs
+    fmu.doStep(1e-3, 1e-3)
+    stepped = fmu.getReal(stats)
+    # The stages of at least one step, and the outputs at its end answered by the last one.
+    assert stepped[3] >= before[3] + 1 and stepped[0] >= before[0] + 2 and stepped[1] == before[1] + 1
+    state = fmu.getFMUstate()
+    second = fmu.getReal(outputs)
+    other, _ = started(fmus, "Wheel", tmp_path, {"W": 575.0, "tau": 40.0, "v_hub": 0.3}, instance="b")
+    other.setFMUstate(state)
+    assert other.getReal([vr["statistics.reusedEvaluations"]]) == [0.0]
+    assert other.getReal(outputs) == second  # bit for bit: a fresh evaluation at the same point
+    assert first != second
+    with pytest.raises(Exception, match="status 3"):
+        fmu.setReal([vr["statistics.steps"]], [0.0])
+    fmu.freeFMUstate(state)
+    for instance in (fmu, other):
+        instance.terminate()
+        instance.freeInstance()
+
+
 def test_reset_returns_to_the_start(fmus, tmp_path):
     fmu, vr = started(fmus, "SingleWheel", tmp_path, {"W": 275.0, "tau": 30.0})
     first = run_steps(fmu, vr, 0.0, 50, ["v", "slip"])

@@ -154,7 +154,9 @@ static int off_u(void) { return model_info.np + 2 * model_info.nx; }
 static int off_y(void) { return model_info.np + 2 * model_info.nx + model_info.nu; }
 static int vr_rtol(void) { return off_y() + model_info.ny; }
 static int vr_max_step(void) { return vr_rtol() + 1; }
-static int n_real(void) { return vr_max_step() + 1; }
+static int vr_statistics(void) { return vr_max_step() + 1; }
+#define N_STATISTICS 5 /* codegen.STATISTICS */
+static int n_real(void) { return vr_statistics() + N_STATISTICS; }
 
 /* A value reference as an index, or -1 when it is no Real variable (compared unsigned, so
  * 0xFFFFFFFF and values >= 2^31 are out of range, not negative). */
@@ -538,8 +540,10 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
 fmi2Status fmi2Terminate(fmi2Component component) {
     ENTER(F_Terminate);
     if (c->type == fmi2CoSimulation)
-        log_message(c, fmi2OK, "logStatistics", "integrator: %ld steps, %ld rejected, %ld Jacobians, %ld derivative evaluations",
-                    c->solver.steps, c->solver.rejected, c->solver.jacobians, c->solver.rhs_calls);
+        log_message(c, fmi2OK, "logStatistics", "integrator: %ld steps, %ld rejected, %ld Jacobians, %ld derivative "
+                    "requests; model: %llu evaluations, %llu requests answered by the last one",
+                    c->solver.steps, c->solver.rejected, c->solver.jacobians, c->solver.rhs_calls,
+                    c->eval.evaluations, c->eval.reused);
     c->mode = MODE_TERMINATED;
     return fmi2OK;
 }
@@ -551,6 +555,17 @@ fmi2Status fmi2Reset(fmi2Component component) {
 }
 
 /* ---- values ----------------------------------------------------------------------------- */
+/* The runtime's counters, in the order of codegen.STATISTICS. */
+static double statistic(const Instance *c, int k) {
+    switch (k) {
+    case 0: return (double)c->eval.evaluations;
+    case 1: return (double)c->eval.reused;
+    case 2: return (double)c->solver.jacobians;
+    case 3: return (double)c->solver.steps;
+    default: return (double)c->solver.rejected;
+    }
+}
+
 fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     ENTER(F_GetReal);
     NOT_NULL(F_GetReal, vr, nvr);
@@ -573,7 +588,8 @@ fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], s
         else if (r < off_y()) value[i] = c->u[r - off_u()];
         else if (r < vr_rtol()) value[i] = c->y[r - off_y()];
         else if (r == vr_rtol()) value[i] = c->rtol;
-        else value[i] = c->max_step;
+        else if (r == vr_max_step()) value[i] = c->max_step;
+        else value[i] = statistic(c, r - vr_statistics());
     }
     return fmi2OK;
 }
@@ -590,6 +606,7 @@ static const char *set_real_refusal(const Instance *c, int r, double value) {
     if (r >= off_y() && r < vr_rtol()) return "is calculated by the model: it cannot be set";
     if (r == vr_rtol() && !(value > 0.0 && value < 1.0)) return "expected 0 < tolerance < 1";
     if (r == vr_max_step() && !(value >= 0.0)) return "expected >= 0 (0: no limit besides the communication step)";
+    if (r >= vr_statistics()) return "is a statistic of the runtime: it cannot be set";
     return NULL;
 }
 
