@@ -70,13 +70,19 @@ lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/mypy
 
-## bench: benchmarks (not tests) -> results/bench/*.json
-bench: $(STAMP)
+## bench: benchmarks (not tests) -> results/bench/*.json (installs the bench extra: ecospy)
+BENCH_STAMP := $(VENV)/.installed-bench
+$(BENCH_STAMP): $(STAMP)
+	$(PY) -m pip install --quiet -e '.[bench]'
+	@touch $@
+
+bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
 	$(PY) -P benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
 	$(PY) -P benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
 	$(PY) -P benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
 	$(PY) -P benchmarks/bench_controller.py --out $(RESULTS)/bench/controller.json --model $(RESULTS)/identification/model.json
+	$(PY) -P benchmarks/bench_closed_loop.py --out $(RESULTS)/bench/closed_loop.json --model $(RESULTS)/identification/model.json
 
 clean:
 	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

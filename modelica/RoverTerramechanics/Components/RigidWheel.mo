@@ -20,8 +20,9 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   output Real entryAngle(unit="rad") "Entry angle, Eq. (1), signed with the direction of travel";
   output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left (Ishigami et al. 2007)";
   output Real slipAngle(unit="rad") "Slip angle of the hub velocity, seen from the direction of travel";
+  Real contactEvaluations(unit="1") "Force evaluations of the sinkage solve at this point (a cost, for benchmarks)";
 equation
-  (slip, sinkage, Fx, Fz, Tx, entryAngle, Fy, slipAngle) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub, soil, wheel, vEps, vHold, vStick, nNodes, nIterations, v_lat);
+  (slip, sinkage, Fx, Fz, Tx, entryAngle, Fy, slipAngle, contactEvaluations) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub, soil, wheel, vEps, vHold, vStick, nNodes, nIterations, v_lat);
   wheel.J*der(omega) = tau - Tx;
   assert(soil.c >= 0, "soil.c: the cohesion must be >= 0 Pa");
   assert(soil.phi > 0 and soil.phi < 1.5707963267948966, "soil.phi: the internal friction angle must be in (0, pi/2) rad");

@@ -15,6 +15,7 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   output Real Tx(unit="N.m") "Resistance torque at h, Eq. (13)";
   output Real Fy(unit="N") "Lateral force at h";
   output Real FySidewall(unit="N") "Sidewall part of Fy";
+  output Real evaluations(unit="1") "Force evaluations the solve used";
 protected
   Real load(unit="N") "Load, floored at WMin";
   Real x "log(h/m), the iterate";
@@ -45,12 +46,14 @@ algorithm
   Tx := 0;
   Fy := 0;
   FySidewall := 0;
+  evaluations := 0;
   done := false;
   first := true;
   for k in 1:nIterations loop
     if not done then
       h := exp(x);
       (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nNodes, slipAngle);
+      evaluations := evaluations + 1;
       // A skidding wheel that has barely sunk can have Fz <= 0: treat it as "too shallow".
       f := if noEvent(Fz > 0) then log(Fz/load) else -1e3;
       if noEvent(abs(f) <= tolerance) then

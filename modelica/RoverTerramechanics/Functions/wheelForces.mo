@@ -19,6 +19,7 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   output Real entryAngle(unit="rad") "Entry angle, signed: positive ahead of the axle, negative behind it when reversing";
   output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left";
   output Real slipAngle(unit="rad") "Slip angle of the hub velocity, seen from the direction of travel";
+  output Real contactEvaluations(unit="1") "Force evaluations of the sinkage solve";
 protected
   Real direction "+1 travelling forwards, -1 backwards";
   Real FxSteady(unit="N") "Paper's Fx of the mirrored wheel";
@@ -35,8 +36,8 @@ algorithm
   slip := slipRatio(wheel.r*omega, v, vEps);
   direction := if noEvent(v > 0) then 1.0 else if noEvent(v < 0) then -1.0 else if noEvent(omega < 0) then -1.0 else 1.0;
   slipAngle := atan2(direction*vLat, noEvent(max(abs(v), vEps)));
-  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall) := wheelContact(W, direction*slip, soil, wheel, nNodes, nIterations,
-    1e-10, 1e-3, slipAngle);
+  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall, contactEvaluations) := wheelContact(W, direction*slip, soil, wheel,
+    nNodes, nIterations, 1e-10, 1e-3, slipAngle);
   thetaF := acos(1 - h/wheel.r);
   thetaR := -acos(1 - soil.lam*h/wheel.r);
   entryAngle := direction*thetaF;
