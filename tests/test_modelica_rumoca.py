@@ -194,9 +194,10 @@ model SinkageProbe
   Real W(unit="N");
   Real slip(unit="1");
   Real h(unit="m");
+  Real evaluations(unit="1");
 """ + PROBE_COMMON + """  W = 10^(0.5 + 3*time);
   slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*5*time));
-  (h, Fx, Fz, Tx, Fy, FySidewall) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
+  (h, Fx, Fz, Tx, Fy, FySidewall, evaluations) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
 end SinkageProbe;
 """
 
@@ -209,6 +210,8 @@ def test_wheel_contact_carries_the_load_and_matches_the_reference_sinkage():
     np.testing.assert_allclose(df["Fz"], load, rtol=1e-9)
     state = wheel_state(load, slip)
     np.testing.assert_allclose(df["h"], state.sinkage, rtol=1e-4)
+    # The solve's own count: within the documented 5 force evaluations, never at the bound of 12.
+    assert df["evaluations"].min() >= 1 and df["evaluations"].max() <= 5
 
 
 SLIP_PROBE = """
