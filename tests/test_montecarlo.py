@@ -7,6 +7,7 @@ damaged file, a Dask LocalCluster gives the rows of local processes)."""
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -313,3 +314,22 @@ def test_cli_runs_a_study_and_prints_the_share_meeting_1_n(model, fmu_dir, tmp_p
     printed = capsys.readouterr().out
     assert "2 runs computed, 0 from the cache, 0 failed" in printed and "RMS(Fx - Fx_des) <= 1 N" in printed
     assert len(pd.read_csv(out / "runs.csv")) == 2
+
+
+# --- the report ----------------------------------------------------------------------------------------
+
+def test_the_report_shows_the_study_when_it_was_run(study_run, tmp_path):
+    from rover_cosim.report import build_report
+    from rover_cosim.report.sections import montecarlo_section
+
+    folder = study_run.files[0].parent
+    section = "\n".join(montecarlo_section(folder))
+    text = re.sub(r"src='data:[^']*'", "", section)
+    assert "Monte Carlo over soil uncertainty" in text and "RMS ≤ 1 N on every limb [% of completed]" in text
+    assert "<td>75</td>" not in text and ">100<" in text   # 3 of the 3 completed runs meet 1 N
+    assert "nan" not in text.lower() and text.count("<table") == text.count("<div class='scroll'><table") >= 1
+    assert "not produced" not in text and "No sensitivity ranking" in text   # 3 runs, 3 parameters: none
+    assert section.count("<img") == 2   # distributions and scatter; no ranking figure without a ranking
+    assert montecarlo_section(tmp_path / "none") == []   # no study run: no section
+    page = build_report(folder.parent)
+    assert "Monte Carlo over soil uncertainty" in page and "rover-cosim montecarlo" in page   # provenance too

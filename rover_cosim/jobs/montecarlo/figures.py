@@ -12,6 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.ticker import NullFormatter
 
 from rover_cosim.identification.figures import finish, png_bytes
 
@@ -40,8 +41,9 @@ def distributions(runs: pd.DataFrame, nominal: pd.Series | None) -> bytes:
             ax.axvline(RMS_FLOOR, color="tab:red", ls=":", lw=1.8, label="paper's floor, 1 N")
             if np.nanmax(values, initial=0) > 10 * max(np.nanmin(values, initial=1), 1e-3):
                 ax.set_xscale("log")
-        if column == "time_to_98_s" and np.isnan(values).any():
-            ax.set_title(f"{int(np.isnan(values).sum())} runs never reach 0.98 m/s (curve ends below 1)", fontsize=10)
+        never = int(np.isnan(values).sum())
+        if column == "time_to_98_s" and never:
+            ax.set_title(f"{never} of {len(values)} runs never reach 0.98 m/s (the curve ends below 1)", fontsize=10)
         ax.set_xlabel(OUTPUTS[column])
         ax.set_ylabel("share of runs ≤ x [-]")
         ax.set_ylim(0, 1.02)
@@ -77,6 +79,8 @@ def scatter(runs: pd.DataFrame, parameters: list[str], labels: dict[str, str], n
     rows = math.ceil(len(parameters) / columns)
     fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows), squeeze=False)
     stuck = runs["stuck"].astype(bool).to_numpy()
+    errors = runs["rms_Fx_max_N"].to_numpy(float)
+    spread = bool(np.nanmax(errors, initial=0) > 10 * max(np.nanmin(errors, initial=1), 1e-3))   # log y
     for ax, name in zip(axes.ravel(), parameters):
         ax.scatter(runs.loc[~stuck, name], runs.loc[~stuck, "rms_Fx_max_N"], s=14, alpha=0.7, label="runs")
         if stuck.any():
@@ -88,6 +92,9 @@ def scatter(runs: pd.DataFrame, parameters: list[str], labels: dict[str, str], n
         ax.axhline(RMS_FLOOR, color="tab:red", ls=":", lw=1.5, label="1 N")
         if name in logarithmic:
             ax.set_xscale("log")
+            ax.xaxis.set_minor_formatter(NullFormatter())   # decades only: the minor labels overlap
+        if spread:
+            ax.set_yscale("log")
         ax.set_xlabel(labels.get(name, name))
         ax.set_ylabel("largest RMS(Fx - Fx_des) [N]")
     for ax in axes.ravel()[len(parameters):]:
