@@ -390,10 +390,12 @@ def _print_montecarlo(outcome) -> None:  # noqa: ANN001 - MonteCarloResult, impo
         print(f"{scenario}: {numbers['completed']} of {numbers['runs']} runs completed; RMS(Fx - Fx_des) <= 1 N on "
               f"every limb in {numbers['meeting_1N_rms']} ({'-' if share is None else f'{100 * share:.1f} %'} of "
               f"the completed); stuck in {numbers['stuck']}")
-    ranking = outcome.sensitivity[outcome.sensitivity["output"] == "rms_Fx_max_N"].dropna(subset=["prcc"])
+    ranking = outcome.sensitivity[outcome.sensitivity["output"] == "rms_Fx_max_N"].dropna(subset=["rank"])
     if len(ranking):
-        print("Sensitivity of the largest RMS(Fx - Fx_des) (partial rank correlation):")
-        print(ranking.sort_values("rank")[["rank", "parameter", "prcc", "spearman", "p_value"]]
+        print("Sensitivity of the largest RMS(Fx - Fx_des) (rank correlations: partial, and with the distance "
+              "from the nominal value):")
+        print(ranking.sort_values("rank")[["rank", "parameter", "prcc", "p_value", "distance_spearman",
+                                           "distance_p_value", "strongest"]]
               .to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     for path in outcome.files:
         print(f"wrote {path}")

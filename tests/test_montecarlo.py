@@ -174,6 +174,19 @@ def test_sensitivity_ranks_the_parameter_that_drives_the_output_first():
     assert late.loc["c", "spearman"] > 0.99 and late.loc["c", "rank"] == 1
 
 
+def test_sensitivity_finds_an_output_that_worsens_both_ways_from_the_nominal():
+    """A V around the nominal (the controller is exact there): invisible to PRCC, caught by the
+    rank correlation with the distance from the nominal value (in ln for a log-normal parameter)."""
+    rng = np.random.default_rng(1)
+    runs = pd.DataFrame({"a": rng.uniform(size=300), "k": np.exp(rng.normal(size=300))})
+    runs["rms_Fx_max_N"] = np.abs(np.log(runs["k"])) + 0.5 * runs["a"] + 0.01 * rng.normal(size=300)
+    table = sensitivity.sensitivity(runs, ["a", "k"], nominal={"a": 0.5, "k": 1.0}, logarithmic={"k"})
+    rms = table[table["output"] == "rms_Fx_max_N"].set_index("parameter")
+    assert abs(rms.loc["k", "prcc"]) < 0.2 and rms.loc["k", "distance_spearman"] > 0.95
+    assert rms.loc["k", "rank"] == 1 and rms.loc["k", "strongest"] == "distance from nominal"
+    assert rms.loc["a", "strongest"] == "monotonic" and rms.loc["a", "p_value"] < 0.01 < rms.loc["k", "p_value"]
+
+
 def test_sensitivity_of_too_few_runs_is_empty_not_wrong():
     runs = pd.DataFrame({"a": [1.0, 2.0, 3.0], "b": [3.0, 1.0, 2.0], "rms_Fx_max_N": [1.0, 2.0, 3.0]})
     table = sensitivity.sensitivity(runs, ["a", "b"])
@@ -285,6 +298,24 @@ def test_a_dask_cluster_on_loopback_gives_the_rows_of_local_processes(study_run,
     pd.testing.assert_frame_equal(remote.runs.drop(columns="wall_s"), study_run.runs.drop(columns="wall_s"))
 
 
+def test_the_path_scenario_runs_on_the_steerable_rover(fmu_dir, model, tmp_path):
+    study = _study(runs=2, seed=3, stop_time=0.3, path_stop_time=0.3, scenarios=["straight", "path"],
+                   parameters={"soil.kphi": {"distribution": "lognormal", "median": 8.14e5, "sigma": 0.5},
+                               "rover.M": {"distribution": "uniform", "lower": 1500.0, "upper": 1600.0}})
+    result = run_montecarlo(study, fmu_dir, model, tmp_path / "montecarlo", workers=1)
+    runs = result.runs.set_index(["sample", "scenario"])
+    assert (runs["status"] == "ok").all() and len(runs) == 4
+    assert np.isfinite(runs.loc[(1, "path"), "cross_track_rms_m"]) and np.isnan(runs.loc[(1, "straight"),
+                                                                                          "cross_track_rms_m"])
+    assert set(result.summary["scenarios"]) == {"straight", "path"}
+
+
+def test_a_parameter_no_fmu_has_is_refused_naming_it(fmu_dir):
+    study = _study(parameters={"rover.mass": {"distribution": "uniform", "lower": 1.0, "upper": 2.0}})
+    with pytest.raises(StudyError, match="'rover.mass': not a parameter of Rover.fmu"):
+        nominal_values(study, choose(), fmu_dir)
+
+
 # --- the command line ----------------------------------------------------------------------------------
 
 def test_cli_refuses_bad_input_naming_it(tmp_path, capsys):
@@ -328,8 +359,8 @@ def test_the_report_shows_the_study_when_it_was_run(study_run, tmp_path):
     assert "Monte Carlo over soil uncertainty" in text and "RMS ≤ 1 N on every limb [% of completed]" in text
     assert "<td>75</td>" not in text and ">100<" in text   # 3 of the 3 completed runs meet 1 N
     assert "nan" not in text.lower() and text.count("<table") == text.count("<div class='scroll'><table") >= 1
-    assert "not produced" not in text and "No sensitivity ranking" in text   # 3 runs, 3 parameters: none
-    assert section.count("<img") == 2   # distributions and scatter; no ranking figure without a ranking
+    assert "not produced" not in text and "No sensitivity ranking" not in text and "PRCC [-]" in text
+    assert section.count("<img") == 3   # distributions, ranking, scatter
     assert montecarlo_section(tmp_path / "none") == []   # no study run: no section
     page = build_report(folder.parent)
     assert "Monte Carlo over soil uncertainty" in page and "rover-cosim montecarlo" in page   # provenance too

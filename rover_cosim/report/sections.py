@@ -252,17 +252,20 @@ def montecarlo_section(montecarlo: Path) -> list[str]:
     sections.append(table(pd.DataFrame(rows), {"runs": "{:.0f}", "completed": "{:.0f}", "failed": "{:.0f}",
                                                "stuck": "{:.0f}"}, default="{:.3g}"))
     ranking_path = montecarlo / "sensitivity.csv"
-    ranking = pd.read_csv(ranking_path) if ranking_path.exists() else pd.DataFrame(columns=["output", "prcc", "rank"])
-    ranking = ranking[ranking["output"] == "rms_Fx_max_N"].dropna(subset=["prcc"]).sort_values("rank")
+    ranking = pd.read_csv(ranking_path) if ranking_path.exists() else pd.DataFrame(columns=["output", "rank"])
+    ranking = ranking[ranking["output"] == "rms_Fx_max_N"].dropna(subset=["rank"]).sort_values("rank")
     if not len(ranking):
-        sections.append("<p>No sensitivity ranking: it needs more completed runs than parameters + 1.</p>")
+        sections.append("<p>No sensitivity ranking: too few completed runs.</p>")
     else:
         shown = pd.DataFrame({"rank": ranking["rank"].astype(int).astype(str), "parameter": ranking["parameter"],
-                              "PRCC [-]": ranking["prcc"], "Spearman [-]": ranking["spearman"],
-                              "p-value": ranking["p_value"]})
-        sections += ["<p>Which parameter matters most for the largest RMS(Fx - Fx_des): partial rank "
-                     "correlation coefficients (monotonic effects, correlated inputs allowed; every output's "
-                     "ranking in <code>sensitivity.csv</code>):</p>", table(shown, default="{:.3g}")]
+                              "PRCC [-]": ranking["prcc"], "p-value": ranking["p_value"],
+                              "ρ with distance from nominal [-]": ranking["distance_spearman"],
+                              "its p-value": ranking["distance_p_value"], "strongest": ranking["strongest"]})
+        sections += ["<p>Which parameter matters most for the largest RMS(Fx - Fx_des): partial rank correlation "
+                     "coefficients (monotonic effects, correlated inputs allowed) and the rank correlation with "
+                     "the parameter's distance from its nominal value (the controller is identified there, so it "
+                     "may degrade whichever way the soil departs); ranked by the larger. Every output's ranking "
+                     "is in <code>sensitivity.csv</code>.</p>", table(shown, default="{:.3g}")]
     figures = (("fig_distributions.png", "distributions of the outcomes over the sampled soils"),
                ("fig_sensitivity.png", "sensitivity ranking (PRCC)"),
                ("fig_scatter.png", "largest RMS(Fx - Fx_des) against each parameter"))

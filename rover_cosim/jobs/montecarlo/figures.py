@@ -53,22 +53,28 @@ def distributions(runs: pd.DataFrame, nominal: pd.Series | None) -> bytes:
 
 
 def ranking(table: pd.DataFrame, labels: dict[str, str]) -> bytes:
-    """Horizontal bars of the PRCC of each parameter, for the worst-limb RMS and the position lag."""
-    shown = [o for o in ("rms_Fx_max_N", "position_lag_m", "time_to_98_s") if o in set(table["output"])]
+    """Horizontal bars per parameter: the PRCC (monotonic effect) and the rank correlation with the
+    distance from the nominal value (V-shaped effect), for the worst-limb RMS and the position lag."""
+    shown = [o for o in ("rms_Fx_max_N", "position_lag_m") if o in set(table["output"])]
     first = table[table["output"] == shown[0]].sort_values("rank", ascending=False) if shown else table
     parameters = list(first["parameter"])
-    fig, ax = plt.subplots(figsize=(10, 1.2 + 0.55 * len(parameters) * max(len(shown), 1) / 1.6))
-    height = 0.8 / max(len(shown), 1)
-    for k, output in enumerate(shown):
-        values = table[table["output"] == output].set_index("parameter").loc[parameters, "prcc"]
-        ax.barh(np.arange(len(parameters)) + (k - (len(shown) - 1) / 2) * height, values, height=height,
-                label=OUTPUTS[output])
+    bars = [(o, m) for o in shown for m in ("prcc", "distance_spearman")]
+    fig, ax = plt.subplots(figsize=(10, 1.5 + 0.32 * len(parameters) * max(len(bars), 1)))
+    height = 0.84 / max(len(bars), 1)
+    colours = {"rms_Fx_max_N": "tab:blue", "position_lag_m": "tab:orange"}
+    for k, (output, measure) in enumerate(bars):
+        values = table[table["output"] == output].set_index("parameter").loc[parameters, measure]
+        what = "PRCC (monotonic)" if measure == "prcc" else "ρ with distance from nominal"
+        ax.barh(np.arange(len(parameters)) - (k - (len(bars) - 1) / 2) * height, values, height=height,
+                color=colours[output], alpha=1.0 if measure == "prcc" else 0.45,
+                hatch="" if measure == "prcc" else "//", label=f"{OUTPUTS[output]}: {what}")
     ax.set_yticks(np.arange(len(parameters)), [labels.get(p, p) for p in parameters])
     ax.axvline(0.0, color="k", lw=0.8)
     ax.set_xlim(-1, 1)
-    ax.set_xlabel("partial rank correlation coefficient (PRCC) [-]: > 0 the output grows with the parameter")
-    ax.set_title("Sensitivity ranking (most influential at the top, by |PRCC| on the largest RMS)")
+    ax.set_xlabel("rank correlation [-]: > 0 the output grows with the parameter (or with its distance from nominal)")
+    ax.set_title("Sensitivity ranking, most influential on the largest RMS at the top")
     finish(ax)
+    ax.legend(fontsize=8, loc="lower left")
     return png_bytes(fig)
 
 
@@ -92,7 +98,9 @@ def scatter(runs: pd.DataFrame, parameters: list[str], labels: dict[str, str], n
         ax.axhline(RMS_FLOOR, color="tab:red", ls=":", lw=1.5, label="1 N")
         if name in logarithmic:
             ax.set_xscale("log")
-            ax.xaxis.set_minor_formatter(NullFormatter())   # decades only: the minor labels overlap
+            values = runs[name].to_numpy(float)
+            if np.nanmax(values) >= 10 * np.nanmin(values):   # decades labelled: the minor labels would overlap
+                ax.xaxis.set_minor_formatter(NullFormatter())
         if spread:
             ax.set_yscale("log")
         ax.set_xlabel(labels.get(name, name))

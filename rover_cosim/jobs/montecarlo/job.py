@@ -18,6 +18,7 @@ results/montecarlo/
 from __future__ import annotations
 
 import json
+import os
 import time
 import warnings
 from collections.abc import Callable
@@ -171,7 +172,8 @@ def _cost(runs: pd.DataFrame, computed: int, seconds: float, workers: int | None
           scheduler: str | None) -> dict[str, Any]:
     """What the runs cost: wall time of the computing, runs per minute, mean wall time of one run."""
     walls = runs["wall_s"].dropna() if "wall_s" in runs else pd.Series(dtype=float)
-    return {"workers": workers, "scheduler": scheduler, "compute_wall_seconds": seconds,
+    local = None if scheduler else (workers or os.cpu_count() or 1)   # parallel_map's default: all cores
+    return {"workers": local, "scheduler": scheduler, "compute_wall_seconds": seconds,
             "runs_per_minute": 60 * computed / seconds if computed and seconds > 0 else None,
             "mean_run_wall_seconds": float(walls.mean()) if len(walls) else None}
 
@@ -242,7 +244,9 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     runs, failures = _tables(study, samples, results, errors)
     straight = runs[(runs["scenario"] == "straight") & (runs["status"] == "ok")] if "straight" in study.scenarios \
         else runs.iloc[0:0]
-    ranking = sensitivity(straight, study.names) if len(straight) else sensitivity(straight, study.names, {})
+    logarithmic = {p.name for p in study.parameters if p.kind == "lognormal"}
+    ranking = sensitivity(straight, study.names, OUTPUTS if len(straight) else {},
+                          nominal_values(study, nominal_choice, fmu_dir), logarithmic)
     numbers = _summary_numbers(study, runs)
     summary = run_record("rover-cosim montecarlo", study.settings())
     summary.update({
@@ -274,6 +278,6 @@ def _figures(study: Study, straight: pd.DataFrame, ranking: pd.DataFrame) -> dic
     logarithmic = {p.name for p in study.parameters if p.kind == "lognormal"}
     out: dict[str, bytes] = {"fig_distributions.png": figures.distributions(straight, nominal),
                              "fig_scatter.png": figures.scatter(straight, study.names, labels, nominal, logarithmic)}
-    if len(ranking) and ranking["prcc"].notna().any():
+    if len(ranking) and ranking["rank"].notna().any():
         out["fig_sensitivity.png"] = figures.ranking(ranking, labels)
     return out

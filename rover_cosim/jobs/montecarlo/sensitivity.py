@@ -1,6 +1,6 @@
 """Which uncertain parameter matters most: rank correlations of each output with each parameter (pure).
 
-Two measures, both on ranks (so any monotonic effect counts, whatever its shape or units):
+Rank correlations (so any monotonic effect counts, whatever its shape or units):
   spearman   Spearman's rank correlation of the output with the parameter alone;
   prcc       the partial rank correlation coefficient: the correlation of the output's ranks
              and the parameter's ranks after the linear effect of every other parameter's ranks
@@ -11,8 +11,11 @@ work with the study's plain Monte Carlo samples of any size, with correlated inp
 copula) and with the samples that failed left out; Sobol indices need Saltelli's design of
 N (2d + 2) runs and independent inputs, and an extra dependency. What rank correlations miss:
 non-monotonic effects and interactions (a scatter plot per parameter, figures.py, shows them).
-An output that is NaN (e.g. 0.98 m/s never reached) ranks after every finite value: never is
-the slowest.
+The identified controller is exact at the nominal soil, so an output may worsen whichever way a
+parameter departs from it (a V shape, invisible to both measures): a third measure, the Spearman
+correlation of the output with the parameter's distance from its nominal value, catches that
+(sensitivity's ``distance_spearman``); the ranking takes the larger of the two. An output that is
+NaN (e.g. 0.98 m/s never reached) ranks after every finite value: never is the slowest.
 """
 
 from __future__ import annotations
@@ -62,24 +65,59 @@ def prcc(inputs: np.ndarray, output: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return coefficients, p_values
 
 
-def sensitivity(runs: pd.DataFrame, parameters: list[str], outputs: dict[str, str] = OUTPUTS) -> pd.DataFrame:
-    """output, parameter, spearman, prcc, p_value, rank (1: largest |prcc| for that output; empty
-    without a PRCC), n,
-    from the completed runs (one row per run, the parameters' and outputs' columns)."""
+def distances(runs: pd.DataFrame, nominal: dict[str, float], logarithmic: set[str]) -> pd.DataFrame:
+    """Each parameter's distance from its nominal value: |x - x0|, or |ln x - ln x0| for the
+    parameters in ``logarithmic`` (log-normal ones, whose spread is a factor)."""
+    table = {}
+    for name, centre in nominal.items():
+        values = runs[name].to_numpy(float)
+        table[name] = np.abs(np.log(values / centre)) if name in logarithmic else np.abs(values - centre)
+    return pd.DataFrame(table, index=runs.index)
+
+
+def _spearman(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """Spearman's rho of ``a`` and ``b`` (NaN in ``b`` ranked last) with its p-value (t test)."""
+    n = len(a)
+    rho = _correlation(_ranks(a), _ranks(b)) if n > 2 else float("nan")
+    if not np.isfinite(rho):
+        return float("nan"), float("nan")
+    t = rho * np.sqrt((n - 2) / max(1.0 - rho * rho, 1e-300))
+    return rho, float(2 * stats.t.sf(abs(t), n - 2))
+
+
+def sensitivity(runs: pd.DataFrame, parameters: list[str], outputs: dict[str, str] = OUTPUTS,
+                nominal: dict[str, float] | None = None, logarithmic: frozenset[str] | set[str] = frozenset(),
+                ) -> pd.DataFrame:
+    """output, parameter, spearman, prcc, p_value, distance_spearman, distance_p_value, strongest,
+    rank, n from the completed runs (one row per run, the parameters' and outputs' columns).
+
+    distance_spearman: Spearman's rho of the output with the parameter's distance from ``nominal``
+    (``distances``): a controller identified at the nominal soil may degrade whichever way the soil
+    departs from it, a V-shaped effect that rank correlations with the value itself miss. The rank
+    (1: most influential; empty without either measure) orders by the larger of |prcc| and
+    |distance_spearman|; ``strongest`` says which it was ("monotonic" or "distance from nominal")."""
     rows = []
     inputs = runs[parameters].to_numpy(float)
+    away = distances(runs, {p: nominal[p] for p in parameters}, set(logarithmic)).to_numpy(float) \
+        if nominal is not None else np.full_like(inputs, np.nan)
     for output in (o for o in outputs if o in runs.columns):
         values = runs[output].to_numpy(float)
         coefficients, p_values = prcc(inputs, values)
-        ranked = _ranks(values)
-        order = np.argsort(-np.nan_to_num(np.abs(coefficients), nan=-1.0), kind="stable")
+        distance = [_spearman(away[:, j], values) for j in range(len(parameters))]
+        strength = np.fmax(np.abs(coefficients), np.abs([d[0] for d in distance]))
+        order = np.argsort(-np.nan_to_num(strength, nan=-1.0), kind="stable")
         rank = np.empty(len(parameters))
         rank[order] = np.arange(1, len(parameters) + 1)
-        rank[np.isnan(coefficients)] = np.nan   # no ranking without a PRCC
+        rank[np.isnan(strength)] = np.nan   # no ranking without a measure
         for j, name in enumerate(parameters):
-            rows.append({"output": output, "parameter": name,
-                         "spearman": _correlation(_ranks(inputs[:, j]), ranked) if len(runs) > 2 else float("nan"),
-                         "prcc": coefficients[j], "p_value": p_values[j], "rank": rank[j], "n": len(runs)})
-    table = pd.DataFrame(rows, columns=["output", "parameter", "spearman", "prcc", "p_value", "rank", "n"])
+            by_distance = bool(np.nan_to_num(abs(distance[j][0]), nan=-1) > np.nan_to_num(abs(coefficients[j]), nan=-1))
+            rows.append({"output": output, "parameter": name, "spearman": _spearman(inputs[:, j], values)[0],
+                         "prcc": coefficients[j], "p_value": p_values[j], "distance_spearman": distance[j][0],
+                         "distance_p_value": distance[j][1],
+                         "strongest": "" if np.isnan(strength[j]) else
+                         ("distance from nominal" if by_distance else "monotonic"),
+                         "rank": rank[j], "n": len(runs)})
+    table = pd.DataFrame(rows, columns=["output", "parameter", "spearman", "prcc", "p_value", "distance_spearman",
+                                        "distance_p_value", "strongest", "rank", "n"])
     table["rank"] = table["rank"].astype("Int64")
     return table

@@ -76,6 +76,9 @@ class Distribution:
 
 @dataclass(frozen=True)
 class Study:
+    """A study: its distributions, correlation, number of runs and seed, the scenarios and their
+    stop times, and the nominal soil and wheel (library names or files)."""
+
     title: str
     runs: int
     seed: int
