@@ -19,6 +19,9 @@ from pathlib import Path
 
 import pandas as pd
 
+#: read_csv's options for floats read back exactly (none needed from pandas 3 on, where the option is deprecated)
+_ROUND_TRIP: dict[str, str] = {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
+
 
 def checksum_file(path: Path) -> Path:
     return path.with_name(path.name + ".sha256")
@@ -34,18 +37,21 @@ def _atomic_write(target: Path, data: bytes) -> None:
         Path(temporary).unlink(missing_ok=True)
 
 
-def write_run(target: Path, data: pd.DataFrame) -> None:
-    """The run's CSV, then its checksum (so a checksum always describes a whole file)."""
+def write_run(target: Path, data: pd.DataFrame, float_format: str | None = "%.12g") -> None:
+    """The run's CSV, then its checksum (so a checksum always describes a whole file).
+    ``float_format`` None writes every float exactly (shortest repr that reads back the same)."""
     target = Path(target)
-    payload = data.to_csv(index=False, float_format="%.12g").encode()
+    payload = data.to_csv(index=False, float_format=float_format).encode()
     _atomic_write(target, payload)
     record = {"sha256": hashlib.sha256(payload).hexdigest(), "rows": len(data), "columns": list(data.columns)}
     _atomic_write(checksum_file(target), json.dumps(record).encode())
 
 
-def read_run(path: Path, rows: int, columns: list[str]) -> tuple[pd.DataFrame | None, str | None]:
+def read_run(path: Path, rows: int, columns: list[str], exact: bool = False) -> tuple[pd.DataFrame | None, str | None]:
     """(the run, None) when the file is whole and as expected; (None, why not) otherwise, or
-    (None, None) when there is no file at all."""
+    (None, None) when there is no file at all. ``exact``: every float as written, to the last bit
+    (pandas >= 3 reads so by default; older pandas' default parser may be one unit in the last
+    place off, and needs its round-trip parser)."""
     path = Path(path)
     check = checksum_file(path)
     if not path.exists():  # never written, or removed on purpose (a checksum left alone goes too)
@@ -61,7 +67,7 @@ def read_run(path: Path, rows: int, columns: list[str]) -> tuple[pd.DataFrame | 
     if not isinstance(record, dict) or hashlib.sha256(payload).hexdigest() != record.get("sha256"):
         return None, "its content does not match its checksum (cut short or changed)"
     try:
-        data = pd.read_csv(io.BytesIO(payload))
+        data = pd.read_csv(io.BytesIO(payload), **_ROUND_TRIP if exact else {})
     except (ValueError, pd.errors.ParserError) as error:
         return None, f"not a readable CSV ({error})"
     if len(data) != rows or not set(columns) <= set(data.columns):

@@ -15,11 +15,9 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 import time
 import warnings
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import NamedTuple
@@ -30,6 +28,7 @@ from rover_cosim import terramechanics
 from rover_cosim.common.outputs import file_sha256
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.common.paper import TARGET_VELOCITY
+from rover_cosim.common.parallel import parallel_map
 from rover_cosim.terramechanics.library import from_fmu_parameters
 
 from .cache import discard, read_run, remove_partial_files, write_run
@@ -160,50 +159,8 @@ Result = tuple[Case, str | None, float]
 
 def _results(arguments: list[Arguments], workers: int | None, scheduler: str | None) -> Iterator[Result]:
     """compute_run for every argument tuple, on a Dask cluster, local processes or serially;
-    results in the order they complete."""
-    if scheduler is not None:
-        from dask.distributed import Client
-        from dask.distributed import as_completed as dask_completed
-
-        with Client(scheduler) as client:
-            for future in dask_completed([client.submit(compute_run, *a, pure=False) for a in arguments]):
-                yield future.result()
-        return
-    workers = workers or os.cpu_count() or 1
-    if workers < 1:
-        raise ValueError(f"workers = {workers!r}: expected >= 1")
-    if workers == 1 or len(arguments) <= 1:
-        yield from (compute_run(*a) for a in arguments)
-        return
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_end_with_parent)
-    try:
-        for future in as_completed([pool.submit(compute_run, *a) for a in arguments]):
-            yield future.result()
-    except BaseException:  # Ctrl-C, SIGTERM (raised as KeyboardInterrupt by the CLI), the consumer closing
-        _stop(pool)
-        raise
-    pool.shutdown()
-
-
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """Cancel what has not started and end the workers now."""
-    processes = list(getattr(pool, "_processes", {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for process in processes:
-        process.terminate()
-    for process in processes:
-        process.join(timeout=5)
-
-
-def _end_with_parent() -> None:
-    """In a worker: ask the kernel for SIGTERM when the parent process dies (Linux only)."""
-    try:
-        import ctypes
-        import signal
-
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG = 1
-    except (OSError, AttributeError):
-        pass
+    results in the order they complete (common.parallel)."""
+    return parallel_map(compute_run, arguments, workers, scheduler)
 
 
 def _cached(folder: Path, plan: SweepPlan) -> tuple[dict[Case, pd.DataFrame], dict[Path, str]]:

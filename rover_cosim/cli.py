@@ -134,6 +134,23 @@ def build_parser() -> argparse.ArgumentParser:
                           help="only the paper's straight run, or only the path following (default: both)")
     _add_soil_options(simulate)
 
+    monte = commands.add_parser("montecarlo", help="Monte Carlo over soil uncertainty: the paper's closed loop with "
+                                "the identified model on every sampled soil, local processes or a Dask cluster -> "
+                                "results/montecarlo/")
+    monte.add_argument("--study", default="lunar_regolith",
+                       help="study file (TOML), or a shipped study: lunar_regolith (default)")
+    monte.add_argument("--model", type=Path, default=Path("results/identification/model.json"),
+                       help="identified model (from `rover-cosim identify` on the study's nominal soil)")
+    monte.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are")
+    monte.add_argument("--out", type=Path, default=Path("results/montecarlo"), help="output folder")
+    monte.add_argument("--runs", type=int, default=None, help="number of samples, the nominal included "
+                       "(default: the study's)")
+    monte.add_argument("--seed", type=int, default=None, help="random seed (default: the study's)")
+    monte.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
+    monte.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
+    monte.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    monte.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+
     commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources")
     commands.add_parser("blocks", help="the block types of system files, with their keys, units and defaults")
 
@@ -333,6 +350,57 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _montecarlo(args: argparse.Namespace) -> int:
+    from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
+    from rover_cosim.progress import ProgressBar
+
+    for option, value, least in (("--workers", args.workers, 1), ("--runs", args.runs, 1), ("--seed", args.seed, 0)):
+        if value is not None and value < least:
+            print(f"rover-cosim montecarlo: {option} {value}: expected >= {least}", file=sys.stderr)
+            return 2
+    if not args.model.is_file():
+        print(f"rover-cosim montecarlo: identified model {args.model} not found (run `make identify`)",
+              file=sys.stderr)
+        return 2
+    try:
+        study = load_study(args.study, runs=args.runs, seed=args.seed)
+    except StudyError as error:
+        print(f"rover-cosim montecarlo: {error}", file=sys.stderr)
+        return 2
+    bar = ProgressBar("montecarlo", enabled=not args.quiet)
+    try:
+        outcome = run_montecarlo(study, args.fmu_dir, args.model, args.out, workers=args.workers,
+                                 scheduler=args.scheduler, cache_dir=args.cache, progress=bar)
+    except (OSError, RuntimeError, ValueError) as error:
+        bar.close()
+        print(f"rover-cosim montecarlo: {error} (nothing written)", file=sys.stderr)
+        return 1
+    bar.close()
+    _print_montecarlo(outcome)
+    return 0
+
+
+def _print_montecarlo(outcome) -> None:  # noqa: ANN001 - MonteCarloResult, imported lazily
+    summary = outcome.summary
+    print(f"{outcome.computed} runs computed, {outcome.cached} from the cache, {summary['runs_failed']} failed, "
+          f"{summary['wall_seconds']:.1f} s" + (f" ({summary['runs_per_minute']:.1f} runs/min)"
+                                                  if summary["runs_per_minute"] else ""))
+    for scenario, numbers in summary["scenarios"].items():
+        share = numbers["share_meeting_1N_rms_of_completed"]
+        print(f"{scenario}: {numbers['completed']} of {numbers['runs']} runs completed; RMS(Fx - Fx_des) <= 1 N on "
+              f"every limb in {numbers['meeting_1N_rms']} ({'-' if share is None else f'{100 * share:.1f} %'} of "
+              f"the completed); stuck in {numbers['stuck']}")
+    ranking = outcome.sensitivity[outcome.sensitivity["output"] == "rms_Fx_max_N"].dropna(subset=["rank"])
+    if len(ranking):
+        print("Sensitivity of the largest RMS(Fx - Fx_des) (rank correlations: partial, and with the distance "
+              "from the nominal value):")
+        print(ranking.sort_values("rank")[["rank", "parameter", "prcc", "p_value", "distance_spearman",
+                                           "distance_p_value", "strongest"]]
+              .to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for path in outcome.files:
+        print(f"wrote {path}")
+
+
 def _print_path(outcome) -> None:  # noqa: ANN001 - PathResult, imported lazily
     columns = {"cross_track_rms_m": "cross-track RMS [m]", "cross_track_max_m": "max [m]",
                "speed_error_max_percent": "speed error [%]"}
@@ -394,7 +462,7 @@ def _report(args: argparse.Namespace) -> int:
 
     target = args.out or args.results / "report.html"
     produced = [p for p in ("fig3_fx_vs_slip.csv", "identification/fit_models.csv", "simulation/rms.csv",
-                            "simulation/path_metrics.csv") if (args.results / p).exists()]
+                            "simulation/path_metrics.csv", "montecarlo/runs.csv") if (args.results / p).exists()]
     if not produced:
         print(f"rover-cosim report: nothing to report in {args.results} (no results of fig3, identify or "
               "simulate; run `make run`)", file=sys.stderr)
@@ -442,7 +510,7 @@ def _fig3(args: argparse.Namespace) -> int:
 
 COMMANDS = {"build-fmus": _build_fmus, "run": _run, "export-ssp": _export_ssp, "cosim-study": _cosim_study,
             "identify": _identify,
-            "simulate": _simulate, "report": _report, "fig3": _fig3, "soils": _soils,
+            "simulate": _simulate, "montecarlo": _montecarlo, "report": _report, "fig3": _fig3, "soils": _soils,
             "blocks": _blocks}
 
 

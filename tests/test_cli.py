@@ -17,8 +17,8 @@ def test_version(capsys):
     assert done.value.code == 0 and capsys.readouterr().out.strip() == f"rover-cosim {__version__}"
 
 
-@pytest.mark.parametrize("command", ["fig3", "run", "identify", "simulate", "cosim-study", "export-ssp", "report",
-                                     "build-fmus"])
+@pytest.mark.parametrize("command", ["fig3", "run", "identify", "simulate", "montecarlo", "cosim-study", "export-ssp",
+                                     "report", "build-fmus"])
 def test_help_shows_every_default_without_markup(command, capsys):
     with pytest.raises(SystemExit):
         main([command, "--help"])

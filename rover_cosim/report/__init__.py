@@ -23,6 +23,7 @@ def build_report(results: Path) -> str:
     parts += sections.closed_loop_section(simulation)
     parts += sections.path_section(simulation)
     parts += sections.coupling_section(results)
+    parts += sections.montecarlo_section(results / "montecarlo")
     parts += sections.scope_section(results)
     parts += sections.provenance_section(results)
     return document("rover-cosim report", parts)

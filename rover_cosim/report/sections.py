@@ -1,10 +1,11 @@
 """The sections of the report, each from the files one job wrote (a section whose files are
 missing says so): soil and wheel (Table 2), Fig. 3, identification (Table 1), the lateral force,
-the closed loop (Table 3, Fig. 10, tracking), path following, the coupling study, behaviour
-outside the paper's scope, provenance."""
+the closed loop (Table 3, Fig. 10, tracking), path following, the coupling study, Monte Carlo
+over soil uncertainty, behaviour outside the paper's scope, provenance."""
 
 from __future__ import annotations
 
+import html
 import json
 import math
 from dataclasses import asdict
@@ -227,6 +228,50 @@ def coupling_section(results: Path) -> list[str]:
             image(results / "cosim_study" / "coupling_error.png", "co-simulated against monolithic rover")]
 
 
+def montecarlo_section(montecarlo: Path) -> list[str]:
+    """Monte Carlo over soil uncertainty (shown only when results/montecarlo exists): the share of
+    runs meeting the paper's 1 N, quantiles, the sensitivity ranking and the figures."""
+    summary_path = montecarlo / "summary.json"
+    if not summary_path.exists():
+        return []
+    summary = json.loads(summary_path.read_text())
+    study = summary.get("parameters", {})
+    sections = ["<h2>Monte Carlo over soil uncertainty</h2>",
+                f"<p>Study <b>{html.escape(str(study.get('title') or study.get('file')))}</b>: {study.get('runs')} "
+                f"samples (seed {study.get('seed')}); sample 0 is the nominal soil the model was identified on "
+                f"({html.escape(str(study.get('soil')))}); the paper's closed loop, {study.get('stop_time_s')} s, "
+                "with the controller and the identified model unchanged.</p>"]
+    rows = []
+    for scenario, numbers in summary.get("scenarios", {}).items():
+        share = numbers.get("share_meeting_1N_rms_of_completed")
+        quantiles = numbers.get("quantiles", {}).get("rms_Fx_max_N", {})
+        rows.append({"scenario": scenario, "runs": numbers["runs"], "completed": numbers["completed"],
+                     "failed": numbers["failed"], "stuck": numbers["stuck"],
+                     "RMS ≤ 1 N on every limb [% of completed]": 100 * share if share is not None else float("nan"),
+                     "largest RMS, median [N]": quantiles.get("median"), "largest RMS, 95 % [N]": quantiles.get("p95")})
+    sections.append(table(pd.DataFrame(rows), {"runs": "{:.0f}", "completed": "{:.0f}", "failed": "{:.0f}",
+                                               "stuck": "{:.0f}"}, default="{:.3g}"))
+    ranking_path = montecarlo / "sensitivity.csv"
+    ranking = pd.read_csv(ranking_path) if ranking_path.exists() else pd.DataFrame(columns=["output", "rank"])
+    ranking = ranking[ranking["output"] == "rms_Fx_max_N"].dropna(subset=["rank"]).sort_values("rank")
+    if not len(ranking):
+        sections.append("<p>No sensitivity ranking: too few completed runs.</p>")
+    else:
+        shown = pd.DataFrame({"rank": ranking["rank"].astype(int).astype(str), "parameter": ranking["parameter"],
+                              "PRCC [-]": ranking["prcc"], "p-value": ranking["p_value"],
+                              "ρ with distance from nominal [-]": ranking["distance_spearman"],
+                              "its p-value": ranking["distance_p_value"], "strongest": ranking["strongest"]})
+        sections += ["<p>Which parameter matters most for the largest RMS(Fx - Fx_des): partial rank correlation "
+                     "coefficients (monotonic effects, correlated inputs allowed) and the rank correlation with "
+                     "the parameter's distance from its nominal value (the controller is identified there, so it "
+                     "may degrade whichever way the soil departs); ranked by the larger. Every output's ranking "
+                     "is in <code>sensitivity.csv</code>.</p>", table(shown, default="{:.3g}")]
+    figures = (("fig_distributions.png", "distributions of the outcomes over the sampled soils"),
+               ("fig_sensitivity.png", "sensitivity ranking (PRCC)"),
+               ("fig_scatter.png", "largest RMS(Fx - Fx_des) against each parameter"))
+    return sections + [image(montecarlo / name, caption) for name, caption in figures if (montecarlo / name).exists()]
+
+
 def scope_section(results: Path) -> list[str]:
     """What the wheel does outside the paper's scenario, with numbers from the results."""
     lines = ["<h2>Behaviour outside the paper's scope</h2>", "<div class='note'><ul>"]
@@ -250,6 +295,8 @@ def scope_section(results: Path) -> list[str]:
 
 
 def provenance_section(results: Path) -> list[str]:
-    return ["<h2>Provenance</h2>", *(provenance(path) for path in (
-        results / "fig3_fx_vs_slip.json", results / "identification" / "identification.json",
-        results / "simulation" / "simulation.json", results / "simulation" / "path_following.json"))]
+    records = [results / "fig3_fx_vs_slip.json", results / "identification" / "identification.json",
+               results / "simulation" / "simulation.json", results / "simulation" / "path_following.json"]
+    if (results / "montecarlo" / "summary.json").exists():  # an optional study: listed only when run
+        records.append(results / "montecarlo" / "summary.json")
+    return ["<h2>Provenance</h2>", *(provenance(path) for path in records)]

@@ -1,0 +1,69 @@
+"""Many independent calls of one function, on a Dask cluster, local processes or serially,
+with the results in the order they complete (the identification sweep and the Monte Carlo study).
+
+The function must be importable by name (the workers import it) and should not raise: it reports
+its own failures in what it returns, so that one failing call does not stop the others. The
+local worker processes end with the caller: on an error, Ctrl-C or SIGTERM (raised as
+KeyboardInterrupt by the CLI) or the consumer closing the generator, the pool is cancelled and
+its workers terminated; and each worker asks Linux to end it when its parent dies
+(PR_SET_PDEATHSIG), so a killed caller leaves no workers behind.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Any, TypeVar
+
+Result = TypeVar("Result")
+
+
+def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any, ...]], workers: int | None = None,
+                 scheduler: str | None = None) -> Iterator[Result]:
+    """``function(*a)`` for every ``a`` of ``arguments``: on the Dask cluster at ``scheduler``
+    (``tcp://host:port``) when given, else on ``workers`` local processes (default: all cores;
+    1: serially in this process). Results in the order they complete."""
+    if scheduler is not None:
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
+
+        with Client(scheduler) as client:
+            for future in dask_completed([client.submit(function, *a, pure=False) for a in arguments]):
+                yield future.result()
+        return
+    workers = workers or os.cpu_count() or 1
+    if workers < 1:
+        raise ValueError(f"workers = {workers!r}: expected >= 1")
+    if workers == 1 or len(arguments) <= 1:
+        yield from (function(*a) for a in arguments)
+        return
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_end_with_parent)
+    try:
+        for future in as_completed([pool.submit(function, *a) for a in arguments]):
+            yield future.result()
+    except BaseException:  # Ctrl-C, SIGTERM (raised as KeyboardInterrupt by the CLI), the consumer closing
+        _stop(pool)
+        raise
+    pool.shutdown()
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started and end the workers now."""
+    processes = list(getattr(pool, "_processes", {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.terminate()
+    for process in processes:
+        process.join(timeout=5)
+
+
+def _end_with_parent() -> None:
+    """In a worker: ask the kernel for SIGTERM when the parent process dies (Linux only)."""
+    try:
+        import ctypes
+        import signal
+
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        pass

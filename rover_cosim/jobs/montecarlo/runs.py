@@ -1,0 +1,162 @@
+"""One closed-loop run of a Monte Carlo study: one sample's soil (and rover) on one scenario,
+with the controller and the identified model unchanged, cached as a one-row CSV of its metrics.
+
+The plant is the one ``make simulate`` runs, built by the same functions (simulate.
+monolithic_system: Rover.fmu, 1 ms, Gauss-Seidel; path_following.monolithic_system: the lane
+change on SteerableRover.fmu); the sample changes only the FMUs' parameters: soil and wheel
+values through the soil library exactly as ``--set soil.c=500`` does (so a sample the soil model
+refuses, e.g. a negative cohesion, fails with the library's message), other names (``rover.M``)
+as FMU parameters. Sample 0 changes nothing: it is the nominal run, the same system as
+``make simulate``'s.
+
+The cache file of a run is named by a key: SHA-256 of the FMU's and the model's SHA-256, the
+scenario and its stop time and step, the nominal soil and wheel, the sample's values and the
+metrics' version; so a changed FMU, model or sample is computed again and nothing else is.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import fmpy
+import pandas as pd
+
+from rover_cosim.identification.cache import read_run, write_run
+from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.system import system_from_dict
+from rover_cosim.terramechanics.library import DEGREES, Choice, choose
+
+from .. import path_following, simulate
+from .metrics import PATH, STRAIGHT, path_metrics, straight_metrics
+from .study import Study, StudyError
+
+#: Bumped when a metric's definition changes: every cached run is then computed again.
+METRICS_VERSION = 1
+#: The path scenario of a study: the lane change at 1.0 m/s (the paper's speed).
+PATH_SCENARIO = "lane_change"
+#: The FMU of each scenario (in fmu_dir).
+FMUS = {"straight": "Rover.fmu", "path": "SteerableRover.fmu"}
+COLUMNS = {"straight": [*STRAIGHT, "wall_s"], "path": [*PATH, "wall_s"]}
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Everything a worker needs for one run (plain values: it travels to other processes)."""
+
+    sample: int
+    scenario: str                               # "straight" or "path"
+    fmu_dir: str
+    model: str
+    stop_time: float                            # s
+    soil: str                                   # the nominal soil and wheel (library names or files)
+    wheel: str
+    assignments: tuple[str, ...]                # the sample's soil and wheel values as --set takes them
+    parameters: tuple[tuple[str, float], ...]   # the sample's other FMU parameters (rover.M ...)
+    target: str                                 # the cache file
+
+
+def library_value(name: str, choice: Choice) -> float | None:
+    """The value of ``soil.X`` / ``wheel.X`` (degrees for *_deg) in ``choice``; None for other names."""
+    kind, _, key = name.partition(".")
+    if kind not in ("soil", "wheel"):
+        return None
+    record = choice.soil if kind == "soil" else choice.wheel
+    return math.degrees(getattr(record, DEGREES[key])) if key in DEGREES else float(getattr(record, key))
+
+
+def fmu_starts(fmu: Path) -> dict[str, float]:
+    """The parameters of an FMU with their start values."""
+    return {v.name: float(v.start) for v in fmpy.read_model_description(str(fmu)).modelVariables
+            if v.causality == "parameter" and v.start is not None}
+
+
+def nominal_values(study: Study, choice: Choice, fmu_dir: Path) -> dict[str, float]:
+    """Each study parameter's nominal value: the soil library's (the soil the model was identified
+    on), or the start value the FMU of every scenario has; StudyError for a name no FMU has."""
+    values: dict[str, float] = {}
+    starts = {scenario: fmu_starts(Path(fmu_dir) / FMUS[scenario]) for scenario in study.scenarios}
+    for name in study.names:
+        value = library_value(name, choice)
+        if value is None:
+            lacking = [FMUS[s] for s in study.scenarios if name not in starts[s]]
+            if lacking:
+                raise StudyError(f"parameter {name!r}: not a parameter of {', '.join(lacking)}; expected soil.NAME, "
+                                 "wheel.NAME or one of the FMU's parameters (e.g. rover.M)")
+            value = starts[study.scenarios[0]][name]
+        values[name] = value
+    return values
+
+
+def split(values: dict[str, float], nominal: bool) -> tuple[tuple[str, ...], tuple[tuple[str, float], ...]]:
+    """A sample's values as (--set assignments, other FMU parameters); the nominal sample has none."""
+    if nominal:
+        return (), ()
+    assignments = tuple(f"{name}={float(value)!r}" for name, value in values.items()
+                        if name.split(".")[0] in ("soil", "wheel"))
+    parameters = tuple((name, float(value)) for name, value in values.items()
+                       if name.split(".")[0] not in ("soil", "wheel"))
+    return assignments, parameters
+
+
+def cache_key(fingerprint: dict[str, Any], scenario: str, stop_time: float,
+              assignments: tuple[str, ...], parameters: tuple[tuple[str, float], ...]) -> str:
+    """The run's cache key (hex): ``fingerprint`` holds the FMUs', the model's and the nominal soil's."""
+    content = {"fingerprint": fingerprint, "scenario": scenario, "fmu": fingerprint["fmus"][FMUS[scenario]],
+               "stop_time": stop_time, "step": simulate.STEP, "set": list(assignments),
+               "parameters": [list(p) for p in parameters], "metrics_version": METRICS_VERSION}
+    return hashlib.sha256(json.dumps(content, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def fingerprint(fmu_hashes: dict[str, str], model_hash: str, nominal: Choice) -> dict[str, Any]:
+    """What every run of a study shares in its cache key."""
+    return {"fmus": fmu_hashes, "model": model_hash, "soil": asdict(nominal.soil), "wheel": asdict(nominal.wheel)}
+
+
+def _system(spec: RunSpec, choice: Choice) -> dict[str, Any]:
+    fmu_dir, model = Path(spec.fmu_dir), Path(spec.model)
+    if spec.scenario == "straight":
+        system = simulate.monolithic_system(fmu_dir, model, choice)
+    else:
+        system = path_following.monolithic_system(fmu_dir, model, PATH_SCENARIO, "inverse", choice)
+    system["simulation"]["stop_time"] = spec.stop_time
+    system["fmu"][0]["parameters"].update(dict(spec.parameters))
+    return system
+
+
+def simulate_run(spec: RunSpec) -> dict[str, float | bool]:
+    """The run's metrics (raises on a sample the soil library or the FMU refuses)."""
+    choice = choose(spec.soil, spec.wheel, spec.assignments)
+    system = system_from_dict(_system(spec, choice), name=f"Monte Carlo sample {spec.sample} ({spec.scenario})",
+                              base=Path(spec.fmu_dir))
+    outcome = run(system)
+    if spec.scenario == "straight":
+        row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"))
+    else:
+        table = path_following.trajectories(outcome.data, cosim=False)
+        row = path_metrics(table, path_following.metrics(table, path_following.SCENARIOS[PATH_SCENARIO]))
+    row["wall_s"] = outcome.wall_seconds
+    return row
+
+
+def compute_run(spec: RunSpec) -> tuple[int, str, str | None, float]:
+    """Run one sample on one scenario and cache its metrics. Returns (sample, scenario, error,
+    seconds); never raises, so that a failing sample does not stop the study (runs in workers)."""
+    started = time.perf_counter()
+    try:
+        write_run(Path(spec.target), pd.DataFrame([simulate_run(spec)]), float_format=None)
+        return spec.sample, spec.scenario, None, time.perf_counter() - started
+    except Exception as error:  # noqa: BLE001 - recorded per run, the study goes on
+        return spec.sample, spec.scenario, f"{type(error).__name__}: {error}", time.perf_counter() - started
+
+
+def read_cached(spec: RunSpec) -> tuple[dict[str, Any] | None, str | None]:
+    """(the run's metrics, None) from a whole cache file; (None, why not) for a damaged one;
+    (None, None) when there is none."""
+    data, problem = read_run(Path(spec.target), 1, COLUMNS[spec.scenario], exact=True)
+    return (None, problem) if data is None else (data.iloc[0].to_dict(), None)
