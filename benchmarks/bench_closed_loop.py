@@ -9,7 +9,8 @@ solve (``contactEvaluations`` of every wheel, averaged over the communication po
 Written to results/bench/closed_loop.json by ``make bench``. Not a test: nothing asserts a
 time; the goals of issue 18 (20 s in <= 1.0 s on Rover.fmu, <= 2.0 s co-simulated) are
 recorded beside the measured figures. Needs an identified model (``--model``; identified on the
-fly when missing).
+fly when missing). ``--baseline-fmu-dir`` times the same loops on other FMUs as well (e.g. those
+of an earlier commit), interleaved with ours in the same run, and records the ratios.
 """
 
 from __future__ import annotations
@@ -87,6 +88,8 @@ def main() -> None:
     parser.add_argument("--fmu-dir", type=Path, default=Path("fmus"))
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--stop-time", type=float, default=STOP_TIME)
+    parser.add_argument("--baseline-fmu-dir", type=Path, default=None,
+                        help="FMUs to time beside ours (not rebuilt), e.g. an earlier commit's")
     args = parser.parse_args()
     if args.repeats < 1:
         parser.error(f"--repeats={args.repeats}: expected an integer >= 1")
@@ -95,12 +98,15 @@ def main() -> None:
     model = model_file(args.model, fmu_dir)
     steps = round(args.stop_time / STEP)
     results: dict[str, dict[str, Any]] = {}
+    baseline = args.baseline_fmu_dir.resolve() if args.baseline_fmu_dir else None
     for plant in BUILDERS:
-        walls, overheads = [], []
+        walls, overheads, baseline_walls = [], [], []
         for _ in range(args.repeats):
             outcome = run(system(plant, fmu_dir, model, args.stop_time))
             walls.append(outcome.wall_seconds)
             overheads.append(outcome.master_overhead_seconds)
+            if baseline:
+                baseline_walls.append(run(system(plant, baseline, model, args.stop_time)).wall_seconds)
         wall = statistics.median(walls)
         goal = GOALS_S[plant] * args.stop_time / STOP_TIME
         results[plant] = {
@@ -110,6 +116,11 @@ def main() -> None:
             "goal_wall_seconds": goal, "goal_met": wall <= goal,
             "fmu_costs": costs(plant, fmu_dir, model, args.stop_time),
         }
+        if baseline:
+            results[plant].update(baseline_fmu_dir=str(baseline), baseline_wall_seconds=baseline_walls,
+                                  speedup_over_baseline=statistics.median(baseline_walls) / wall)
+            print(f"{plant:10s} baseline FMUs {statistics.median(baseline_walls):6.2f} s: "
+                  f"{statistics.median(baseline_walls) / wall:.2f}x faster now")
         print(f"{plant:10s} {wall:6.2f} s for {args.stop_time:g} s (real-time factor {args.stop_time / wall:.1f}, "
               f"goal {goal:.1f} s), {1e6 * wall / steps:.0f} us/step, master's own "
               f"{results[plant]['master_overhead_per_step_us']:.0f} us/step")
