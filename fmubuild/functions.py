@@ -90,17 +90,11 @@ class FunctionLibrary:
         """A call whose arguments are all known at translation time (e.g. the nodes of a
         quadrature rule from loop indices) is executed at once: its outputs are numbers, which
         fold into the caller's expressions instead of becoming a call in the generated code."""
-        name = definition["name"]
         self._check_supported(definition)
         env: dict[str, Value] = {d["name"]: v for d, v in zip(definition["inputs"], values)}
-        for declared in list(definition["outputs"]) + list(definition["locals"]):
-            if declared["default"] is not None:
-                env[declared["name"]] = Evaluator(env.__getitem__, self.call, name)(declared["default"])
-        self._execute(definition["body"], env, name)
-        for declared in definition["outputs"]:
-            if declared["name"] not in env:
-                raise UnsupportedConstruct(f"output {declared['name']} of {name} is never assigned", name)
-        return tuple(env[d["name"]] for d in definition["outputs"])
+        self._defaults(definition, env)
+        self._execute(definition["body"], env, definition["name"])
+        return tuple(_assigned_outputs(definition, env))
 
     @staticmethod
     def _check_supported(definition: Mapping[str, Any]) -> None:
@@ -124,21 +118,18 @@ class FunctionLibrary:
                 env[declared["name"]] = symbol
             else:
                 env[declared["name"]] = fixed
+        self._defaults(definition, env)
+        return symbols, env
+
+    def _defaults(self, definition: Mapping[str, Any], env: dict[str, Value]) -> None:
+        """Outputs and locals with a declared default get it in ``env`` (inputs already there)."""
         for declared in list(definition["outputs"]) + list(definition["locals"]):
             if declared["default"] is not None:
                 env[declared["name"]] = Evaluator(env.__getitem__, self.call, definition["name"])(declared["default"])
-        return symbols, env
 
     @staticmethod
     def _outputs(definition: Mapping[str, Any], env: dict[str, Value]) -> list[ca.MX]:
-        outputs = []
-        for declared in definition["outputs"]:
-            if declared["name"] not in env:
-                raise UnsupportedConstruct(f"output {declared['name']} of {definition['name']} is never assigned",
-                                           definition["name"])
-            value = env[declared["name"]]
-            outputs.append(value if is_symbolic(value) else ca.MX(float(value)))
-        return outputs
+        return [value if is_symbolic(value) else ca.MX(float(value)) for value in _assigned_outputs(definition, env)]
 
     def _translate(self, definition: Mapping[str, Any], structural: tuple[Any, ...]) -> ca.Function:
         name = definition["name"]
@@ -245,6 +236,15 @@ class FunctionLibrary:
         chosen = ca.Function.if_else("switch", branches[0], branches[1])(condition, *[env[n] for n in live])
         for i, name in enumerate(merged):
             env[name] = chosen[i]
+
+
+def _assigned_outputs(definition: Mapping[str, Any], env: Mapping[str, Value]) -> list[Value]:
+    """The function's outputs from ``env``, in declaration order; each must have been assigned."""
+    for declared in definition["outputs"]:
+        if declared["name"] not in env:
+            raise UnsupportedConstruct(f"output {declared['name']} of {definition['name']} is never assigned",
+                                       definition["name"])
+    return [env[declared["name"]] for declared in definition["outputs"]]
 
 
 def _merged(env: Mapping[str, Value], then_env: Mapping[str, Value], else_env: Mapping[str, Value]) -> list[str]:
