@@ -12,7 +12,8 @@ Generated per model (the runtime in ``fmubuild/runtime`` is the same for all):
 - ``model_data.c``: the ``ModelInfo`` of ``runtime/model.h`` (sizes, defaults, names, GUID).
 
 Real value references follow ``runtime/model.h``: parameters, states, derivatives, inputs, observed
-variables (outputs and locals), then the two solver parameters and the runtime's statistics.
+variables (outputs and locals), memories (:mod:`fmubuild.memory`),
+then the two solver parameters and the runtime's statistics.
 """
 
 from __future__ import annotations
@@ -77,7 +78,7 @@ class ModelLayout:
 
 
 def _functions(model: OdeModel) -> list[ca.Function]:
-    t, x, u, p = model.t, model.x, model.u, model.p
+    t, x, u, p, m = model.t, model.x, model.u, model.p, model.m
     dx = ca.MX.sym("dx", x.numel())
     du = ca.MX.sym("du", u.numel())
     knowns = ca.vertcat(x, u)
@@ -90,17 +91,17 @@ def _functions(model: OdeModel) -> list[ca.Function]:
         # model (e.g. one sinkage solve per wheel); the runtime keeps the last one with the
         # point it was made at. The asserts come with it: an importer reading outputs after
         # each step gets them checked at no extra cost.
-        ca.Function("model_evaluate", [t, x, u, p],
+        ca.Function("model_evaluate", [t, x, u, p, m],
                     [model.xdot, model.y, _column([a.condition for a in model.asserts]),
                      _column([value for a in model.asserts for value in a.values])],
-                    ["t", "x", "u", "p"], ["xdot", "y", "holds", "values"]),
+                    ["t", "x", "u", "p", "m"], ["xdot", "y", "holds", "values"]),
         ca.Function("model_initial", [p], [model.x0], ["p"], ["x0"]),
-        ca.Function("model_ode_jacobian", [t, x, u, p],
+        ca.Function("model_ode_jacobian", [t, x, u, p, m],
                     [ca.densify(ca.jacobian(model.xdot, x)), ca.densify(ca.jacobian(model.xdot, t))],
-                    ["t", "x", "u", "p"], ["dfdx", "dfdt"]),
-        ca.Function("model_directional", [t, x, u, p, dx, du],
+                    ["t", "x", "u", "p", "m"], ["dfdx", "dfdt"]),
+        ca.Function("model_directional", [t, x, u, p, m, dx, du],
                     [ca.densify(sensitivity[:nx]), ca.densify(sensitivity[nx:])],
-                    ["t", "x", "u", "p", "dx", "du"], ["dxdot", "dy"]),
+                    ["t", "x", "u", "p", "m", "dx", "du"], ["dxdot", "dy"]),
     ]
 
 
@@ -152,6 +153,10 @@ def _variables(model: OdeModel, starts: list[float], calculated: list[bool]) -> 
         v = info[name]
         add(name=name, kind="observed", causality="output" if v.is_output else "local", variability="continuous",
             initial="calculated", start=None, unit=v.unit, description=v.description)
+    for name in model.memories:
+        v = info[name]
+        add(name=name, kind="memory", causality="local", variability="continuous", initial="calculated", start=None,
+            unit=v.unit, description=v.description)
     for name, value, unit, description in SOLVER_PARAMETERS:
         add(name=name, kind="solver", causality="parameter", variability="tunable", initial="exact", start=value,
             unit=unit, description=description)
@@ -233,6 +238,7 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path) -
     states = by_kind.get("state", [])
     x_start = model_layout.state_starts
     calculated = [1 if v.initial == "calculated" else 0 for v in states]
+    memory_source = [model.observed.index(source) for source in model.memory_sources]
     names = ",\n    ".join(_c_string(v.name) for v in model_layout.variables)
     asserts = model.asserts
     value_start = [0]
@@ -253,6 +259,8 @@ static const double P_DEFAULT[] = {_c_doubles(p_default)};
 static const double U_DEFAULT[] = {_c_doubles(u_default)};
 static const double X_START[] = {_c_doubles(x_start)};
 static const int X_START_CALCULATED[] = {{{", ".join(map(str, calculated)) or "0"}}};
+static const double M_DEFAULT[] = {_c_doubles(model.memory_defaults)};
+static const int M_SOURCE[] = {{{", ".join(map(str, memory_source)) or "0"}}};
 static const char *const REAL_NAMES[] = {{
     {names}
 }};
@@ -261,7 +269,8 @@ const ModelInfo model_info = {{
     {_c_string(model.name)}, {_c_string(guid)},
     {model_layout.n_states}, {model_layout.n_inputs}, {model_layout.n_parameters}, {model_layout.n_observed},
     P_DEFAULT, U_DEFAULT, X_START, X_START_CALCULATED, REAL_NAMES,
-    {len(asserts)}, ASSERT_MESSAGES, ASSERT_IS_ERROR, ASSERT_VALUE_START, ASSERT_VALUE_NAMES
+    {len(asserts)}, ASSERT_MESSAGES, ASSERT_IS_ERROR, ASSERT_VALUE_START, ASSERT_VALUE_NAMES,
+    {len(model.memories)}, M_DEFAULT, M_SOURCE
 }};
 """
     (directory / "model_data.c").write_text(data)

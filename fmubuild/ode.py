@@ -30,6 +30,7 @@ from .expressions import (
     scalar_name,
 )
 from .functions import FunctionLibrary
+from .memory import bound_variables
 
 
 @dataclass(frozen=True)
@@ -74,14 +75,28 @@ class OdeModel:
     xdot: ca.MX
     y: ca.MX
     x0: ca.MX  # start values of the states, an expression of p
+    m: ca.MX = field(default_factory=lambda: ca.MX.sym("m", 0))  # memories (fmubuild.memory)
+    memories: list[str] = field(default_factory=list)
+    memory_sources: list[str] = field(default_factory=list)  # observed variable each memory holds
+    memory_defaults: list[float] = field(default_factory=list)  # their value before the first step
     parameter_values: dict[str, float] = field(default_factory=dict)
     calculated: dict[str, ca.MX] = field(default_factory=dict)  # dependent parameters, expressions of p
     asserts: list[Assertion] = field(default_factory=list)
 
+    def at_memory_defaults(self) -> tuple[ca.MX, ca.MX]:
+        """xdot and y with every memory at its binding: what a Modelica tool without the runtime's
+        memories computes (e.g. the sinkage solve started cold), expressions of (t, x, u, p)."""
+        if not self.memories:
+            return self.xdot, self.y
+        defaults = ca.DM(self.memory_defaults)
+        return ca.substitute(self.xdot, self.m, defaults), ca.substitute(self.y, self.m, defaults)
+
     def functions(self) -> tuple[ca.Function, ca.Function, ca.Function]:
-        """``ode(t, x, u, p) -> xdot``, ``outputs(t, x, u, p) -> y``, ``initial(p) -> x0``."""
-        ode = ca.Function("ode", [self.t, self.x, self.u, self.p], [self.xdot], ["t", "x", "u", "p"], ["xdot"])
-        outputs = ca.Function("outputs", [self.t, self.x, self.u, self.p], [self.y], ["t", "x", "u", "p"], ["y"])
+        """``ode(t, x, u, p) -> xdot``, ``outputs(t, x, u, p) -> y`` (memories at their bindings),
+        ``initial(p) -> x0``."""
+        xdot, y = self.at_memory_defaults()
+        ode = ca.Function("ode", [self.t, self.x, self.u, self.p], [xdot], ["t", "x", "u", "p"], ["xdot"])
+        outputs = ca.Function("outputs", [self.t, self.x, self.u, self.p], [y], ["t", "x", "u", "p"], ["y"])
         initial = ca.Function("initial", [self.p], [self.x0], ["p"], ["x0"])
         return ode, outputs, initial
 
@@ -304,10 +319,13 @@ def translate(model: Any, name: str) -> OdeModel:
               if _role_names(info)[1] == "Input" and "." not in flat_name]
     states = [s for s in infos if s in state_names]
     t, x, u, p = ca.MX.sym("time"), ca.MX.sym("x", len(states)), ca.MX.sym("u", len(inputs)), parameters.vector()
+    memories, binding_equations = bound_variables(flat, locate.files, _is_parameter, name)
+    m = ca.MX.sym("m", len(memories))
     known: dict[str, Value] = {"time": t, **{s: x[i] for i, s in enumerate(states)},
-                               **{s: u[i] for i, s in enumerate(inputs)}, **parameters.values}
+                               **{s: u[i] for i, s in enumerate(inputs)}, **parameters.values,
+                               **{memory.name: m[i] for i, memory in enumerate(memories)}}
     unknowns = [f"der({s})" for s in states] + [s for s in infos if s not in known and not _is_parameter(infos[s][0])]
-    env = _solve(_equations(flat, locate, name), unknowns, known, library, name)
+    env = _solve(_equations(flat, locate, name) + binding_equations, unknowns, known, library, name)
 
     xdot = ca.vertcat(*[_mx(env[f"der({s})"]) for s in states]) if states else ca.MX(0, 1)
     observed = [s for s in unknowns if not s.startswith("der(")]
@@ -319,8 +337,22 @@ def translate(model: Any, name: str) -> OdeModel:
         variables[public] = replace(variables[public], start=variables[inner].start,
                                     description=variables[public].description or variables[inner].description)
     asserts = _asserts(flat, env, parameters, library, locate, name)
-    return OdeModel(name, variables, states, inputs, parameters.free, observed, t, x, u, p, xdot, y, x0,
+    for memory in memories:
+        if memory.source not in observed:
+            raise UnsupportedConstruct(f"memory {memory.name}: {memory.source} is not an observed variable", name)
+    memory_defaults = [_constant_binding(memory.name, memory.binding, parameters, library, name) for memory in memories]
+    return OdeModel(name, variables, states, inputs, parameters.free, observed, t, x, u, p, xdot, y, x0, m,
+                    [memory.name for memory in memories], [memory.source for memory in memories], memory_defaults,
                     parameters.defaults, parameters.calculated, asserts)
+
+
+def _constant_binding(variable: str, binding: Mapping[str, Any], parameters: _Parameters, library: FunctionLibrary,
+                      name: str) -> float:
+    where = f"{name}: binding of {variable}"
+    value = _evaluator(parameters.values, library, where)(binding)
+    if is_symbolic(value):
+        raise UnsupportedConstruct(f"memory {variable} bound to a value that is not a constant", where)
+    return float(value)
 
 
 def _public_state_names(states: list[str], observed: list[str], env: Mapping[str, Value], x: ca.MX,

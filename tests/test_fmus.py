@@ -362,6 +362,47 @@ def test_outputs_after_a_step_reuse_its_last_evaluation_and_match_a_fresh_one(fm
         instance.freeInstance()
 
 
+MEMORIES = ["logSinkageStart", "slopeStart"]
+
+
+def test_warm_started_sinkage_solve_gives_the_cold_result_with_fewer_evaluations(fmus, tmp_path):
+    """Warm start: the runtime holds each wheel's last sinkage solve (log h and slope, the memories
+    of RigidWheel) from the end of the previous step and starts the next solve there. A fresh
+    instance at the same state and inputs (cold start, Bekker's sinkage) gives the same forces to
+    the solve's tolerance with more force evaluations; the memories are read-only and come back
+    with the FMU state, and reset forgets them."""
+    values = {"W": 575.0, "tau": 40.0, "v_hub": 0.3}
+    fmu, vr = started(fmus, "Wheel", tmp_path, values)
+    assert fmu.getReal([vr[m] for m in MEMORIES]) == [0.0, 0.0]  # cold before the first step
+    outputs = [vr[n] for n in ("Fx", "Fz", "Tx", "sinkage", "slip", "entryAngle")]
+    warm_counts = []
+    for k in range(300):
+        t = k * 1e-3
+        fmu.setReal([vr["tau"], vr["v_hub"]], [40.0 + 10.0 * np.sin(20.0 * t), 0.3 + 0.2 * t])
+        fmu.doStep(t, 1e-3)
+        warm_counts.append(fmu.getReal([vr["contactEvaluations"]])[0])
+    log_h, slope = fmu.getReal([vr[m] for m in MEMORIES])
+    assert slope > 0 and log_h == np.log(fmu.getReal([vr["sinkage"]])[0])
+    warm = np.array(fmu.getReal(outputs))
+    at_end = dict(zip(("tau", "W", "v_hub", "omega"), fmu.getReal([vr[n] for n in ("tau", "W", "v_hub", "omega")])))
+    cold_fmu, _ = started(fmus, "Wheel", tmp_path, at_end, instance="cold")
+    cold = np.array(cold_fmu.getReal(outputs))
+    cold_count = cold_fmu.getReal([vr["contactEvaluations"]])[0]
+    np.testing.assert_allclose(warm, cold, rtol=1e-8, atol=1e-12)
+    assert np.mean(warm_counts[50:]) <= cold_count - 1, (np.mean(warm_counts[50:]), cold_count)
+    with pytest.raises(Exception, match="status 3"):
+        fmu.setReal([vr["slopeStart"]], [1.0])
+    state = fmu.getFMUstate()
+    cold_fmu.setFMUstate(state)
+    assert cold_fmu.getReal([vr[m] for m in MEMORIES]) == [log_h, slope]
+    fmu.freeFMUstate(state)
+    fmu.reset()
+    assert fmu.getReal([vr[m] for m in MEMORIES]) == [0.0, 0.0]
+    fmu.freeInstance()
+    cold_fmu.terminate()
+    cold_fmu.freeInstance()
+
+
 def test_reset_returns_to_the_start(fmus, tmp_path):
     fmu, vr = started(fmus, "SingleWheel", tmp_path, {"W": 275.0, "tau": 30.0})
     first = run_steps(fmu, vr, 0.0, 50, ["v", "slip"])

@@ -195,9 +195,12 @@ model SinkageProbe
   Real slip(unit="1");
   Real h(unit="m");
   Real evaluations(unit="1");
+  Real logSinkage(unit="1");
+  Real slope(unit="1");
 """ + PROBE_COMMON + """  W = 10^(0.5 + 3*time);
   slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*5*time));
-  (h, Fx, Fz, Tx, Fy, FySidewall, evaluations) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
+  (h, Fx, Fz, Tx, Fy, FySidewall, evaluations, logSinkage, slope) =
+    RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
 end SinkageProbe;
 """
 
@@ -212,6 +215,43 @@ def test_wheel_contact_carries_the_load_and_matches_the_reference_sinkage():
     np.testing.assert_allclose(df["h"], state.sinkage, rtol=1e-4)
     # The solve's own count: within the documented 5 force evaluations, never at the bound of 12.
     assert df["evaluations"].min() >= 1 and df["evaluations"].max() <= 5
+
+
+#: Starts of the warm solve: (offset of log h from the cold solution, slope for the first step or
+#: None for the cold solve's): near, a factor 20 above (the fallback), a factor 400 below, exact
+#: with a wrong slope.
+WARM_STARTS = ((0.003, None), (3.0, None), (-6.0, None), (0.0, 25.0))
+
+
+def warm_start_probe() -> str:
+    lines = ["model WarmStartProbe", '  Real W(unit="N");', '  Real slip(unit="1");', '  Real h(unit="m");',
+             '  Real evaluations(unit="1");', '  Real logSinkage(unit="1");', '  Real slope(unit="1");']
+    equations = []
+    for i, (offset, slope) in enumerate(WARM_STARTS, start=1):
+        names = [f"{name}{i}" for name in ("h", "Fx", "Fz", "Tx", "Fy", "FySidewall", "evaluations", "logSinkage",
+                                           "slope")]
+        lines += [f"  Real {name};" for name in names]
+        equations.append(f"  ({', '.join(names)}) = RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel, "
+                         f"16, 12, 1e-10, 1e-3, 0, logSinkage + ({offset}), {slope if slope else 'slope'});")
+    return "\n".join(lines) + PROBE_COMMON + """  W = 10^(0.5 + 3*time);
+  slip = -1 + 2*(0.5 - 0.5*cos(2*3.141592653589793*5*time));
+  (h, Fx, Fz, Tx, Fy, FySidewall, evaluations, logSinkage, slope) =
+    RoverTerramechanics.Functions.wheelContact(W, slip, soil, wheel);
+""" + "\n".join(equations) + "\nend WarmStartProbe;\n"
+
+
+def test_wheel_contact_warm_start_gives_the_cold_result():
+    """The sinkage solve started anywhere (near the solution, a factor 20 above it: the fallback to
+    the cold start, a factor 400 below, exactly at it with a wrong slope) finds the cold solve's
+    sinkage to its tolerance; near the solution it needs fewer force evaluations."""
+    df = simulate_inline(warm_start_probe(), "WarmStartProbe", 0.001)
+    cold, load = df["h"].to_numpy(), df["W"].to_numpy()
+    for i in range(1, len(WARM_STARTS) + 1):
+        np.testing.assert_allclose(df[f"Fz{i}"], load, rtol=1e-9)
+        np.testing.assert_allclose(df[f"h{i}"], cold, rtol=1e-9)
+        assert df[f"evaluations{i}"].max() <= 8, i
+    assert df["evaluations4"].max() == 1  # a converged start is accepted at once
+    assert df["evaluations1"].mean() < df["evaluations"].mean() - 1
 
 
 SLIP_PROBE = """

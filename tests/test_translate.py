@@ -18,11 +18,12 @@ def integrate(ode, params: dict[str, float], stop: float, interval: float):
     values = dict(ode.parameter_values) | params
     p = ca.DM([values[n] for n in ode.parameters])
     grid = np.arange(0.0, stop + interval / 2, interval)
-    dae = {"x": ode.x, "t": ode.t, "p": ode.p, "ode": ode.xdot}
+    xdot, y = ode.at_memory_defaults()
+    dae = {"x": ode.x, "t": ode.t, "p": ode.p, "ode": xdot}
     integrator = ca.integrator("I", "cvodes", dae, 0.0, grid[1:], {"reltol": 1e-10, "abstol": 1e-10})
     x0 = ca.Function("x0", [ode.p], [ode.x0])(p)
     states = np.hstack([np.array(x0), np.array(integrator(x0=x0, p=p)["xf"])])
-    outputs = ca.Function("g", [ode.t, ode.x, ode.u, ode.p], [ode.y])
+    outputs = ca.Function("g", [ode.t, ode.x, ode.u, ode.p], [y])
     observed = np.hstack([np.array(outputs(t, states[:, k], ca.DM.zeros(0), p)) for k, t in enumerate(grid)])
     return grid, dict(zip(ode.states, states)) | dict(zip(ode.observed, observed))
 
@@ -60,7 +61,8 @@ def test_fmu_models_translate_with_their_interfaces(name: str, inputs: list[str]
     assert outputs and all(o in ode.observed or o in ode.states for o in outputs)
     _, _, initial = ode.functions()
     p = ca.DM([ode.parameter_values[n] for n in ode.parameters])
-    jac = ca.Function("j", [ode.t, ode.x, ode.u, ode.p], [ca.jacobian(ode.xdot, ode.x)])
+    xdot, _ = ode.at_memory_defaults()
+    jac = ca.Function("j", [ode.t, ode.x, ode.u, ode.p], [ca.jacobian(xdot, ode.x)])
     u = ca.DM([424.0 if n == "W" else 10.0 for n in ode.inputs])
     assert np.isfinite(np.array(jac(0.0, initial(p), u, p))).all()
 

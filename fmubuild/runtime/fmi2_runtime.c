@@ -97,24 +97,24 @@ static const struct {
     [F_GetStringStatus] = {"fmi2GetStringStatus", ANY_MODE},
 };
 
-#define FMU_STATE_MAGIC 0x524f5644u /* "ROVD": layout 2, with a checksum */
+#define FMU_STATE_MAGIC 0x524f5645u /* "ROVE": layout 3, with a checksum and the memories */
 
 /* What fmi2Get/SetFMUstate save and restore. */
 typedef struct {
-    unsigned magic, nx, nu, np;
+    unsigned magic, nx, nu, np, nm;
     int mode;
     int f0_valid, jac_valid, jac_current, jac_age;  /* integrator memory, so a restored run repeats exactly */
     double t, rtol, max_step, h;
     uint64_t checksum;  /* FNV-1a of the header (this field zero) and the doubles that follow */
-    /* followed by x[nx], u[nu], p[np], x_set[nx], F0[nx], J[nx*nx] (doubles) */
+    /* followed by x[nx], u[nu], p[np], x_set[nx], F0[nx], J[nx*nx], m[nm] (doubles) */
 } StateHeader;
 
-/* The last evaluation of the model (model_evaluate) and the exact point (t, x, u) it was made
- * at: asking again at the same point reuses it. */
+/* The last evaluation of the model (model_evaluate) and the exact point (t, x, u) and memories m
+ * it was made with: asking again with the same ones reuses it. */
 typedef struct {
     int valid;
     double t;
-    double *x, *u, *xdot, *y, *holds, *values;
+    double *x, *u, *m, *xdot, *y, *holds, *values;
     unsigned long long evaluations, reused;
 } Evaluation;
 
@@ -127,6 +127,7 @@ typedef struct {
     double t, t_stop;
     int has_stop;
     double *p, *x, *u, *xdot, *y, *x_set;  /* x_set[i] != 0: the start of state i was set by the user */
+    double *m;  /* memories: values of the previous step (model.h), e.g. the start of a sinkage solve */
     double *holds, *assert_values;         /* the model's asserts, evaluated with the outputs */
     double rtol, max_step;
     int xdot_valid, y_valid;
@@ -152,7 +153,8 @@ static int off_x(void) { return model_info.np; }
 static int off_dx(void) { return model_info.np + model_info.nx; }
 static int off_u(void) { return model_info.np + 2 * model_info.nx; }
 static int off_y(void) { return model_info.np + 2 * model_info.nx + model_info.nu; }
-static int vr_rtol(void) { return off_y() + model_info.ny; }
+static int off_m(void) { return off_y() + model_info.ny; }
+static int vr_rtol(void) { return off_m() + model_info.nm; }
 static int vr_max_step(void) { return vr_rtol() + 1; }
 static int vr_statistics(void) { return vr_max_step() + 1; }
 #define N_STATISTICS 5 /* codegen.STATISTICS */
@@ -243,24 +245,27 @@ static int same(const double *a, const double *b, int n) {
 
 /* Derivatives, outputs and asserts at (t, x) with the inputs at t, into c->eval. The derivatives
  * and outputs share one evaluation of the model (one sinkage solve per wheel), and the last one
- * is reused at the same point, bit for bit: the outputs right after a step are those of its
+ * is reused at the same point with the same memories, bit for bit (so an evaluation is a function
+ * of (t, x, u, p, m) and a restored FMU state repeats a run exactly): the outputs right after a step are those of its
  * last stage, and the next step starts from them when the inputs did not change. Parameters
  * change only through calls that clear it (forget_evaluation). */
 static int evaluate(Instance *c, double t, const double *x) {
     const double *u = inputs_at(c, t);
     Evaluation *e = &c->eval;
-    if (e->valid && e->t == t && same(e->x, x, model_info.nx) && same(e->u, u, model_info.nu)) {
+    if (e->valid && e->t == t && same(e->x, x, model_info.nx) && same(e->u, u, model_info.nu) &&
+        same(e->m, c->m, model_info.nm)) {
         e->reused++;
         return 0;
     }
     e->valid = 0;
-    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = u; c->arg[3] = c->p;
+    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = u; c->arg[3] = c->p; c->arg[4] = c->m;
     c->res[0] = e->xdot; c->res[1] = e->y; c->res[2] = e->holds; c->res[3] = e->values;
     e->evaluations++;
     if (model_evaluate(c->arg, c->res, c->iw, c->w, 0)) return -1;
     e->t = t;
     if (model_info.nx) memcpy(e->x, x, sizeof(double) * (size_t)model_info.nx);
     if (model_info.nu) memcpy(e->u, u, sizeof(double) * (size_t)model_info.nu);
+    if (model_info.nm) memcpy(e->m, c->m, sizeof(double) * (size_t)model_info.nm);
     e->valid = 1;
     return 0;
 }
@@ -281,7 +286,7 @@ static int rhs(void *ctx, double t, const double *x, double *xdot) {
 
 static int jacobian(void *ctx, double t, const double *x, double *dfdx, double *dfdt) {
     Instance *c = ctx;
-    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = inputs_at(c, t); c->arg[3] = c->p;
+    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = inputs_at(c, t); c->arg[3] = c->p; c->arg[4] = c->m;
     c->res[0] = dfdx; c->res[1] = dfdt;
     return model_ode_jacobian(c->arg, c->res, c->iw, c->w, 0);
 }
@@ -363,6 +368,12 @@ static fmi2Status update(Instance *c, Function f, int need_xdot, int need_y) {
     return status;
 }
 
+/* After a completed step: each memory takes the value of its variable at the step's end (the
+ * outputs, valid after update). The outputs stay valid: they were computed at this point. */
+static void remember(Instance *c) {
+    for (int i = 0; i < model_info.nm; i++) c->m[i] = c->y[model_info.m_source[i]];
+}
+
 static void invalidate(Instance *c) {
     c->xdot_valid = 0;
     c->y_valid = 0;
@@ -376,6 +387,7 @@ static void set_defaults(Instance *c) {
     c->interpolating = 0;
     memcpy(c->x, model_info.x_start, sizeof(double) * model_info.nx);
     for (int i = 0; i < model_info.nx; i++) c->x_set[i] = 0.0;
+    memcpy(c->m, model_info.m_default, sizeof(double) * model_info.nm);
     c->rtol = DEFAULT_RTOL;
     c->max_step = DEFAULT_MAX_STEP;
     c->t = 0.0;
@@ -401,9 +413,9 @@ fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn, s
 
 static void free_instance(Instance *c) {
     fmi2CallbackFreeMemory release = c->cb.freeMemory;
-    void *blocks[] = {c->name, c->p, c->x, c->u, c->u_der, c->u_step, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
+    void *blocks[] = {c->name, c->p, c->x, c->m, c->u, c->u_der, c->u_step, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
                       (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y,
-                      c->eval.x, c->eval.u, c->eval.xdot, c->eval.y, c->eval.holds, c->eval.values};
+                      c->eval.x, c->eval.u, c->eval.m, c->eval.xdot, c->eval.y, c->eval.holds, c->eval.values};
     for (size_t i = 0; i < sizeof(blocks) / sizeof(blocks[0]); i++) if (blocks[i]) release(blocks[i]);
     ode23s_free(&c->solver, release);
     release(c);
@@ -413,7 +425,7 @@ static casadi_work const WORKS[] = {model_evaluate_work, model_initial_work,
                                     model_ode_jacobian_work, model_directional_work};
 
 static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
-    casadi_int sz_arg = 6, sz_res = 4, sz_iw = 0, sz_w = 0;
+    casadi_int sz_arg = 7, sz_res = 4, sz_iw = 0, sz_w = 0;
     for (size_t i = 0; i < sizeof(WORKS) / sizeof(WORKS[0]); i++) {
         casadi_int a = 0, r = 0, iw = 0, w = 0;
         WORKS[i](&a, &r, &iw, &w);
@@ -425,7 +437,9 @@ static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     fmi2CallbackAllocateMemory alloc = functions->allocateMemory;
     size_t nx = model_info.nx ? model_info.nx : 1, nu = model_info.nu ? model_info.nu : 1;
     size_t np = model_info.np ? model_info.np : 1, ny = model_info.ny ? model_info.ny : 1;
+    size_t nm = model_info.nm ? model_info.nm : 1;
     c->p = alloc(np, sizeof(double));
+    c->m = alloc(nm, sizeof(double));
     c->x = alloc(nx, sizeof(double));
     c->u = alloc(nu, sizeof(double));
     c->u_der = alloc(nu, sizeof(double));
@@ -447,14 +461,15 @@ static int allocate_work(Instance *c, const fmi2CallbackFunctions *functions) {
     Evaluation *e = &c->eval;
     e->x = alloc(nx, sizeof(double));
     e->u = alloc(nu, sizeof(double));
+    e->m = alloc(nm, sizeof(double));
     e->xdot = alloc(nx, sizeof(double));
     e->y = alloc(ny, sizeof(double));
     e->holds = alloc(model_info.n_asserts ? (size_t)model_info.n_asserts : 1, sizeof(double));
     e->values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
     int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
-    return c->p && c->x && c->u && c->u_der && c->u_step && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
+    return c->p && c->m && c->x && c->u && c->u_der && c->u_step && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
            c->seed_u && c->sens_x && c->sens_y && e->x && e->u && e->xdot && e->y && e->holds && e->values &&
-           !solver_failed;
+           e->m && !solver_failed;
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
@@ -586,7 +601,8 @@ fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], s
         else if (r < off_dx()) value[i] = c->x[r - off_x()];
         else if (r < off_u()) value[i] = c->xdot[r - off_dx()];
         else if (r < off_y()) value[i] = c->u[r - off_u()];
-        else if (r < vr_rtol()) value[i] = c->y[r - off_y()];
+        else if (r < off_m()) value[i] = c->y[r - off_y()];
+        else if (r < vr_rtol()) value[i] = c->m[r - off_m()];
         else if (r == vr_rtol()) value[i] = c->rtol;
         else if (r == vr_max_step()) value[i] = c->max_step;
         else value[i] = statistic(c, r - vr_statistics());
@@ -603,7 +619,8 @@ static const char *set_real_refusal(const Instance *c, int r, double value) {
     if (r >= off_x() && r < off_dx() && !initializing)
         return "is a state: set it before fmi2ExitInitializationMode (Model Exchange: fmi2SetContinuousStates)";
     if (r >= off_dx() && r < off_u()) return "is a derivative (calculated): it cannot be set";
-    if (r >= off_y() && r < vr_rtol()) return "is calculated by the model: it cannot be set";
+    if (r >= off_y() && r < off_m()) return "is calculated by the model: it cannot be set";
+    if (r >= off_m() && r < vr_rtol()) return "is kept by the runtime from the previous step: it cannot be set";
     if (r == vr_rtol() && !(value > 0.0 && value < 1.0)) return "expected 0 < tolerance < 1";
     if (r == vr_max_step() && !(value >= 0.0)) return "expected >= 0 (0: no limit besides the communication step)";
     if (r >= vr_statistics()) return "is a statistic of the runtime: it cannot be set";
@@ -656,7 +673,8 @@ NO_VARIABLES_OF_TYPE(fmi2SetString, F_SetString, "String", const fmi2String)
  * fmi2SerializeFMUstate hands out: a StateHeader and the doubles after it. */
 static size_t state_size(void) {
     return sizeof(StateHeader) +
-           sizeof(double) * (size_t)(3 * model_info.nx + model_info.nu + model_info.np + model_info.nx * model_info.nx);
+           sizeof(double) * (size_t)(3 * model_info.nx + model_info.nu + model_info.np + model_info.nx * model_info.nx +
+                                     model_info.nm);
 }
 
 static uint64_t fnv1a(uint64_t hash, const unsigned char *bytes, size_t n) {
@@ -677,6 +695,7 @@ static void state_write(const Instance *c, unsigned char *payload) {
     memset(&head, 0, sizeof head); /* padding bytes too: the checksum covers them */
     head.magic = FMU_STATE_MAGIC;
     head.nx = (unsigned)model_info.nx; head.nu = (unsigned)model_info.nu; head.np = (unsigned)model_info.np;
+    head.nm = (unsigned)model_info.nm;
     head.mode = (int)c->mode;
     head.f0_valid = c->solver.f0_valid; head.jac_valid = c->solver.jac_valid;
     head.jac_current = c->solver.jac_current; head.jac_age = c->solver.jac_age;
@@ -688,7 +707,8 @@ static void state_write(const Instance *c, unsigned char *payload) {
     memcpy(v, c->p, sizeof(double) * model_info.np); v += model_info.np;
     memcpy(v, c->x_set, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->solver.F0, sizeof(double) * model_info.nx); v += model_info.nx;
-    memcpy(v, c->solver.J, sizeof(double) * model_info.nx * model_info.nx);
+    memcpy(v, c->solver.J, sizeof(double) * model_info.nx * model_info.nx); v += model_info.nx * model_info.nx;
+    memcpy(v, c->m, sizeof(double) * model_info.nm);
     head.checksum = state_checksum(payload, state_size());
     memcpy(payload, &head, sizeof head);
 }
@@ -699,7 +719,7 @@ static const char *state_refusal(const unsigned char *payload, size_t size) {
     if (size != state_size()) return "its size does not match this model's FMU state";
     memcpy(&head, payload, sizeof head);
     if (head.magic != FMU_STATE_MAGIC || head.nx != (unsigned)model_info.nx || head.nu != (unsigned)model_info.nu ||
-        head.np != (unsigned)model_info.np)
+        head.np != (unsigned)model_info.np || head.nm != (unsigned)model_info.nm)
         return "it was not saved by this model";
     if (head.checksum != state_checksum(payload, size)) return "its checksum does not match (corrupted)";
     if (head.mode < 0 || head.mode >= MODE_COUNT || head.jac_age < 0 || !isfinite(head.t) ||
@@ -719,7 +739,8 @@ static void state_read(Instance *c, const unsigned char *payload) {
     memcpy(c->p, v, sizeof(double) * model_info.np); v += model_info.np;
     memcpy(c->x_set, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->solver.F0, v, sizeof(double) * model_info.nx); v += model_info.nx;
-    memcpy(c->solver.J, v, sizeof(double) * model_info.nx * model_info.nx);
+    memcpy(c->solver.J, v, sizeof(double) * model_info.nx * model_info.nx); v += model_info.nx * model_info.nx;
+    memcpy(c->m, v, sizeof(double) * model_info.nm);
     c->mode = (Mode)head.mode;
     c->t = head.t;
     c->rtol = head.rtol;
@@ -835,7 +856,8 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component component, const fmi2Value
     }
     if (c->mode == MODE_INITIALIZATION && initial_states(c, F) != fmi2OK) return fmi2Error;
     double t = c->t;
-    c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->seed_x; c->arg[5] = c->seed_u;
+    c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->m;
+    c->arg[5] = c->seed_x; c->arg[6] = c->seed_u;
     c->res[0] = c->sens_x; c->res[1] = c->sens_y;
     if (model_directional(c->arg, c->res, c->iw, c->w, 0) || !all_finite(c->sens_x, model_info.nx) ||
         !all_finite(c->sens_y, model_info.ny))
@@ -883,7 +905,9 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component component, fmi2Boolean noSe
     NOT_NULL(F_CompletedIntegratorStep, terminateSimulation, 1);
     *enterEventMode = fmi2False;
     *terminateSimulation = fmi2False;
-    return update(c, F_CompletedIntegratorStep, 0, 1); /* the asserts */
+    fmi2Status status = update(c, F_CompletedIntegratorStep, 0, 1); /* the asserts */
+    if (status != fmi2Error) remember(c);
+    return status;
 }
 
 fmi2Status fmi2SetTime(fmi2Component component, fmi2Real time) {
@@ -1017,7 +1041,9 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real currentCommunicationPoin
     }
     if (status != 0) return fail(c, F, BROKEN, "integration failed: %s", message);
     c->t = t_end;
-    return update(c, F, 0, 1); /* the outputs at t_end, and with them the asserts */
+    fmi2Status checked = update(c, F, 0, 1); /* the outputs at t_end, and with them the asserts */
+    if (checked != fmi2Error) remember(c);
+    return checked;
 }
 
 fmi2Status fmi2CancelStep(fmi2Component component) {

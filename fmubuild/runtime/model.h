@@ -5,7 +5,7 @@
  * (fmi2_runtime.c, ode23s.c) is the same for every model.
  *
  * Real value references are indices into one array laid out as
- *   [parameters | states | derivatives | inputs | observed | tolerance, maxStep]
+ *   [parameters | states | derivatives | inputs | observed | memories | tolerance, maxStep | statistics]
  * with the offsets given in ModelInfo.
  */
 #ifndef ROVER_COSIM_MODEL_H
@@ -27,6 +27,9 @@ typedef struct {
     const int *assert_is_error;            /* [n_asserts] 1: error, 0: warning */
     const int *assert_value_start;         /* [n_asserts + 1] offsets into the values of model_evaluate */
     const char *const *assert_value_names; /* names of those values, for the message */
+    int nm;                           /* memories: values the runtime keeps from the previous step */
+    const double *m_default;          /* [nm] their value before the first step */
+    const int *m_source;              /* [nm] index into y of the variable each one remembers */
 } ModelInfo;
 
 extern const ModelInfo model_info;
@@ -35,17 +38,19 @@ extern const ModelInfo model_info;
 typedef int (*casadi_eval)(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 typedef int (*casadi_work)(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
 
-/* model_evaluate(t, x, u, p) -> (xdot, y: observed variables, holds [n_asserts]: nonzero where an
+/* Memories m (fmubuild/memory.py) are an extra argument of the functions below: the start of an
+ * iterative solve, which the results do not depend on beyond the solve's tolerance. */
+/* model_evaluate(t, x, u, p, m) -> (xdot, y: observed variables, holds [n_asserts]: nonzero where an
  * assert's condition holds, values: the variables each condition reads, for the message) */
 int model_evaluate(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 int model_evaluate_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
 /* model_initial(p) -> x0 */
 int model_initial(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 int model_initial_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-/* model_ode_jacobian(t, x, u, p) -> (dxdot/dx [nx*nx, column-major, dense], dxdot/dt [nx]) */
+/* model_ode_jacobian(t, x, u, p, m) -> (dxdot/dx [nx*nx, column-major, dense], dxdot/dt [nx]) */
 int model_ode_jacobian(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 int model_ode_jacobian_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
-/* model_directional(t, x, u, p, dx, du) -> (dxdot, dy): forward directional derivatives */
+/* model_directional(t, x, u, p, m, dx, du) -> (dxdot, dy): forward directional derivatives */
 int model_directional(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 int model_directional_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
 

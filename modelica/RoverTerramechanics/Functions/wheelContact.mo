@@ -9,6 +9,8 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   input Real tolerance(unit="1") = 1e-10 "Relative tolerance on Fz/W - 1";
   input Real WMin(unit="N") = 1e-3 "Smallest load considered (a lifted wheel)";
   input Real slipAngle(unit="rad") = 0 "Slip angle of the hub velocity (Ishigami et al. 2007)";
+  input Real logSinkageStart(unit="1") = 0 "log(h / 1 m) to start from, e.g. the previous solve's logSinkage; used only when slopeStart > 0";
+  input Real slopeStart(unit="1") = 0 "> 0: warm start from logSinkageStart with this slope d log Fz / d log h for the first step (e.g. the previous solve's slope); <= 0: cold start from Bekker's sinkage";
   output Real h(unit="m") "Sinkage";
   output Real Fx(unit="N") "Longitudinal force at h, Eq. (12)";
   output Real Fz(unit="N") "Vertical force at h, Eq. (11): W once converged";
@@ -16,6 +18,8 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   output Real Fy(unit="N") "Lateral force at h";
   output Real FySidewall(unit="N") "Sidewall part of Fy";
   output Real evaluations(unit="1") "Force evaluations the solve used";
+  output Real logSinkage(unit="1") "log(h / 1 m) at the last force evaluation: h = exp(logSinkage) (a start for the next solve)";
+  output Real slope(unit="1") "d log Fz / d log h near the solution, > 0: the solve's last secant (a start for the next solve)";
 protected
   Real load(unit="N") "Load, floored at WMin";
   Real x "log(h/m), the iterate";
@@ -26,21 +30,28 @@ protected
   Real fPrev "Residual at xPrev";
   Real step "Next iterate";
   Real bekkerModulus(unit="N/m3");
-  Real slope "d log Fz / d log h of Bekker's law, for the first step";
+  Real bekkerSlope "d log Fz / d log h of Bekker's law";
+  Real xCold "log of Bekker's sinkage, the cold start";
+  Real secant "Slope of the last secant";
+  Boolean warm "Started from hStart and not yet fallen back to the cold start";
   Boolean done;
   Boolean first;
 algorithm
   load := noEvent(max(W, WMin));
   bekkerModulus := soil.kc/wheel.b + soil.kphi;
-  slope := (2*soil.n + 1)/2;
-  // Bekker's rigid-wheel sinkage as the start: h = [3 W / ((3 - n) b k sqrt(2 r))]^(2/(2n+1)).
-  x := 2/(2*soil.n + 1)*log(3*load/((3 - min(soil.n, 2.9))*wheel.b*bekkerModulus*sqrt(2*wheel.r)));
+  bekkerSlope := (2*soil.n + 1)/2;
   xLow := log(1e-12*wheel.r);
   xHigh := log(wheel.r);
-  x := noEvent(min(max(x, xLow), xHigh));
+  // Bekker's rigid-wheel sinkage as the cold start: h = [3 W / ((3 - n) b k sqrt(2 r))]^(2/(2n+1)).
+  xCold := 2/(2*soil.n + 1)*log(3*load/((3 - min(soil.n, 2.9))*wheel.b*bekkerModulus*sqrt(2*wheel.r)));
+  xCold := noEvent(min(max(xCold, xLow), xHigh));
+  warm := noEvent(slopeStart > 0);
+  x := if warm then noEvent(min(max(logSinkageStart, xLow), xHigh)) else xCold;
+  slope := if warm then slopeStart else bekkerSlope;
   xPrev := x;
   fPrev := 0;
   h := exp(x);
+  logSinkage := x;
   Fx := 0;
   Fz := 0;
   Tx := 0;
@@ -52,6 +63,7 @@ algorithm
   for k in 1:nIterations loop
     if not done then
       h := exp(x);
+      logSinkage := x;
       (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nNodes, slipAngle);
       evaluations := evaluations + 1;
       // A skidding wheel that has barely sunk can have Fz <= 0: treat it as "too shallow".
@@ -64,10 +76,18 @@ algorithm
         else
           xHigh := x;
         end if;
-        if first then
+        if first and warm and noEvent(abs(f) > 1) then
+          // The start is more than a factor e from carrying W: fall back to the cold start.
+          step := xCold;
+          slope := bekkerSlope;
+          warm := false;
+        elseif first then
           step := x - f/slope;
+          first := false;
         elseif noEvent(abs(f - fPrev) > 1e-300) then
-          step := x - f*(x - xPrev)/(f - fPrev);
+          secant := (f - fPrev)/(x - xPrev);
+          slope := if noEvent(secant > 0) then secant else slope;
+          step := x - f/secant;
         else
           step := 0.5*(xLow + xHigh);
         end if;
@@ -77,7 +97,6 @@ algorithm
         xPrev := x;
         fPrev := f;
         x := step;
-        first := false;
       end if;
     end if;
   end for;
@@ -91,6 +110,12 @@ is replaced by bisection. The loop is bounded by <code>nIterations</code> evalua
 Table 2 soil it converges to 1e-10 in at most 5 for loads 1 N to 5 kN and slips -1 to 1
 (measured with the same algorithm on the Python reference). If the soil cannot carry W even at h = r the result is h = r
 with F<sub>z</sub> &lt; W.</p>
+<p>Warm start: given <code>slopeStart</code> &gt; 0 (the previous solve's output <code>slope</code>,
+its last secant) and <code>logSinkageStart</code> (the previous solve's <code>logSinkage</code>,
+log h of its last evaluation) the solve starts there instead; started at a converged solution it
+repeats that evaluation bit for bit and stops after it; a start whose residual exceeds 1 (F<sub>z</sub> more than a factor e from W)
+falls back to the cold start. The result does not depend on the start beyond the tolerance; a
+wheel rolling steadily needs 1-2 evaluations instead of about 4.</p>
 <p>Same method as the Python reference <code>terramechanics.wheel_state</code> (which also splits
 the patch where a skidding wheel's shear displacement changes sign).</p>
 </html>"));

@@ -11,6 +11,8 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   input Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   input Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   input Real vLat(unit="m/s") = 0 "Speed of the hub to the wheel's left (lateral, in the wheel frame)";
+  input Real logSinkageStart(unit="1") = 0 "Start of the sinkage solve, log(h / 1 m) (warm start: the previous logSinkage)";
+  input Real slopeStart(unit="1") = 0 "> 0: warm start with this slope d log Fz / d log h (the previous contactSlope); <= 0: cold start";
   output Real slip(unit="1") "Slip ratio, Eq. (4)";
   output Real h(unit="m") "Sinkage";
   output Real Fx(unit="N") "Longitudinal force of the soil on the wheel";
@@ -20,6 +22,8 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left";
   output Real slipAngle(unit="rad") "Slip angle of the hub velocity, seen from the direction of travel";
   output Real contactEvaluations(unit="1") "Force evaluations of the sinkage solve";
+  output Real logSinkage(unit="1") "log(h / 1 m) from the sinkage solve (a start for the next solve)";
+  output Real contactSlope(unit="1") "d log Fz / d log h near the sinkage (a start for the next solve)";
 protected
   Real direction "+1 travelling forwards, -1 backwards";
   Real FxSteady(unit="N") "Paper's Fx of the mirrored wheel";
@@ -36,8 +40,8 @@ algorithm
   slip := slipRatio(wheel.r*omega, v, vEps);
   direction := if noEvent(v > 0) then 1.0 else if noEvent(v < 0) then -1.0 else if noEvent(omega < 0) then -1.0 else 1.0;
   slipAngle := atan2(direction*vLat, noEvent(max(abs(v), vEps)));
-  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall, contactEvaluations) := wheelContact(W, direction*slip, soil, wheel,
-    nNodes, nIterations, 1e-10, 1e-3, slipAngle);
+  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall, contactEvaluations, logSinkage, contactSlope) := wheelContact(W,
+    direction*slip, soil, wheel, nNodes, nIterations, 1e-10, 1e-3, slipAngle, logSinkageStart, slopeStart);
   thetaF := acos(1 - h/wheel.r);
   thetaR := -acos(1 - soil.lam*h/wheel.r);
   entryAngle := direction*thetaF;
