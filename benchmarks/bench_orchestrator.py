@@ -1,9 +1,9 @@
 """Benchmark of the co-simulation master: the co-simulated rover (RoverBody + 6 Wheel FMUs) over
 20 s at a 1 ms communication step, run by our orchestrator (Jacobi and Gauss-Seidel, FMUs
-stepped in threads as by default) and by libcosimpy (Open Simulation Platform's libcosim,
-fixed-step) and ecospy (Ecos, which steps the FMUs on all cores) on the same FMUs in the same run.
-ecospy needs Debian's libtbb12: where it cannot be loaded the benchmark says why and goes on
-without it.
+stepped from C in threads as by default, and Jacobi with the Python master for comparison) and
+by libcosimpy (Open Simulation Platform's libcosim, fixed-step) and ecospy (Ecos, which steps the
+FMUs on all cores) on the same FMUs in the same run. ecospy needs Debian's libtbb12: where it
+cannot be loaded the benchmark says why and goes on without it.
 
 The torques are constant start values (20 N·m on every wheel and as reaction on the body), so
 the system has FMUs only and libcosim runs it in one ``simulate_until`` call. Reported: wall time,
@@ -28,6 +28,7 @@ from rover_cosim.fmubuild import build
 from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.libcosim import run_libcosim
 from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.native import unavailable_reason
 from rover_cosim.orchestrator.system import system_from_dict
 
 SYSTEM = example("rover_cosim")
@@ -35,9 +36,9 @@ FLOOR_RATIO = 3.0
 TORQUE = 20.0  # N·m
 
 
-def bench_system(algorithm: str, stop_time: float, step: float):
+def bench_system(algorithm: str, stop_time: float, step: float, native: bool = True):
     data = tomllib.loads(SYSTEM.read_text())
-    data["simulation"].update(algorithm=algorithm, stop_time=stop_time, step=step)
+    data["simulation"].update(algorithm=algorithm, stop_time=stop_time, step=step, native=native)
     data.pop("block")
     data["connection"] = [c for c in data["connection"] if not c["from"].startswith("torque.")]
     for fmu in data["fmu"]:
@@ -83,6 +84,43 @@ def run_ecospy(system: Any) -> tuple[float, float]:
     return time.perf_counter() - started, final_v
 
 
+def run_variant(name: str, stop_time: float, step: float) -> tuple[float, float | None, float | None]:
+    """One run of the variant ``name``: wall seconds, our master's overhead [s] and the body's
+    final velocity [m/s] (None where the tool does not give them)."""
+    if name == "ecospy":
+        wall, final_v = run_ecospy(bench_system("jacobi", stop_time, step))
+        return wall, None, final_v
+    if name == "libcosim":
+        return run_libcosim(bench_system("jacobi", stop_time, step), record=False).wall_seconds, None, None
+    algorithm = "gauss-seidel" if name == "ours_gauss_seidel" else "jacobi"
+    result = run(bench_system(algorithm, stop_time, step, native=name != "ours_jacobi_python_master"))
+    return result.wall_seconds, result.master_overhead_seconds, float(result.data["body.v"].iloc[-1])
+
+
+def measure(names: tuple[str, ...], repeats: int, stop_time: float, step: float) -> dict[str, dict[str, Any]]:
+    """``repeats`` rounds of one run of every variant (interleaved, so that a slower spell of the
+    machine hits all alike): per variant its entry (:func:`summary`)."""
+    runs: dict[str, list[tuple[float, float | None, float | None]]] = {name: [] for name in names}
+    for _ in range(repeats):
+        for name in names:
+            runs[name].append(run_variant(name, stop_time, step))
+    return {name: summary(outcomes, round(stop_time / step)) for name, outcomes in runs.items()}
+
+
+def summary(outcomes: list[tuple[float, float | None, float | None]], steps: int) -> dict[str, Any]:
+    """Wall times, their median per step, ours' master overhead and the final velocity."""
+    walls = [wall for wall, _, _ in outcomes]
+    overheads = [overhead for _, overhead, _ in outcomes if overhead is not None]
+    finals = [final for _, _, final in outcomes if final is not None]
+    entry: dict[str, Any] = {"wall_seconds": walls, "wall_seconds_median": statistics.median(walls),
+                             "wall_per_step_us_median": 1e6 * statistics.median(walls) / steps}
+    if overheads:  # negative where the FMUs step on several threads at once (their times add up)
+        entry["master_overhead_seconds"] = overheads
+    if finals:
+        entry["final_body_v_m_s"] = finals[-1]
+    return entry
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", type=Path, default=Path("results/bench/orchestrator.json"))
@@ -95,43 +133,25 @@ def main() -> None:
 
     build.build_all(build.FMU_MODELS, Path("fmus"), backend="builtin")
     steps = round(args.stop_time / args.step)
-    results: dict[str, dict] = {}
     missing = ecospy_missing()
     if missing:
         print(f"ecospy skipped: {missing}")
-    for name in ("ours_jacobi", "ours_gauss_seidel", "libcosim") + (() if missing else ("ecospy",)):
-        walls, overheads, finals = [], [], []
-        for _ in range(args.repeats):
-            if name == "ecospy":
-                wall, final_v = run_ecospy(bench_system("jacobi", args.stop_time, args.step))
-                walls.append(wall)
-                finals.append(final_v)
-            elif name == "libcosim":
-                outcome = run_libcosim(bench_system("jacobi", args.stop_time, args.step), record=False)
-                walls.append(outcome.wall_seconds)
-            else:
-                algorithm = "jacobi" if name == "ours_jacobi" else "gauss-seidel"
-                result = run(bench_system(algorithm, args.stop_time, args.step))
-                walls.append(result.wall_seconds)
-                overheads.append(result.master_overhead_seconds)
-                finals.append(float(result.data["body.v"].iloc[-1]))
-        entry = {"wall_seconds": walls, "wall_seconds_median": statistics.median(walls),
-                 "wall_per_step_us_median": 1e6 * statistics.median(walls) / steps}
-        if overheads:
-            entry["master_overhead_seconds"] = overheads
-            entry["master_overhead_per_step_us_median"] = 1e6 * statistics.median(overheads) / steps
-        if finals:
-            entry["final_body_v_m_s"] = finals[-1]
-        results[name] = entry
-        print(f"{name:18s} {entry['wall_seconds_median']:6.2f} s for {steps} steps "
-              f"({entry['wall_per_step_us_median']:.0f} us/step"
-              + (f", master overhead {entry['master_overhead_per_step_us_median']:.0f} us/step)" if overheads else ")"))
+    native_missing = unavailable_reason()
+    if native_missing:
+        print(native_missing)
+    names = ("ours_jacobi", "ours_gauss_seidel", "ours_jacobi_python_master", "libcosim") + (
+        () if missing else ("ecospy",))
+    results = measure(names, args.repeats, args.stop_time, args.step)
+    for name, entry in results.items():
+        print(f"{name:26s} {entry['wall_seconds_median']:6.2f} s for {steps} steps "
+              f"({entry['wall_per_step_us_median']:.0f} us/step)")
     ratios = {name: results[name]["wall_seconds_median"] / results["libcosim"]["wall_seconds_median"]
-              for name in ("ours_jacobi", "ours_gauss_seidel")}
+              for name in ("ours_jacobi", "ours_gauss_seidel", "ours_jacobi_python_master")}
     print("wall time / libcosim: " + ", ".join(f"{k} {v:.2f}x" for k, v in ratios.items())
           + f" (floor {FLOOR_RATIO:.0f}x)")
     to_ecospy = ({name: results[name]["wall_seconds_median"] / results["ecospy"]["wall_seconds_median"]
-                  for name in ("ours_jacobi", "ours_gauss_seidel")} if "ecospy" in results else None)
+                  for name in ("ours_jacobi", "ours_gauss_seidel", "ours_jacobi_python_master")}
+                 if "ecospy" in results else None)
     if to_ecospy:
         print("wall time / ecospy: " + ", ".join(f"{k} {v:.2f}x" for k, v in to_ecospy.items()) + " (goal <= 1)")
     record = run_record("make bench", {"repeats": args.repeats, "stop_time_s": args.stop_time, "step_s": args.step,

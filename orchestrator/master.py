@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from . import native
 from .participants import BlockParticipant, FmuParticipant, Participant, RunError
 from .recorder import Recorder, communication_points
 from .system import Iteration, System
@@ -58,6 +59,7 @@ class Master(ABC):
         self.step_seconds = {p.name: 0.0 for p in participants}
 
     pool: Crew | None = None
+    stepper: native.NativeStepper | None = None
 
     @abstractmethod
     def step(self, values: np.ndarray, t: float, h: float) -> None:
@@ -67,6 +69,29 @@ class Master(ABC):
         """End the master's threads (if any)."""
         if self.pool is not None:
             self.pool.shutdown()
+        if self.stepper is not None:
+            self.step_seconds.update(self.stepper.seconds())
+            self.stepper.close()
+            self.stepper = None
+
+    def _native(self, groups: list[list[int]], jacobi: bool, threads: int, enabled: bool) -> None:
+        """Hand the FMU groups to a native stepper (``native``), when enabled and available."""
+        fmu_groups = [g for g in groups if not isinstance(self.participants[g[0]], BlockParticipant)]
+        if not enabled or not fmu_groups or native.unavailable_reason() is not None:
+            return
+        self.stepper = native.NativeStepper(self.participants, self.inputs, self.outputs, fmu_groups, jacobi, threads)
+        self.pool = None  # the stepper has its own threads
+
+    @property
+    def blocks_free(self) -> bool:
+        return not any(isinstance(p, BlockParticipant) for p in self.participants)
+
+    def _check_native(self, failed: int, values: np.ndarray, t: float) -> None:
+        """A non-finite output from the native stepper, named as check_finite names it."""
+        if failed >= 0:
+            check_finite({p.name: p.outputs for p in self.participants if isinstance(p, FmuParticipant)},
+                         self, values, t)
+            raise RunError(f"native stepper: a non-finite output at t = {t:.6g} s")
 
     def _advance(self, i: int, u: np.ndarray, t: float, h: float) -> np.ndarray:
         """Step participant ``i`` with ``u`` and return a copy of its outputs at ``t + h``."""
@@ -98,15 +123,18 @@ class GaussSeidelMaster(Master):
     row of the order that read none of each other's outputs (the six wheels after the body) step
     at the same time in threads: the same values as one after the other."""
 
-    def __init__(self, participants: list[Participant], wiring: Wiring, threads: int = 1):
+    def __init__(self, participants: list[Participant], wiring: Wiring, threads: int = 1, use_native: bool = True):
         super().__init__(participants, wiring)
         self.pool = _pool(threads)
-        self.groups = _independent_runs(participants, self.inputs, self.outputs) if self.pool else [
+        self.groups = _independent_runs(participants, self.inputs, self.outputs) if threads > 1 else [
             [i] for i in range(len(participants))]
+        self._native(self.groups, False, threads, use_native)
 
     def step(self, values: np.ndarray, t: float, h: float) -> None:
         for group in self.groups:
-            if len(group) == 1:
+            if self.stepper is not None and not isinstance(self.participants[group[0]], BlockParticipant):
+                self._check_native(self.stepper.step_group(values, group[0], t, h), values, t + h)
+            elif len(group) == 1:
                 self._step_one(group[0], values, values[self.inputs[group[0]]], t, h)
             else:
                 self._step_together(group, values, [values[self.inputs[i]] for i in group], t, h)
@@ -116,13 +144,20 @@ class JacobiMaster(Master):
     """Every participant from the values at ``t``; outputs exchanged after all have stepped. With
     threads, the FMUs step at the same time (blocks, Python, in the calling thread)."""
 
-    def __init__(self, participants: list[Participant], wiring: Wiring, threads: int = 1):
+    def __init__(self, participants: list[Participant], wiring: Wiring, threads: int = 1, use_native: bool = True):
         super().__init__(participants, wiring)
         self.pool = _pool(threads)
         self.fmus = [i for i, p in enumerate(participants) if not isinstance(p, BlockParticipant)]
         self.blocks = [i for i, p in enumerate(participants) if isinstance(p, BlockParticipant)]
+        self._native([self.fmus], True, threads, use_native)
 
     def step(self, values: np.ndarray, t: float, h: float) -> None:
+        if self.stepper is not None:
+            gathered_blocks = [values[self.inputs[i]] for i in self.blocks]
+            self._check_native(self.stepper.step(values, t, h), values, t + h)
+            for i, u in zip(self.blocks, gathered_blocks):
+                values[self.outputs[i]] = self._advance(i, u, t, h)
+            return
         gathered = [values[inputs] for inputs in self.inputs]
         if self.pool is None or len(self.fmus) < 2:
             for i in range(len(self.participants)):
@@ -371,7 +406,7 @@ def make_master(system: System, participants: list[Participant], wiring: Wiring)
         return IterativeMaster(participants, wiring, system.iteration,
                                [names.get(slot, f"slot {slot}") for slot in range(wiring.size)])
     master_class = GaussSeidelMaster if system.algorithm == "gauss-seidel" else JacobiMaster
-    return master_class(participants, wiring, threads=system.threads)
+    return master_class(participants, wiring, threads=system.threads, use_native=system.native)
 
 
 def run(system: System, *, progress: Callable[[float], None] | None = None) -> RunResult:
@@ -391,16 +426,40 @@ def run(system: System, *, progress: Callable[[float], None] | None = None) -> R
         check_finite(names, master, values, system.start_time)
         recorder.sample(0, values)
         try:
-            for k in range(n_steps):
-                master.step(values, float(times[k]), float(times[k + 1] - times[k]))
-                check_finite(names, master, values, float(times[k + 1]))
-                recorder.sample(k + 1, values)
-                if progress is not None:
-                    progress((k + 1) / n_steps)
+            if master.stepper is not None and master.blocks_free:
+                _run_native(master, values, times, recorder, progress)
+            else:
+                for k in range(n_steps):
+                    master.step(values, float(times[k]), float(times[k + 1] - times[k]))
+                    check_finite(names, master, values, float(times[k + 1]))
+                    recorder.sample(k + 1, values)
+                    if progress is not None:
+                        progress((k + 1) / n_steps)
         except RunError as error:
             error.partial = recorder.frame()
             raise
+        master.close()
         return RunResult(recorder.frame(), time.perf_counter() - started, n_steps, master.step_seconds)
+
+
+#: Steps per call of the native stepper in a system without blocks (between progress reports).
+NATIVE_STRETCH = 500
+
+
+def _run_native(master: Master, values: np.ndarray, times: np.ndarray, recorder: Recorder,
+                progress: Callable[[float], None] | None) -> None:
+    """A system of FMUs only: stretches of steps in one native call each, recorded in place."""
+    assert master.stepper is not None
+    n_steps = len(times) - 1
+    record = np.ascontiguousarray(recorder.slots, dtype=np.int64)
+    for first in range(0, n_steps, NATIVE_STRETCH):
+        last = min(first + NATIVE_STRETCH, n_steps)
+        failed = master.stepper.run(values, times, first, last, record, recorder.rows)
+        recorder.filled = master.stepper.reached + 1
+        if failed >= 0:
+            master._check_native(failed, values, float(times[master.stepper.reached + 1]))
+        if progress is not None:
+            progress(last / n_steps)
 
 
 def check_finite(names: dict[str, list[str]], master: Master, values: np.ndarray, t: float) -> None:

@@ -175,9 +175,14 @@ class FmuParticipant:
         try:
             return action()
         except Exception as error:  # noqa: BLE001 - FMPy raises plain Exceptions on fmi2Error
-            detail = "; ".join(self.messages[-3:]) or str(error)
-            at = f" at t = {t:.6g} s" if t is not None else ""
-            raise RunError(f"{self.name} ({self.entry.path.name}): {what}{at} failed: {detail}") from None
+            self.fail(what, t, str(error))
+            raise  # not reached
+
+    def fail(self, what: str, t: float | None, error: str) -> None:
+        """Raise the RunError of the failed call ``what``, with what the FMU logged (else ``error``)."""
+        detail = "; ".join(self.messages[-3:]) or error
+        at = f" at t = {t:.6g} s" if t is not None else ""
+        raise RunError(f"{self.name} ({self.entry.path.name}): {what}{at} failed: {detail}") from None
 
     def configure(self, inputs: list[str], reads: list[str]) -> None:
         """Fix the inputs set and the variables read at every step (preallocated arrays)."""
@@ -191,6 +196,16 @@ class FmuParticipant:
         self.read_values = np.zeros(len(reads))
         self._in_pointer = self.input_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._read_pointer = self.read_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+    @property
+    def input_references(self) -> list[int]:
+        """Value references of the connected inputs, in the order of configure."""
+        return list(self._in_refs)[:len(self.inputs)]
+
+    @property
+    def output_references(self) -> list[int]:
+        """Value references of the variables read, in the order of configure."""
+        return list(self._read_refs)[:len(self.outputs)]
 
     def set_values(self, names: dict[str, float]) -> None:
         if names:

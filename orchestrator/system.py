@@ -123,6 +123,7 @@ class System:
     iteration: Iteration = field(default_factory=Iteration)
     algebraic_loop: list[Port] | None = None  # a cycle of direct feedthrough, if there is one
     threads: int = 1  # FMUs stepped at the same time where the algorithm allows (Jacobi, Gauss-Seidel)
+    native: bool = True  # Jacobi/Gauss-Seidel step the FMUs from C (orchestrator.native) where it builds
 
     def participants(self) -> dict[str, FmuEntry | BlockEntry]:
         """Every FMU and block entry by instance name."""
@@ -134,7 +135,8 @@ class System:
 #: The keys each section of a system file may have.
 SECTION_KEYS = {
     "simulation": {"stop_time", "step", "start_time", "algorithm", "order", "tolerance", "max_iterations",
-                   "relaxation", "allow_algebraic_loops", "threads"},
+                   "relaxation", "allow_algebraic_loops", "threads",
+                   "native"},
     "fmu": {"name", "path", "parameters", "start"},
     "connection": {"from", "to"},
     "record": {"variables"},
@@ -240,8 +242,11 @@ def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path 
     if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
         raise context.error("[simulation] threads", f"{threads!r}: expected a whole number >= 1 (FMUs stepped "
                             "at the same time)")
+    native = simulation.get("native", True)
+    if not isinstance(native, bool):
+        raise context.error("[simulation] native", f"{native!r}: expected true or false (FMUs stepped from C)")
     return System(path, fmus, blocks, connections, step, stop_time, start_time, algorithm, order, record, iteration,
-                  loop, threads)
+                  loop, threads, native)
 
 
 def dependency_graph(fmus: list[FmuEntry], blocks: list[BlockEntry],
