@@ -83,6 +83,13 @@ class Master(ABC):
         self.pool = None  # the stepper has its own threads
 
     @property
+    def checked_in_python(self) -> list[int]:
+        """Participants whose outputs the run loop checks (the native stepper checks its own)."""
+        if self.stepper is None:
+            return list(range(len(self.participants)))
+        return [i for i, p in enumerate(self.participants) if isinstance(p, BlockParticipant)]
+
+    @property
     def blocks_free(self) -> bool:
         return not any(isinstance(p, BlockParticipant) for p in self.participants)
 
@@ -429,9 +436,10 @@ def run(system: System, *, progress: Callable[[float], None] | None = None) -> R
             if master.stepper is not None and master.blocks_free:
                 _run_native(master, values, times, recorder, progress)
             else:
+                checked = master.checked_in_python
                 for k in range(n_steps):
                     master.step(values, float(times[k]), float(times[k + 1] - times[k]))
-                    check_finite(names, master, values, float(times[k + 1]))
+                    check_finite(names, master, values, float(times[k + 1]), checked)
                     recorder.sample(k + 1, values)
                     if progress is not None:
                         progress((k + 1) / n_steps)
@@ -462,9 +470,12 @@ def _run_native(master: Master, values: np.ndarray, times: np.ndarray, recorder:
             progress(last / n_steps)
 
 
-def check_finite(names: dict[str, list[str]], master: Master, values: np.ndarray, t: float) -> None:
-    """A RunError naming the participant, the signal and the time of the first non-finite output."""
-    for participant, outputs in zip(master.participants, master.outputs):
+def check_finite(names: dict[str, list[str]], master: Master, values: np.ndarray, t: float,
+                 which: list[int] | None = None) -> None:
+    """A RunError naming the participant, the signal and the time of the first non-finite output
+    (of the participants ``which``, default all)."""
+    for i in range(len(master.participants)) if which is None else which:
+        participant, outputs = master.participants[i], master.outputs[i]
         produced = values[outputs]
         if not np.all(np.isfinite(produced)):
             bad = int(np.nonzero(~np.isfinite(produced))[0][0])
