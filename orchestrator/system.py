@@ -8,6 +8,8 @@ stop_time = 6.0            # s
 step = 1e-3                # s, communication step
 algorithm = "gauss-seidel" # or "jacobi"
 # order = ["torque", "body", "wheel1"]   # Gauss-Seidel order (default: sources, FMUs, other blocks)
+# threads = 2              # FMUs stepped at the same time (default: the cores)
+# native = true            # FMUs stepped from C (orchestrator.native; default true)
 
 [[fmu]]
 name = "body"
