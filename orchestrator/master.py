@@ -80,7 +80,9 @@ class Master(ABC):
         if not enabled or not fmu_groups or native.unavailable_reason() is not None:
             return
         self.stepper = native.NativeStepper(self.participants, self.inputs, self.outputs, fmu_groups, jacobi, threads)
-        self.pool = None  # the stepper has its own threads
+        if self.pool is not None:  # the stepper has its own threads
+            self.pool.shutdown()
+            self.pool = None
 
     @property
     def checked_in_python(self) -> list[int]:

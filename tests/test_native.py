@@ -5,6 +5,7 @@ falls back to Python with the reason."""
 
 from __future__ import annotations
 
+import threading
 import tomllib
 
 import numpy as np
@@ -49,13 +50,16 @@ def test_native_stepping_gives_the_python_masters_results_exactly(fmu_dir, fmus,
 
 
 def test_the_masters_use_the_native_stepper_unless_switched_off(fmu_dir, fmus):
+    threads_before = threading.active_count()
     for switch, expected in ((True, True), (False, False)):
         system = system_from_dict(rover(native=switch), name="s", base=fmu_dir)
         wiring = wire(system)
         with participants_of(system, wiring) as participants:
             master = JacobiMaster(participants, wiring, threads=2, use_native=system.native)
             assert (master.stepper is not None) is expected
+            assert (master.pool is None) is expected  # the stepper has its own threads
             master.close()
+    assert threading.active_count() == threads_before  # no Python helper thread left behind
 
 
 @pytest.mark.parametrize("blocks", [True, False], ids=["with a block", "FMUs only"])
