@@ -12,7 +12,9 @@ The interface is small and mirrors an FMU slave at a fixed communication step:
 Optional: ``feedthrough`` (bool; default True for a block with inputs: its outputs depend on
 its inputs at the same instant, which the algebraic-loop check follows); ``get_state() -> state``
 and ``set_state(state)`` for the iterative master, which repeats a step (without them the
-master keeps a deep copy of the block's attributes).
+master keeps a deep copy of the block's attributes); ``native() -> native.NativeBlock | None``:
+the block's C twin, made from its state after ``start``, which the Jacobi and Gauss-Seidel masters
+step from C with the FMUs (see ``orchestrator.native``; the closed-loop controller has one).
 
 Sources ignore their inputs (they have none). A user block is any class with this interface;
 ``type = "python"`` in a system file loads it from ``factory = "module:callable"`` (the module

@@ -60,6 +60,8 @@ class Master(ABC):
 
     pool: Crew | None = None
     stepper: native.NativeStepper | None = None
+    #: Participants stepped by the native stepper (FMUs, and blocks with a C twin).
+    natively: frozenset[int] = frozenset()
 
     @abstractmethod
     def step(self, values: np.ndarray, t: float, h: float) -> None:
@@ -74,32 +76,44 @@ class Master(ABC):
             self.stepper.close()
             self.stepper = None
 
-    def _native(self, groups: list[list[int]], jacobi: bool, threads: int, enabled: bool) -> None:
-        """Hand the FMU groups to a native stepper (``native``), when enabled and available."""
-        fmu_groups = [g for g in groups if not isinstance(self.participants[g[0]], BlockParticipant)]
-        if not enabled or not fmu_groups or native.unavailable_reason() is not None:
-            return
-        self.stepper = native.NativeStepper(self.participants, self.inputs, self.outputs, fmu_groups, jacobi, threads)
+    def _steppable(self, i: int) -> bool:
+        """Whether participant ``i`` can be stepped natively: an FMU, or a block that has a C twin."""
+        participant = self.participants[i]
+        return not isinstance(participant, BlockParticipant) or participant.make_native()
+
+    def _native(self, groups: list[list[int]], jacobi: bool, threads: int, enabled: bool) -> list[list[int]]:
+        """Hand the groups whose participants can all be stepped natively to a native stepper,
+        when enabled and available (Jacobi: the participants of its one group that can); returns
+        those groups."""
+        if not enabled or native.unavailable_reason() is not None:
+            return []
+        if jacobi:
+            chosen = [[i for i in g if self._steppable(i)] for g in groups]
+        else:
+            chosen = [g for g in groups if all(self._steppable(i) for i in g)]
+        chosen = [g for g in chosen if g]
+        if not any(not isinstance(self.participants[i], BlockParticipant) for g in chosen for i in g):
+            return []  # blocks alone: nothing to gain
+        self.stepper = native.NativeStepper(self.participants, self.inputs, self.outputs, chosen, jacobi, threads)
+        self.natively = frozenset(i for g in chosen for i in g)
         if self.pool is not None:  # the stepper has its own threads
             self.pool.shutdown()
             self.pool = None
+        return chosen
 
     @property
     def checked_in_python(self) -> list[int]:
         """Participants whose outputs the run loop checks (the native stepper checks its own)."""
-        if self.stepper is None:
-            return list(range(len(self.participants)))
-        return [i for i, p in enumerate(self.participants) if isinstance(p, BlockParticipant)]
+        return [i for i in range(len(self.participants)) if i not in self.natively]
 
     @property
-    def blocks_free(self) -> bool:
-        return not any(isinstance(p, BlockParticipant) for p in self.participants)
+    def all_native(self) -> bool:
+        return len(self.natively) == len(self.participants)
 
     def _check_native(self, failed: int, values: np.ndarray, t: float) -> None:
         """A non-finite output from the native stepper, named as check_finite names it."""
         if failed >= 0:
-            check_finite({p.name: p.outputs for p in self.participants if isinstance(p, FmuParticipant)},
-                         self, values, t)
+            check_finite({p.name: p.outputs for p in self.participants}, self, values, t, sorted(self.natively))
             raise RunError(f"native stepper: a non-finite output at t = {t:.6g} s")
 
     def _advance(self, i: int, u: np.ndarray, t: float, h: float) -> np.ndarray:
@@ -141,7 +155,8 @@ class GaussSeidelMaster(Master):
 
     def step(self, values: np.ndarray, t: float, h: float) -> None:
         for group in self.groups:
-            if self.stepper is not None and not isinstance(self.participants[group[0]], BlockParticipant):
+            if group[0] in self.natively:
+                assert self.stepper is not None
                 self._check_native(self.stepper.step_group(values, group[0], t, h), values, t + h)
             elif len(group) == 1:
                 self._step_one(group[0], values, values[self.inputs[group[0]]], t, h)
@@ -156,9 +171,12 @@ class JacobiMaster(Master):
     def __init__(self, participants: list[Participant], wiring: Wiring, threads: int = 1, use_native: bool = True):
         super().__init__(participants, wiring)
         self.pool = _pool(threads)
+        every = list(range(len(participants)))
+        native_units = self._native([every], True, threads, use_native)
         self.fmus = [i for i, p in enumerate(participants) if not isinstance(p, BlockParticipant)]
         self.blocks = [i for i, p in enumerate(participants) if isinstance(p, BlockParticipant)]
-        self._native([self.fmus], True, threads, use_native)
+        if native_units:  # the blocks left for Python
+            self.blocks = [i for i in every if i not in self.natively]
 
     def step(self, values: np.ndarray, t: float, h: float) -> None:
         if self.stepper is not None:
@@ -403,7 +421,9 @@ def participants_of(system: System, wiring: Wiring) -> Iterator[list[Participant
             fmu.configure(ports.inputs, ports.outputs)
             by_name[entry.name] = fmu
         for block in system.blocks:
-            by_name[block.name] = BlockParticipant(block.name, block.block)
+            participant = BlockParticipant(block.name, block.block)
+            stack.callback(participant.close)
+            by_name[block.name] = participant
         yield [by_name[name] for name in system.order]
 
 
@@ -435,7 +455,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None) -> R
         check_finite(names, master, values, system.start_time)
         recorder.sample(0, values)
         try:
-            if master.stepper is not None and master.blocks_free:
+            if master.stepper is not None and master.all_native:
                 _run_native(master, values, times, recorder, progress)
             else:
                 checked = master.checked_in_python
@@ -452,13 +472,13 @@ def run(system: System, *, progress: Callable[[float], None] | None = None) -> R
         return RunResult(recorder.frame(), time.perf_counter() - started, n_steps, master.step_seconds)
 
 
-#: Steps per call of the native stepper in a system without blocks (between progress reports).
+#: Steps per call of the native stepper in a system stepped natively throughout (between progress reports).
 NATIVE_STRETCH = 500
 
 
 def _run_native(master: Master, values: np.ndarray, times: np.ndarray, recorder: Recorder,
                 progress: Callable[[float], None] | None) -> None:
-    """A system of FMUs only: stretches of steps in one native call each, recorded in place."""
+    """A system stepped natively throughout: stretches of steps in one native call each, recorded in place."""
     assert master.stepper is not None
     n_steps = len(times) - 1
     record = np.ascontiguousarray(recorder.slots, dtype=np.int64)

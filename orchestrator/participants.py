@@ -30,6 +30,7 @@ from fmpy.fmi2 import (
 )
 
 from .blocks import Block
+from .native import NativeBlock, NativeCalls, function_address
 from .system import FmuEntry
 
 T = TypeVar("T")
@@ -71,7 +72,9 @@ class Participant(Protocol):
 
 
 class BlockParticipant:
-    """A Python block in a run; ``outputs`` are the block's, ``inputs`` its (connected) inputs."""
+    """A Python block in a run; ``outputs`` are the block's, ``inputs`` its (connected) inputs.
+    A block with a ``native()`` method may be stepped by the native stepper instead
+    (:meth:`make_native`)."""
 
     iterative_start = False
 
@@ -81,6 +84,32 @@ class BlockParticipant:
         self.inputs = list(block.inputs)
         self.outputs = list(block.outputs)
         self.last = np.zeros(len(self.outputs))
+        self.native: NativeBlock | None = None
+        self._asked = False
+
+    def make_native(self) -> bool:
+        """Ask the block once for its C twin (``native()``, made from the block's state now, after
+        its start); False when it has none (no such method, or it returned None)."""
+        if not self._asked:
+            self._asked = True
+            maker = getattr(self.block, "native", None)
+            if maker is not None:
+                try:
+                    self.native = maker()
+                except Exception as error:  # noqa: BLE001 - user code: name the block
+                    raise RunError(f"{self.name} (block): native() failed: {type(error).__name__}: {error}") from error
+        return self.native is not None
+
+    def native_calls(self) -> NativeCalls:
+        """The C twin's calls for the native stepper (after make_native returned True)."""
+        assert self.native is not None
+        return self.native.calls(len(self.inputs), len(self.outputs))
+
+    def fail(self, what: str, t: float | None, error: str) -> None:
+        """Raise the RunError of a failed native step, with the C twin's message."""
+        detail = (self.native.message() if self.native is not None else "") or error
+        at = f" at t = {t:.6g} s" if t is not None else ""
+        raise RunError(f"{self.name} (block): step{at} failed: {detail}") from None
 
     def _call(self, what: str, action: Callable[[], Any], t: float) -> np.ndarray:
         try:
@@ -137,7 +166,9 @@ class BlockParticipant:
         """Nothing to free: the state is a Python object."""
 
     def close(self) -> None:
-        """Blocks hold no external resources."""
+        """Free the C twin, if one was made."""
+        if self.native is not None:
+            self.native.close()
 
 
 class FmuParticipant:
@@ -196,6 +227,13 @@ class FmuParticipant:
         self.read_values = np.zeros(len(reads))
         self._in_pointer = self.input_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._read_pointer = self.read_values.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+    def native_calls(self) -> NativeCalls:
+        """The instance and its fmi2SetReal, fmi2GetReal, fmi2DoStep for the native stepper."""
+        dll = self.fmu.dll
+        return NativeCalls(self.fmu.component, function_address(dll, "fmi2SetReal"),
+                           function_address(dll, "fmi2GetReal"), function_address(dll, "fmi2DoStep"),
+                           self.input_references, self.output_references)
 
     @property
     def input_references(self) -> list[int]:

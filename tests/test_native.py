@@ -80,6 +80,7 @@ def test_without_a_compiler_the_masters_stay_in_python_and_say_why(fmu_dir, fmus
     monkeypatch.setenv("ROVER_COSIM_CACHE", str(tmp_path / "cache"))
     monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
     native._library.cache_clear()
+    native.load_library.cache_clear()
     try:
         reason = native.unavailable_reason()
         assert reason is not None and "no-such-compiler" in reason
@@ -88,4 +89,5 @@ def test_without_a_compiler_the_masters_stay_in_python_and_say_why(fmu_dir, fmus
     finally:
         monkeypatch.undo()
         native._library.cache_clear()
+        native.load_library.cache_clear()
     assert native.unavailable_reason() is None

@@ -3,13 +3,18 @@
 The Jacobi and Gauss-Seidel masters hand their FMU participants to a :class:`NativeStepper`:
 one ctypes call steps a group of FMUs (gather inputs, fmi2SetReal, fmi2DoStep, fmi2GetReal,
 scatter outputs, finite check), on the stepper's own threads where the group has several, and a
-system without Python blocks runs whole stretches of steps in one call. The FMUs see the same
-calls in the same order as from the Python master, so the results are identical (tests).
+system whose participants are all stepped natively runs whole stretches of steps in one call. The
+FMUs see the same calls in the same order as from the Python master, so the results are
+identical (tests).
 
-``stepper.c`` is compiled on first use with the C compiler (``$CC`` or ``cc``) into the user's
-cache folder (``$ROVER_COSIM_CACHE`` or ``~/.cache/rover-cosim``), named by a digest of the source,
-written atomically so that parallel workers may race. Where no compiler works the masters stay
-in Python: :func:`unavailable_reason` says why.
+A block may be stepped natively as well: its ``native()`` returns a :class:`NativeBlock`, a C
+object with functions shaped like fmi2SetReal, fmi2DoStep and fmi2GetReal (inputs and outputs
+numbered 0, 1, ... in the block's order), which the stepper calls as it calls an FMU.
+
+``stepper.c`` (and a native block's source) is compiled on first use with the C compiler (``$CC``
+or ``cc``) into the user's cache folder (``$ROVER_COSIM_CACHE`` or ``~/.cache/rover-cosim``), named
+by a digest of the source, written atomically so that parallel workers may race. Where no
+compiler works the masters stay in Python: :func:`unavailable_reason` says why.
 """
 
 from __future__ import annotations
@@ -20,7 +25,8 @@ import os
 import shutil
 import subprocess
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -41,14 +47,17 @@ def cache_folder() -> Path:
     return Path(base) / "rover-cosim"
 
 
-def _compile(target: Path) -> None:
+def _compile(source: Path, target: Path) -> None:
     compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
     if not compiler:
         raise OSError("no C compiler ($CC, cc or gcc) on PATH")
     target.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=target.parent) as scratch:
         built = Path(scratch) / target.name
-        command = [compiler, "-O2", "-shared", "-fPIC", "-pthread", str(SOURCE), "-o", str(built), "-lm"]
+        # -ffp-contract=off: no fused multiply-adds, so that C arithmetic rounds as Python's does
+        # (native blocks give their Python twins' results bit for bit).
+        command = [compiler, "-O2", "-ffp-contract=off", "-shared", "-fPIC", "-pthread", str(source), "-o",
+                   str(built), "-lm"]
         done = subprocess.run(command, capture_output=True, text=True, check=False)
         if done.returncode != 0:
             raise OSError(f"{' '.join(command)} failed: {done.stderr.strip()[:500]}")
@@ -75,16 +84,26 @@ def _declare(library: ctypes.CDLL) -> ctypes.CDLL:
 
 
 @cache
-def _library() -> ctypes.CDLL | str:
-    """The loaded stepper library, or why there is none."""
-    digest = hashlib.sha256(SOURCE.read_bytes()).hexdigest()[:16]
-    target = cache_folder() / f"stepper-{digest}.so"
+def load_library(source: Path) -> ctypes.CDLL | str:
+    """The C file ``source`` compiled into a shared library (cached by its digest) and loaded,
+    or why that failed."""
+    digest = hashlib.sha256(source.read_bytes()).hexdigest()[:16]
+    target = cache_folder() / f"{source.stem}-{digest}.so"
     try:
         if not target.exists():
-            _compile(target)
-        return _declare(ctypes.CDLL(str(target)))
+            _compile(source, target)
+        return ctypes.CDLL(str(target))
     except OSError as error:
-        return f"native stepper unavailable ({error}); the masters step FMUs from Python"
+        return str(error)
+
+
+@cache
+def _library() -> ctypes.CDLL | str:
+    """The loaded stepper library, or why there is none."""
+    library = load_library(SOURCE)
+    if isinstance(library, str):
+        return f"native stepper unavailable ({library}); the masters step FMUs from Python"
+    return _declare(library)
 
 
 def unavailable_reason() -> str | None:
@@ -93,14 +112,59 @@ def unavailable_reason() -> str | None:
     return library if isinstance(library, str) else None
 
 
-def _function_address(dll: Any, name: str) -> int:
+def function_address(dll: Any, name: str) -> int:
     return ctypes.cast(getattr(dll, name), ctypes.c_void_p).value or 0
 
 
+@dataclass(frozen=True)
+class NativeCalls:
+    """What the stepper calls for one participant: ``component`` and the addresses of functions
+    shaped like fmi2SetReal, fmi2GetReal and fmi2DoStep, with the value references of the
+    inputs it sets and the outputs it reads (in the participant's order)."""
+
+    component: int
+    set_real: int
+    get_real: int
+    do_step: int
+    input_references: list[int]
+    output_references: list[int]
+
+
+class NativeBlock:
+    """A block's C twin: ``component`` (made by the library) and the library's functions
+    ``<prefix>_set_real``, ``<prefix>_get_real``, ``<prefix>_do_step`` (fmi2-shaped: status 0 ok,
+    3 error), ``<prefix>_message`` (the last error, a C string) and ``<prefix>_free``. Inputs
+    and outputs are numbered 0, 1, ... in the block's order. ``keep``: buffers the component
+    points into, kept alive with it."""
+
+    def __init__(self, library: ctypes.CDLL, component: int, prefix: str, keep: Sequence[Any] = ()):
+        self.library, self.component, self.prefix, self._keep = library, component, prefix, list(keep)
+        getattr(library, f"{prefix}_message").restype = ctypes.c_char_p
+        getattr(library, f"{prefix}_message").argtypes = [ctypes.c_void_p]
+        getattr(library, f"{prefix}_free").argtypes = [ctypes.c_void_p]
+        self._free: Callable[[int], None] | None = getattr(library, f"{prefix}_free")
+
+    def calls(self, n_inputs: int, n_outputs: int) -> NativeCalls:
+        def address(name: str) -> int:
+            return function_address(self.library, f"{self.prefix}_{name}")
+
+        return NativeCalls(self.component, address("set_real"), address("get_real"), address("do_step"),
+                           list(range(n_inputs)), list(range(n_outputs)))
+
+    def message(self) -> str:
+        text: bytes | None = getattr(self.library, f"{self.prefix}_message")(self.component)
+        return (text or b"").decode(errors="replace")
+
+    def close(self) -> None:
+        if self._free is not None:
+            self._free(self.component)
+            self._free = None
+
+
 class NativeStepper:
-    """Steps ``units`` (FMU participants, each with its input and output slots in the value
-    vector) group after group (``groups``: lists of positions in ``units``); Jacobi gathers every
-    input at ``t`` before any unit steps."""
+    """Steps ``units`` (participants with ``native_calls()`` and ``fail()``, each with its input
+    and output slots in the value vector) group after group (``groups``: lists of positions in
+    ``units``); Jacobi gathers every input at ``t`` before any unit steps."""
 
     def __init__(self, units: Sequence[Any], inputs: Sequence[np.ndarray], outputs: Sequence[np.ndarray],
                  groups: Sequence[Sequence[int]], jacobi: bool, threads: int):
@@ -121,17 +185,17 @@ class NativeStepper:
         def flat(kind: Any, per_unit: Sequence[Any]) -> Any:
             return array(kind, [int(v) for values in per_unit for v in values])
 
-        fmus = [unit.fmu for unit in self.units]
+        calls: list[NativeCalls] = [unit.native_calls() for unit in self.units]
         self._handle = library.stepper_new(
-            len(self.units), array(ctypes.c_void_p, [fmu.component for fmu in fmus]),
-            array(ctypes.c_void_p, [_function_address(fmu.dll, "fmi2SetReal") for fmu in fmus]),
-            array(ctypes.c_void_p, [_function_address(fmu.dll, "fmi2GetReal") for fmu in fmus]),
-            array(ctypes.c_void_p, [_function_address(fmu.dll, "fmi2DoStep") for fmu in fmus]),
-            array(ctypes.c_int, [len(unit.inputs) for unit in self.units]),
-            flat(ctypes.c_uint, [list(unit.input_references) for unit in self.units]),
+            len(self.units), array(ctypes.c_void_p, [c.component for c in calls]),
+            array(ctypes.c_void_p, [c.set_real for c in calls]),
+            array(ctypes.c_void_p, [c.get_real for c in calls]),
+            array(ctypes.c_void_p, [c.do_step for c in calls]),
+            array(ctypes.c_int, [len(c.input_references) for c in calls]),
+            flat(ctypes.c_uint, [c.input_references for c in calls]),
             flat(ctypes.c_longlong, [inputs[i] for i in order]),
-            array(ctypes.c_int, [len(unit.outputs) for unit in self.units]),
-            flat(ctypes.c_uint, [list(unit.output_references) for unit in self.units]),
+            array(ctypes.c_int, [len(c.output_references) for c in calls]),
+            flat(ctypes.c_uint, [c.output_references for c in calls]),
             flat(ctypes.c_longlong, [outputs[i] for i in order]),
             len(groups), array(ctypes.c_int, list(np.cumsum([0] + [len(g) for g in groups]))),
             int(jacobi), max(1, threads))
@@ -186,4 +250,4 @@ def _pointer(array: np.ndarray) -> int:
     return array.ctypes.data
 
 
-__all__ = ["NativeStepper", "cache_folder", "unavailable_reason"]
+__all__ = ["NativeBlock", "NativeCalls", "NativeStepper", "cache_folder", "load_library", "unavailable_reason"]

@@ -19,11 +19,18 @@ kp x_lag / kv = 0.5 %).
 
 from __future__ import annotations
 
+import ctypes
+from pathlib import Path
+
 import numpy as np
+
+from rover_cosim.orchestrator import native as native_code
 
 from .longitudinal import LongitudinalInverse, read_model
 
 WHEELS = 6
+#: The block's C twin (same arithmetic, same results), for the native stepper.
+C_SOURCE = Path(__file__).with_name("inverse_controller.c")
 
 
 class InverseModelController:
@@ -81,6 +88,35 @@ class InverseModelController:
 
     def set_state(self, state: tuple[np.ndarray, np.ndarray]) -> None:
         self.inverse.filter_state, self.torque = state[0].copy(), state[1].copy()
+
+    def native(self) -> native_code.NativeBlock | None:
+        """The block's C twin (inverse_controller.c) from its state now, for the native stepper;
+        None where it cannot be compiled (the block then steps in Python)."""
+        library = native_code.load_library(C_SOURCE)
+        if isinstance(library, str):
+            return None
+        inverse, model = self.inverse, self.model
+        if model.degree not in (1, 2):
+            return None  # the Python block reports it
+        real, pointer = ctypes.c_double, ctypes.c_void_p
+
+        def doubles(values: object) -> ctypes.Array:
+            flat = np.ascontiguousarray(values, dtype=float).ravel()
+            return (real * max(1, flat.size))(*flat.tolist())
+
+        library.controller_new.restype = pointer
+        library.controller_new.argtypes = [ctypes.c_int] * 4 + [pointer] * 7
+        settings = [self.mass, self.v_target, self.kv, self.kp, self.a_max, inverse.wn, self.step_size,
+                    float(self.fixed_load) if self.fixed_load else 0.0]
+        component = library.controller_new(
+            WHEELS, len(inverse._inverse), len(inverse._torques), model.degree, doubles(settings),
+            doubles(inverse._inverse), doubles(inverse._torques), doubles(inverse._settled), doubles(inverse._log_t),
+            doubles(inverse._coefficients), doubles(inverse.filter_state))
+        if not component:
+            sizes = f"{len(inverse._inverse)} loads x {len(inverse._torques)} torques"
+            raise MemoryError(f"block {self.name!r}: its C twin could not be made (tables of {sizes}: expected >= 2 "
+                              "each; or out of memory)")
+        return native_code.NativeBlock(library, component, "controller")
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         if not 0 < h <= self.step_size * (1 + 1e-9):

@@ -11,7 +11,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.linalg import expm
 
 from rover_cosim.identification.fits import IdentifiedModel
 
@@ -48,13 +47,14 @@ class LongitudinalInverse:
         self._coefficients = [[float(v) for v in row] for row in model.fx_coefficients]
 
     def discretised(self, step: float) -> tuple[np.ndarray, np.ndarray]:
-        """Eq. (17) as x' = A x + B u, x = (slip_f, slip_f'), discretised exactly for an input
-        held over ``step`` [s]."""
+        """Eq. (17) as x' = A x + b u, x = (slip_f, slip_f'), A = [[0, 1], [-wn², -2 wn]],
+        b = (0, wn²), discretised exactly for an input held over ``step`` [s]. The filter is
+        critically damped, so exp(A h) = e^(-wn h) [[1 + wn h, h], [-wn² h, 1 - wn h]] and
+        b_d = (1 - e^(-wn h) (1 + wn h), wn² h e^(-wn h)) (the C twin computes the same)."""
         wn = self.wn
-        a = np.array([[0.0, 1.0], [-wn**2, -2.0 * wn]])
-        b = np.array([0.0, wn**2])
-        ad = expm(a * step)
-        return ad, np.linalg.solve(a, (ad - np.eye(2)) @ b)
+        decay, wh, wn2 = math.exp(-wn * step), wn * step, wn * wn
+        ad = np.array([[decay * (1.0 + wh), decay * step], [decay * (-wn2 * step), decay * (1.0 - wh)]])
+        return ad, np.array([1.0 - decay * (1.0 + wh), wn2 * step * decay])
 
     def slips_for_forces(self, loads: np.ndarray, forces: np.ndarray) -> np.ndarray:
         """The slip at which the Fx(W, slip) block gives each force (for the quadratic model, the
@@ -137,7 +137,7 @@ class LongitudinalInverse:
             return linear
         if self.model.degree != 2:
             raise ValueError(f"block {self.name!r}: inverse of a degree-{self.model.degree} Fx model not implemented")
-        discriminant = c[1] ** 2 - 4.0 * c[2] * (c[0] - force)
+        discriminant = c[1] * c[1] - 4.0 * c[2] * (c[0] - force)
         if c[2] == 0 or discriminant < 0:
             return linear
         root = math.sqrt(discriminant)

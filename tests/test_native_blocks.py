@@ -1,0 +1,150 @@
+"""Blocks stepped by the native stepper (orchestrator.native.NativeBlock): the closed-loop
+controller's C twin (control/inverse_controller.c) gives the Python block's outputs bit for bit,
+alone on random inputs and in the paper's closed loop on both plants; its failures are named as
+the Python block's; without a compiler the block steps in Python."""
+
+from __future__ import annotations
+
+import ctypes
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.linalg import expm
+
+from rover_cosim.control.controller import InverseModelController
+from rover_cosim.jobs.simulate import cosim_system, monolithic_system
+from rover_cosim.orchestrator import native
+from rover_cosim.orchestrator.master import RunError, make_master, participants_of, run
+from rover_cosim.orchestrator.participants import BlockParticipant
+from rover_cosim.orchestrator.system import system_from_dict
+from rover_cosim.orchestrator.wiring import wire
+
+pytestmark = pytest.mark.skipif(native.unavailable_reason() is not None,
+                                reason=str(native.unavailable_reason()))
+
+
+@pytest.fixture(scope="module")
+def model(identified, results_root) -> Path:
+    return results_root / "identification" / "model.json"
+
+
+class Twin:
+    """The C twin of a block, called as the stepper calls it."""
+
+    def __init__(self, block: InverseModelController):
+        made = block.native()
+        assert made is not None
+        self.made, self.library = made, made.library
+        pointer = ctypes.c_void_p
+        for name in ("set_real", "get_real"):
+            getattr(self.library, f"controller_{name}").argtypes = [pointer, pointer, ctypes.c_size_t, pointer]
+        self.library.controller_do_step.argtypes = [pointer, ctypes.c_double, ctypes.c_double, ctypes.c_int]
+        self.inputs = (ctypes.c_uint * len(block.inputs))(*range(len(block.inputs)))
+        self.outputs = (ctypes.c_uint * len(block.outputs))(*range(len(block.outputs)))
+        self.values = np.zeros(len(block.outputs))
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        u = np.ascontiguousarray(u, dtype=float)
+        self.library.controller_set_real(self.made.component, self.inputs, u.size, u.ctypes.data)
+        status = self.library.controller_do_step(self.made.component, t, h, 1)
+        if status != 0:
+            raise ValueError(self.made.message())
+        self.library.controller_get_real(self.made.component, self.outputs, self.values.size, self.values.ctypes.data)
+        return self.values.copy()
+
+
+def random_inputs(rng: np.random.Generator) -> np.ndarray:
+    """x [m], v [m/s] (inside and beyond the saturation of the demand), six loads [N] across the
+    table and beyond it."""
+    return np.array([rng.uniform(-2.0, 40.0), rng.uniform(-1.0, 2.0), *rng.uniform(50.0, 1200.0, 6)])
+
+
+@pytest.mark.parametrize("options", [{}, {"model_label": "linear"}, {"fixed_load": 424.0}],
+                         ids=["quadratic model", "linear model", "fixed load"])
+def test_the_c_twin_gives_the_python_blocks_outputs_bit_for_bit(model, options):
+    rng = np.random.default_rng(18)
+    block = InverseModelController("ctrl", str(model), **options)
+    block.start(0.0, random_inputs(rng))
+    twin = Twin(block)
+    steps = [1e-3] * 3000 + [4e-4, 1e-3 * (1 + 1e-10), 1e-3]  # a shorter step, one within the allowance
+    t = 0.0
+    for k, h in enumerate(steps):
+        u = random_inputs(rng)
+        expected, got = block.step(t, h, u), twin.step(t, h, u)
+        assert np.array_equal(expected, got), f"step {k}: {expected - got}"
+        t += h
+    twin.made.close()
+
+
+def test_the_c_twin_refuses_what_the_python_block_refuses(model):
+    block = InverseModelController("ctrl", str(model))
+    u = np.array([0.0, 0.0, *[424.0] * 6])
+    block.start(0.0, u)
+    twin = Twin(block)
+    with pytest.raises(ValueError, match=r"communication step 0.002 s: expected at most its step = 0.001 s"):
+        twin.step(0.0, 2e-3, u)
+    with pytest.raises(ValueError, match=r"loads = -5 N: expected > 0"):
+        twin.step(0.0, 1e-3, np.array([0.0, 0.0, 424.0, -5.0, *[424.0] * 4]))
+    twin.made.close()
+
+
+def test_the_filter_is_discretised_exactly(model):
+    """The closed form of the critically damped filter against scipy's matrix exponential."""
+    inverse = InverseModelController("ctrl", str(model)).inverse
+    wn = inverse.wn
+    a, b = np.array([[0.0, 1.0], [-wn * wn, -2.0 * wn]]), np.array([0.0, wn * wn])
+    for step in (1e-5, 1e-3, 2.5e-2):  # wn h up to 8.6
+        ad, bd = inverse.discretised(step)
+        exact = expm(a * step)
+        np.testing.assert_allclose(ad, exact, rtol=1e-12, atol=1e-12 * np.abs(exact).max())
+        np.testing.assert_allclose(bd, np.linalg.solve(a, (exact - np.eye(2)) @ b), rtol=1e-10, atol=1e-13)
+
+
+def short(system: dict, stop_time: float, **simulation: object) -> dict:
+    system["simulation"].update(stop_time=stop_time, **simulation)
+    return system
+
+
+@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
+@pytest.mark.parametrize("plant", [monolithic_system, cosim_system], ids=["Rover.fmu", "co-simulated"])
+def test_the_closed_loop_with_the_c_twin_is_the_python_closed_loop(fmu_dir, model, plant, algorithm):
+    def system(native_stepping: bool) -> dict:
+        return short(plant(fmu_dir, model), 0.4, algorithm=algorithm, native=native_stepping)
+
+    python = run(system_from_dict(system(False), name="python", base=fmu_dir))
+    ours = system_from_dict(system(True), name="native", base=fmu_dir)
+    wiring = wire(ours)
+    with participants_of(ours, wiring) as participants:
+        master = make_master(ours, participants, wiring)
+        assert master.all_native  # the controller is stepped by the stepper as well
+        master.close()
+    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+
+
+def test_a_failing_c_twin_is_named_with_its_message(fmu_dir, model):
+    data = short(monolithic_system(fmu_dir, model, step=5e-4), 0.1)  # made for a shorter step than the system's
+    with pytest.raises(RunError, match=r"ctrl \(block\): step at t = 0 s failed: communication step 0.001 s: "
+                                       r"expected at most its step = 0.0005 s") as info:
+        run(system_from_dict(data, name="t", base=fmu_dir))
+    assert len(info.value.partial) == 1  # the start only
+
+
+def test_without_a_compiler_the_controller_steps_in_python(fmu_dir, model, tmp_path, monkeypatch):
+    monkeypatch.setenv("ROVER_COSIM_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    native.load_library.cache_clear()  # the stepper stays loaded; the controller's source is new to the cache
+    try:
+        assert InverseModelController("ctrl", str(model)).native() is None
+        system = system_from_dict(short(monolithic_system(fmu_dir, model), 0.05), name="t", base=fmu_dir)
+        wiring = wire(system)
+        with participants_of(system, wiring) as participants:
+            master = make_master(system, participants, wiring)
+            ctrl = next(p for p in participants if isinstance(p, BlockParticipant))
+            assert master.stepper is not None and participants.index(ctrl) not in master.natively
+            master.close()
+        assert len(run(system).data) == 51
+    finally:
+        monkeypatch.undo()
+        native.load_library.cache_clear()
