@@ -1,8 +1,10 @@
 """Benchmark of the paper's closed loop (issue 18, part 6): 20 s at 1 ms, Gauss-Seidel, the
 identified-model controller on the monolithic Rover.fmu and on the co-simulated RoverBody + 6
-Wheel (FMUs stepped in threads, as by default), timed in the same run; and where the time goes:
-per communication step, the wall time, the master's own share (wall minus the time inside
-participant calls) and, from the FMUs' statistics (one more run that records them), the model
+Wheel (FMUs stepped in threads, as by default), timed in the same run, each also with the
+controller stepped in Python instead of its C twin; and where the time goes: per communication
+step, the wall time, the time inside each participant's calls (measured by the native stepper;
+summed over threads, so wall minus their sum, the "master's own share", is negative when
+participants step in parallel) and, from the FMUs' statistics (one more run that records them), the model
 evaluations, Jacobians and integrator steps of each FMU, and the force evaluations of each sinkage
 solve (``contactEvaluations`` of every wheel, averaged over the communication points).
 
@@ -18,12 +20,15 @@ from __future__ import annotations
 import argparse
 import statistics
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.control.controller import InverseModelController
 from rover_cosim.fmubuild import build
 from rover_cosim.jobs.simulate import STEP, STOP_TIME, cosim_system, monolithic_system
 from rover_cosim.orchestrator.master import run
@@ -81,6 +86,18 @@ def costs(plant: str, fmu_dir: Path, model: Path, stop_time: float) -> dict[str,
     return per_fmu
 
 
+@contextmanager
+def python_controller() -> Iterator[None]:
+    """The controller block without its C twin: stepped in Python between native FMU steps
+    (what the closed loop cost before the twin)."""
+    original = InverseModelController.native
+    InverseModelController.native = lambda self: None  # type: ignore[method-assign]
+    try:
+        yield
+    finally:
+        InverseModelController.native = original  # type: ignore[method-assign]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", type=Path, default=Path("results/bench/closed_loop.json"))
@@ -100,11 +117,16 @@ def main() -> None:
     results: dict[str, dict[str, Any]] = {}
     baseline = args.baseline_fmu_dir.resolve() if args.baseline_fmu_dir else None
     for plant in BUILDERS:
-        walls, overheads, baseline_walls = [], [], []
-        for _ in range(args.repeats):
+        walls, overheads, baseline_walls, python_walls = [], [], [], []
+        inside: dict[str, list[float]] = {}
+        for _ in range(args.repeats):  # the variants interleaved, round by round
             outcome = run(system(plant, fmu_dir, model, args.stop_time))
             walls.append(outcome.wall_seconds)
             overheads.append(outcome.master_overhead_seconds)
+            for name, seconds in outcome.step_seconds.items():
+                inside.setdefault(name, []).append(1e6 * seconds / steps)
+            with python_controller():
+                python_walls.append(run(system(plant, fmu_dir, model, args.stop_time)).wall_seconds)
             if baseline:
                 baseline_walls.append(run(system(plant, baseline, model, args.stop_time)).wall_seconds)
         wall = statistics.median(walls)
@@ -113,9 +135,13 @@ def main() -> None:
             "wall_seconds": walls, "wall_seconds_median": wall, "real_time_factor": args.stop_time / wall,
             "wall_per_step_us": 1e6 * wall / steps,
             "master_overhead_per_step_us": 1e6 * statistics.median(overheads) / steps,
+            "inside_participant_us_per_step": {name: statistics.median(v) for name, v in inside.items()},
+            "python_controller_wall_seconds": python_walls,
+            "speedup_over_python_controller": statistics.median(python_walls) / wall,
             "goal_wall_seconds": goal, "goal_met": wall <= goal,
             "fmu_costs": costs(plant, fmu_dir, model, args.stop_time),
         }
+        print(f"{plant:10s} with the controller in Python {statistics.median(python_walls):6.2f} s")
         if baseline:
             results[plant].update(baseline_fmu_dir=str(baseline), baseline_wall_seconds=baseline_walls,
                                   speedup_over_baseline=statistics.median(baseline_walls) / wall)

@@ -44,6 +44,7 @@ algorithm
   d2 := 1/tan(soil.xc) + tan(soil.phi)/tan(soil.xc)^2;
   sumFy := 0;
   sumPile := 0;
+  depth := 0;
   hc := noEvent(min(max(h, 0.0), wheel.r));
   thetaF := acos(1 - hc/wheel.r);
   thetaR := -acos(1 - soil.lam*hc/wheel.r);
@@ -66,9 +67,12 @@ algorithm
     Fz := Fz + ds*dFront*(sigma*cos(theta) + tau*sin(theta));
     Fx := Fx + ds*dFront*(tau*cos(theta) - sigma*sin(theta));
     Tx := Tx + ds*dFront*tau;
-    sumFy := sumFy + ds*dFront*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
-    depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
-    sumPile := sumPile + ds*dFront*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
+    if noEvent(tanBeta <> 0) then
+      // Lateral shear and sidewall: both vanish at beta = 0 (zero displacement), not computed then.
+      sumFy := sumFy + ds*dFront*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
+      depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
+      sumPile := sumPile + ds*dFront*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
+    end if;
     // Rear piece [thetaR, thetaM], Eq. (6), nodes crowding at thetaR: the equivalent front
     // angle of this node, thetaF - (theta - thetaR)/dRear*dFront, is the front node's, so the
     // normal stress is the one just computed.
@@ -77,9 +81,11 @@ algorithm
     Fz := Fz + ds*dRear*(sigma*cos(theta) + tau*sin(theta));
     Fx := Fx + ds*dRear*(tau*cos(theta) - sigma*sin(theta));
     Tx := Tx + ds*dRear*tau;
-    sumFy := sumFy + ds*dRear*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
-    depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
-    sumPile := sumPile + ds*dRear*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
+    if noEvent(tanBeta <> 0) then
+      sumFy := sumFy + ds*dRear*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
+      depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
+      sumPile := sumPile + ds*dRear*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
+    end if;
   end for;
   Fz := wheel.r*wheel.b*Fz;
   Fx := wheel.r*wheel.b*Fx;
@@ -119,6 +125,7 @@ D<sub>2</sub> &rho; g h<sup>2</sup>/2) with h = r(cos &theta; - cos &theta;<sub>
 1960, as in Ishigami 2007), integrated with the lever r - h cos &theta; and mobilised by
 1 - exp(-|j<sub>y</sub>(&theta;<sub>r</sub>)|/k<sub>y</sub>), so that it vanishes smoothly at
 &beta; = 0. F<sub>y</sub> = F<sub>y,sidewall</sub> - r b &int;&tau;<sub>y</sub> d&theta; opposes
-the sideways sliding. Same as <code>terramechanics.lateral</code>.</p>
+the sideways sliding. Same as <code>terramechanics.lateral</code>. At &beta; = 0 both lateral parts are
+zero (no lateral displacement) and are not computed: a third of the exponentials of an evaluation.</p>
 </html>"));
 end contactForces;
