@@ -48,6 +48,7 @@ typedef struct {
     const long long *in_slot, *out_slot;
     double *in, *out;   /* gathered inputs, outputs read */
     double seconds;     /* time inside this unit's FMI calls */
+    double last;        /* ... in its last step, to order the next one */
     int failed_call, status;
 } Unit;
 
@@ -70,6 +71,7 @@ struct Stepper {
     int pending, stop;      /* helpers still working on it (atomic); shutting down */
     int work_begin, work_end; /* the units of the piece of work */
     int next;                 /* the next unit of it to take (atomic) */
+    int *order;               /* the units of the piece of work, the costliest of the last step first */
     double t, h;
 };
 
@@ -102,16 +104,28 @@ static void advance(Unit *u, double t, double h) {
         for (int i = 0; i < u->n_out; i++)
             if (!isfinite(u->out[i])) { u->failed_call = CALL_NOT_FINITE; break; }
     u->status = status;
-    u->seconds += now() - begin;
+    u->last = now() - begin;
+    u->seconds += u->last;
 }
 
 /* The threads take the units of the piece of work one at a time, the next free one each (their
- * costs differ from step to step: rejected integrator steps, Jacobians). */
+ * costs differ from step to step: rejected integrator steps, Jacobians), the costliest of the
+ * last step first, so that the cheap ones fill the gaps at the end (longest processing time
+ * first). Which thread steps a unit does not change its results. */
 static void advance_share(Stepper *s) {
     for (;;) {
-        int i = __atomic_fetch_add(&s->next, 1, __ATOMIC_ACQ_REL);
-        if (i >= s->work_end) return;
-        advance(&s->units[i], s->t, s->h);
+        int k = __atomic_fetch_add(&s->next, 1, __ATOMIC_ACQ_REL);
+        if (k >= s->work_end) return;
+        advance(&s->units[s->order[k]], s->t, s->h);
+    }
+}
+
+/* order[begin..end-1]: units begin..end-1 by decreasing cost in their last step. */
+static void order_by_cost(Stepper *s, int begin, int end) {
+    for (int k = begin; k < end; k++) {
+        int unit = k, j = k;
+        for (; j > begin && s->units[s->order[j - 1]].last < s->units[unit].last; j--) s->order[j] = s->order[j - 1];
+        s->order[j] = unit;
     }
 }
 
@@ -164,6 +178,7 @@ static void advance_units(Stepper *s, int begin, int end, double t, double h) {
         return;
     }
     s->work_begin = begin; s->work_end = end; s->t = t; s->h = h;
+    order_by_cost(s, begin, end);
     __atomic_store_n(&s->next, begin, __ATOMIC_RELEASE);
     __atomic_store_n(&s->pending, s->threads - 1, __ATOMIC_RELEASE);
     __atomic_add_fetch(&s->generation, 1, __ATOMIC_ACQ_REL); /* publishes the work above */
@@ -256,7 +271,8 @@ Stepper *stepper_new(int n_units, Component *components, void **set_real, void *
     pthread_cond_init(&s->wake, NULL);
     pthread_cond_init(&s->done, NULL);
     s->units = calloc((size_t)(n_units ? n_units : 1), sizeof *s->units);
-    if (!s->units) { s->threads = 1; stepper_free(s); return NULL; }
+    s->order = calloc((size_t)(n_units ? n_units : 1), sizeof *s->order);
+    if (!s->units || !s->order) { s->threads = 1; s->n_units = s->units ? n_units : 0; stepper_free(s); return NULL; }
     size_t offset_in = 0, offset_out = 0;
     for (int i = 0; i < n_units; i++) {
         Unit *u = &s->units[i];
@@ -298,6 +314,7 @@ void stepper_free(Stepper *s) {
     }
     for (int i = 0; i < s->n_units; i++) { free(s->units[i].in); free(s->units[i].out); }
     free(s->units);
+    free(s->order);
     pthread_mutex_destroy(&s->lock);
     pthread_cond_destroy(&s->wake);
     pthread_cond_destroy(&s->done);
