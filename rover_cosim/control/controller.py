@@ -91,7 +91,8 @@ class InverseModelController:
 
     def native(self) -> native_code.NativeBlock | None:
         """The block's C twin (inverse_controller.c) from its state now, for the native stepper;
-        None where it cannot be compiled (the block then steps in Python)."""
+        None where it cannot be compiled (the block then steps in Python). The twin keeps its own
+        state: a run stepped by it leaves this block's state as it was after ``start``."""
         library = native_code.load_library(C_SOURCE)
         if isinstance(library, str):
             return None
@@ -108,12 +109,12 @@ class InverseModelController:
         library.controller_new.argtypes = [ctypes.c_int] * 4 + [pointer] * 7
         settings = [self.mass, self.v_target, self.kv, self.kp, self.a_max, inverse.wn, self.step_size,
                     float(self.fixed_load) if self.fixed_load else 0.0]
+        loads, torques, settled, log_t, coefficients = inverse.tables()
         component = library.controller_new(
-            WHEELS, len(inverse._inverse), len(inverse._torques), model.degree, doubles(settings),
-            doubles(inverse._inverse), doubles(inverse._torques), doubles(inverse._settled), doubles(inverse._log_t),
-            doubles(inverse._coefficients), doubles(inverse.filter_state))
+            WHEELS, len(loads), len(torques), model.degree, doubles(settings), doubles(loads), doubles(torques),
+            doubles(settled), doubles(log_t), doubles(coefficients), doubles(inverse.filter_state))
         if not component:
-            sizes = f"{len(inverse._inverse)} loads x {len(inverse._torques)} torques"
+            sizes = f"{len(loads)} loads x {len(torques)} torques"
             raise MemoryError(f"block {self.name!r}: its C twin could not be made (tables of {sizes}: expected >= 2 "
                               "each; or out of memory)")
         return native_code.NativeBlock(library, component, "controller")

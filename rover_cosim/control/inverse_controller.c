@@ -188,9 +188,6 @@ int controller_do_step(void *component, double t, double h, int no_prior_state) 
     return outputs(c, t + h, 1, h);
 }
 
-/* The outputs at the start (the filter settled at the targets), for tests. */
-int controller_start(void *component, double t0) { return outputs(component, t0, 0, 0.0); }
-
 const char *controller_message(void *component) { return ((Controller *)component)->message; }
 
 void controller_free(void *component) {

@@ -46,6 +46,12 @@ class LongitudinalInverse:
         self._log_t = [[float(v) for v in row] for row in np.log(np.asarray(model.time_constant, float))]
         self._coefficients = [[float(v) for v in row] for row in model.fx_coefficients]
 
+    def tables(self) -> tuple[list[float], list[float], list[list[float]], list[list[float]], list[list[float]]]:
+        """The tables of the per-step path, for the controller's C twin: 1/W of the loads
+        [1/N] (decreasing), the torques [N·m], per load the settled slips and log T [log s], and
+        the Fx model's coefficient rows."""
+        return self._inverse, self._torques, self._settled, self._log_t, self._coefficients
+
     def discretised(self, step: float) -> tuple[np.ndarray, np.ndarray]:
         """Eq. (17) as x' = A x + b u, x = (slip_f, slip_f'), A = [[0, 1], [-wn², -2 wn]],
         b = (0, wn²), discretised exactly for an input held over ``step`` [s]. The filter is
