@@ -13,3 +13,8 @@
   ``fmubuild.build``: compile and package, incremental and atomic; ``fmubuild.omc``: the
   OpenModelica backend.
 """
+
+from rover_cosim.common.identity import require_root
+
+require_root(__name__)
+

@@ -10,3 +10,8 @@
   Fit at 275, 575, 875 N and 7.5, 12.5 deg; ``lateral_figures``;
   ``make identify`` is the job ``rover_cosim.jobs.identify``.
 """
+
+from rover_cosim.common.identity import require_root
+
+require_root(__name__)
+

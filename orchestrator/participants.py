@@ -30,8 +30,8 @@ from fmpy.fmi2 import (
 )
 
 from .blocks import Block
+from .model import FmuEntry
 from .native import NativeBlock, NativeCalls, function_address
-from .system import FmuEntry
 
 T = TypeVar("T")
 

@@ -1,11 +1,14 @@
-"""Recorded values of a run: one row per communication point, in a preallocated array."""
+"""Recorded values of a run: one row per communication point, in a preallocated array, and the
+:class:`RunResult` a run returns."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
-from .system import Port
+from .model import Port
 
 
 def communication_points(t0: float, stop_time: float, h: float) -> np.ndarray:
@@ -39,3 +42,17 @@ class Recorder:
         data = pd.DataFrame(self.rows[:self.filled], columns=self.columns)
         data.insert(0, "time", self.times[:self.filled])
         return data
+
+
+@dataclass
+class RunResult:
+    data: pd.DataFrame  # time [s] and one column per recorded "instance.variable"
+    wall_seconds: float
+    steps: int
+    step_seconds: dict[str, float] = field(default_factory=dict)  # time inside each participant's step
+    #: Why an observer ended the run before its stop time (None: it ran to the end).
+    stopped: str | None = None
+
+    @property
+    def master_overhead_seconds(self) -> float:
+        return self.wall_seconds - sum(self.step_seconds.values())

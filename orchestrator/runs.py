@@ -8,8 +8,10 @@ from typing import Any
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 
-from .master import RunResult
-from .system import System
+from .model import System
+from .observers import Observer
+from .participants import RunError
+from .recorder import RunResult
 
 
 def sidecar(system: System, result: RunResult, command: str) -> dict[str, object]:
@@ -66,3 +68,16 @@ def write_run(system: System, result: RunResult, csv_path: Path, command: str = 
     csv_bytes = result.data.to_csv(index=False, float_format="%.10g").encode()
     write_all({csv_path: csv_bytes, json_path: json_bytes(sidecar(system, result, command))})
     return [csv_path, json_path]
+
+
+class PartialWriter(Observer):
+    """An observer that writes the rows of a failed run (more than the start) with
+    :func:`write_partial`; ``written``: the files, once it did."""
+
+    def __init__(self, system: System, csv_path: Path, command: str = "rover-cosim run"):
+        self.system, self.csv_path, self.command = system, Path(csv_path), command
+        self.written: list[Path] = []
+
+    def fail(self, error: RunError) -> None:
+        if error.partial is not None and len(error.partial) > 1:
+            self.written = write_partial(self.system, error.partial, self.csv_path, str(error), self.command)

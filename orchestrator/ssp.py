@@ -29,7 +29,9 @@ from lxml import etree
 
 from rover_cosim.common.units import base_units
 
-from .system import BlockEntry, Connection, System, system_from_dict
+from .blocks import make_block
+from .builder import SystemBuilder
+from .model import BlockEntry, Connection, System
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -80,7 +82,7 @@ def _classify_blocks(system: System) -> tuple[dict[str, float], list[BlockEntry]
     for entry in system.blocks:
         targets = [c.target.instance for c in system.connections if c.source.instance == entry.name]
         if entry.kind == "constant" and all(t in fmus for t in targets):
-            constants[entry.name] = float(entry.keys["value"])
+            constants[entry.name] = float(entry.block.constant)  # type: ignore[attr-defined]
         else:
             external.append(entry)
     return constants, external
@@ -197,9 +199,16 @@ class _SsdWriter:
                               "max_iterations": system.iteration.max_iterations,
                               "relaxation": system.iteration.relaxation},
                 "allow_algebraic_loops": system.algebraic_loop is not None,
-                "blocks": [{"name": e.name, "type": e.kind, **e.keys} for e in self.external],
+                "blocks": [{"name": e.name, "type": e.kind, **_keys(e)} for e in self.external],
                 "block_connections": [{"from": str(c.source), "to": str(c.target)} for c in system.connections
                                       if c.source.instance in self.outside or c.target.instance in self.outside]}
+
+
+def _keys(entry: BlockEntry) -> dict[str, Any]:
+    if entry.keys is None:
+        raise SspError(f"block {entry.name!r} ({type(entry.block).__name__}) was built in code from an object: the "
+                       "archive keeps a block as its type and keys, so it cannot be exported")
+    return entry.keys
 
 
 def parameter_file(instance: str) -> str:
@@ -260,15 +269,29 @@ def load_ssp(archive: Path, folder: Path) -> System:
     ns = {"ssd": SSD, "ssc": SSC, "ssv": SSV}
     top = ssd_root.find("ssd:System", ns)
     settings = _settings(ssd_root, ns)
-    connections = [{"from": f"{c.get('startElement')}.{c.get('startConnector')}",
-                    "to": f"{c.get('endElement')}.{c.get('endConnector')}"}
-                   for c in top.findall("ssd:Connections/ssd:Connection", ns)
-                   if c.get("startElement") and c.get("endElement")]  # system connectors: the blocks' side
-    data = {"simulation": _simulation(settings), "fmu": _fmu_entries(top, folder, ns),
-            "block": settings.get("blocks", []), "connection": connections + settings.get("block_connections", [])}
+    builder = SystemBuilder(str(archive), base=folder)
+    builder.simulation(where="[simulation]", **_simulation(settings))
+    for entry in _fmu_entries(top, folder, ns):
+        builder.add_fmu(entry["name"], entry["path"], parameters=entry["parameters"], start=entry["start"],
+                        where=f"[[fmu]] {entry['name']!r}")
+    for entry in settings.get("blocks", []):
+        keys = {k: v for k, v in entry.items() if k not in ("name", "type")}
+        where = f"[[block]] {entry['name']!r}"
+        try:
+            block = make_block(entry["name"], entry["type"], keys, None)
+        except ValueError as failure:
+            raise builder.error(where, str(failure)) from None
+        builder.add_block(entry["name"], block, kind=entry["type"], keys=keys, where=where)
+    elements = [c for c in top.findall("ssd:Connections/ssd:Connection", ns)
+                if c.get("startElement") and c.get("endElement")]  # system connectors: the blocks' side
+    connections = [(f"{c.get('startElement')}.{c.get('startConnector')}",
+                    f"{c.get('endElement')}.{c.get('endConnector')}") for c in elements]
+    connections += [(c["from"], c["to"]) for c in settings.get("block_connections", [])]
+    for i, (source, target) in enumerate(connections, 1):
+        builder.connect(source, target, where=f"connection {i} ({source} -> {target})")
     if settings.get("record"):
-        data["record"] = {"variables": settings["record"]}
-    return system_from_dict(data, name=str(archive), base=folder, path=None)
+        builder.record(*settings["record"], where="recorded variables")
+    return builder.build()
 
 
 def _simulation(settings: dict[str, Any]) -> dict[str, Any]:

@@ -8,11 +8,12 @@ is pure bookkeeping on the checked :class:`System`: no FMU is loaded here.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .system import FmuEntry, Port, System
+from .model import FmuEntry, Port, System
 
 
 @dataclass
@@ -31,6 +32,7 @@ class Wiring:
     record_slots: np.ndarray                     # slots of system.record, in its order
     constants: dict[int, float]                  # slot -> value of unconnected FMU inputs
     size: int                                    # length of the value vector
+    extra_slots: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # of wire()'s extra ports
 
     def initial_values(self) -> np.ndarray:
         """The value vector before initialization: zeros and the constant inputs."""
@@ -86,8 +88,9 @@ class _Builder:
         return list(self.reads[name]) if isinstance(entry, FmuEntry) else list(entry.block.outputs)
 
 
-def wire(system: System) -> Wiring:
-    """Slots for every connection, FMU read and recorded variable of ``system``."""
+def wire(system: System, extra: Sequence[Port] = ()) -> Wiring:
+    """Slots for every connection, FMU read and recorded variable of ``system``, and for the
+    ``extra`` ports (what observers watch)."""
     builder = _Builder(system)
     wired = {name: ParticipantWiring() for name in builder.entries}
     for name, ports in wired.items():
@@ -98,7 +101,8 @@ def wire(system: System) -> Wiring:
         for output in entry.block.outputs:
             builder.slots(Port(entry.name, output))
     record_slots = np.array([builder.slot_of(port) for port in system.record], dtype=int)
+    extra_slots = np.array([builder.slot_of(port) for port in extra], dtype=int)
     for name, ports in wired.items():
         ports.outputs = builder.outputs_of(name)
         ports.output_slots = np.array([builder.slots(Port(name, v)) for v in ports.outputs], dtype=int)
-    return Wiring(wired, record_slots, builder.constants, len(builder.slots.index))
+    return Wiring(wired, record_slots, builder.constants, len(builder.slots.index), extra_slots)

@@ -180,10 +180,9 @@ def _system_path(args: argparse.Namespace) -> tuple[Path, Path | None]:
 def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - System, imported lazily
     """The system of ``rover-cosim run`` with the command line's overrides (SystemFileError if
     bad); an .ssp archive is unpacked into ``unpack``."""
-    import dataclasses
-
+    from rover_cosim.orchestrator.builder import replace_settings
     from rover_cosim.orchestrator.ssp import SspError, load_ssp
-    from rover_cosim.orchestrator.system import SystemFileError, load_system, system_from_dict
+    from rover_cosim.orchestrator.system import SystemFileError, load_system
 
     path, fmu_dir = _system_path(args)
     overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
@@ -194,17 +193,10 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
             system = load_ssp(path, unpack)
         except SspError as error:
             raise SystemFileError(str(error)) from None
-        if overrides.get("algorithm", "iterative") != "iterative" and system.algebraic_loop is not None:
-            raise SystemFileError(f"{path}: --algorithm {overrides['algorithm']}: the system has an algebraic loop")
-        return dataclasses.replace(system, **overrides), path
-    system = load_system(path, fmu_dir=fmu_dir)
+    else:
+        system = load_system(path, fmu_dir=fmu_dir)
     if overrides:
-        import tomllib
-
-        data = tomllib.loads(path.read_text())
-        data.setdefault("simulation", {}).update(overrides)
-        system = system_from_dict(data, name=f"{path} (with command-line overrides)",
-                                  base=fmu_dir or path.parent, path=path)
+        system = replace_settings(system, name=f"{path} (with command-line overrides)", **overrides)
     return system, path
 
 
@@ -229,8 +221,9 @@ def _export_ssp(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.soil import soil_parameters
+    from rover_cosim.orchestrator.builder import with_parameters
     from rover_cosim.orchestrator.system import SystemFileError
+    from rover_cosim.terramechanics.library import fmu_parameters
 
     choice = None
     if args.soil or args.wheel or args.assignments:
@@ -243,14 +236,14 @@ def _run(args: argparse.Namespace) -> int:
         except SystemFileError as error:
             print(f"rover-cosim run: {error}", file=sys.stderr)
             return 2
-        for fmu in system.fmus:  # the chosen soil and wheel go to every FMU that has them
-            fmu.parameters.update(soil_parameters(fmu.path, choice))
+        if choice is not None:  # the chosen soil and wheel go to every FMU that has them
+            system = with_parameters(system, fmu_parameters(choice.soil, choice.wheel))
         return _run_system(args, system, path)
 
 
 def _run_system(args: argparse.Namespace, system, path: Path) -> int:  # noqa: ANN001 - System, imported lazily
     from rover_cosim.orchestrator.master import RunError, run
-    from rover_cosim.orchestrator.runs import sidecar_path, write_partial, write_run
+    from rover_cosim.orchestrator.runs import PartialWriter, sidecar_path, write_run
     from rover_cosim.progress import ProgressBar
 
     output = args.output or Path("results") / f"{path.stem}.csv"
@@ -260,14 +253,14 @@ def _run_system(args: argparse.Namespace, system, path: Path) -> int:  # noqa: A
         print(f"rover-cosim run: {error}", file=sys.stderr)
         return 2
     bar = ProgressBar(path.stem, enabled=not args.quiet)
+    partial = PartialWriter(system, output)
     try:
-        result = run(system, progress=bar)
+        result = run(system, progress=bar, observers=[partial])
     except RunError as error:
         bar.close()
         kept = ""
-        if error.partial is not None and len(error.partial) > 1:
-            partial = write_partial(system, error.partial, output, str(error))
-            kept = f"; the {len(error.partial)} rows computed before it are in {partial[0]} (partial)"
+        if partial.written:
+            kept = f"; the {len(error.partial)} rows computed before it are in {partial.written[0]} (partial)"
         print(f"rover-cosim run: {error} ({output} not written{kept})", file=sys.stderr)
         return 1
     bar.close()

@@ -8,6 +8,10 @@ the lateral force Fy at a slip angle (Ishigami et al. 2007) in ``contact_forces`
 ``wheel_state`` (``slip_angle=``) and ``wheel_forces`` (``v_lateral=``).
 """
 
+from rover_cosim.common.identity import require_root
+
+require_root(__name__)
+
 from .forces import DEFAULT_NODES, ContactForces, contact_forces
 from .kinematics import entry_angle, exit_angle, max_stress_angle, slip_ratio, travel_direction
 from .lateral import bulldozing_factors, lateral_displacement, sidewall_resistance, slip_angle

@@ -14,7 +14,9 @@ import pytest
 
 from rover_cosim.cli import EXAMPLES
 from rover_cosim.orchestrator import native
-from rover_cosim.orchestrator.master import JacobiMaster, RunError, participants_of, run
+from rover_cosim.orchestrator.algorithms import Jacobi
+from rover_cosim.orchestrator.execution import Execution
+from rover_cosim.orchestrator.master import RunError, participants_of, run
 from rover_cosim.orchestrator.system import SystemFileError, system_from_dict
 from rover_cosim.orchestrator.wiring import wire
 
@@ -55,7 +57,7 @@ def test_the_masters_use_the_native_stepper_unless_switched_off(fmu_dir, fmus):
         system = system_from_dict(rover(native=switch), name="s", base=fmu_dir)
         wiring = wire(system)
         with participants_of(system, wiring) as participants:
-            master = JacobiMaster(participants, wiring, threads=2, use_native=system.native)
+            master = Execution(Jacobi(), participants, wiring, threads=2, use_native=system.native)
             assert (master.stepper is not None) is expected
             assert (master.pool is None) is expected  # the stepper has its own threads
             master.close()

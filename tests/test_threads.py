@@ -9,7 +9,9 @@ import pandas as pd
 import pytest
 
 from rover_cosim.cli import EXAMPLES
-from rover_cosim.orchestrator.master import GaussSeidelMaster, RunError, _independent_runs, run
+from rover_cosim.orchestrator.algorithms import GaussSeidel, independent_runs
+from rover_cosim.orchestrator.execution import Execution
+from rover_cosim.orchestrator.master import RunError, run
 from rover_cosim.orchestrator.system import SystemFileError, system_from_dict
 from rover_cosim.orchestrator.wiring import wire
 
@@ -33,9 +35,9 @@ def test_the_wheels_after_the_body_form_one_group(fmu_dir, fmus):
     from rover_cosim.orchestrator.master import participants_of
 
     with participants_of(system, wiring) as participants:
-        master = GaussSeidelMaster(participants, wiring, threads=2)
+        master = Execution(GaussSeidel(), participants, wiring, threads=2)
         groups = [[participants[i].name for i in group] for group in
-                  _independent_runs(participants, master.inputs, master.outputs)]
+                  independent_runs(participants, master.inputs, master.outputs)]
         master.close()
     assert groups == [["torque"], ["body"], [f"wheel{i}" for i in range(1, 7)]]
 

@@ -1,0 +1,196 @@
+"""Master algorithms at a fixed communication step: which participants step in which order, and
+which values each one sees. How a stage of steps is carried out (in Python, on threads, from C)
+is the executors' business (``executors``); ``execution`` puts the two together.
+
+- :class:`Jacobi`: every participant from the values at ``t``; outputs exchanged after all have
+  stepped (one stage);
+- :class:`GaussSeidel`: participant after participant, each with the newest values of those
+  before it (a stage each; with threads, FMUs in a row of the order that read none of each
+  other's outputs form one stage: the same values as one after the other);
+- :class:`Iterative`: each step repeated from the participants' saved states until the exchanged
+  values converge.
+
+Participants are numbered by their position in the system's order; ``inputs[i]`` and
+``outputs[i]`` are participant ``i``'s slots in the value vector (``wiring``).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .model import Iteration
+from .participants import BlockParticipant, Participant, RunError
+
+if TYPE_CHECKING:
+    from .execution import Execution
+
+#: Pieces of the iterative master's first communication step (see Iterative.step).
+START_SUBSTEPS = 10
+
+
+class Algorithm:
+    """An explicit algorithm is a list of stages stepped one after the other each communication
+    step; the participants of a stage see the values as they were when the stage began."""
+
+    name = "algorithm"
+    #: Every input of the (one) stage is gathered at t before any participant steps (Jacobi).
+    gathers_first = False
+    #: The executors may step its stages on threads or from C (explicit algorithms).
+    explicit = True
+
+    def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+               outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
+        """The stages of one communication step, as lists of participant positions."""
+        return [[i] for i in range(len(participants))]
+
+    def prepare(self, execution: Execution) -> None:
+        """Called once the execution is set up (before the first step)."""
+
+    def step(self, execution: Execution, values: np.ndarray, t: float, h: float) -> None:
+        """Advance every participant from ``t`` to ``t + h``; ``values`` then holds the outputs at ``t + h``."""
+        for stage in execution.stages:
+            execution.run_stage(stage, values, t, h)
+
+
+class Jacobi(Algorithm):
+    """Every participant from the values at ``t`` (one stage)."""
+
+    name = "jacobi"
+    gathers_first = True
+
+    def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+               outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
+        return [list(range(len(participants)))]
+
+
+class GaussSeidel(Algorithm):
+    """Participant after participant in the system's order; with threads, runs of FMUs that read
+    none of each other's outputs (the six wheels after the body) form one stage."""
+
+    name = "gauss-seidel"
+
+    def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+               outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
+        if threads > 1:
+            return independent_runs(participants, inputs, outputs)
+        return [[i] for i in range(len(participants))]
+
+
+def independent_runs(participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+                     outputs: Sequence[np.ndarray]) -> list[list[int]]:
+    """The order cut into runs of FMUs that read none of each other's outputs (blocks alone)."""
+    groups: list[list[int]] = []
+    written: set[int] = set()
+    for i, participant in enumerate(participants):
+        reads = set(inputs[i].tolist())
+        if (groups and not isinstance(participant, BlockParticipant) and len(groups[-1]) >= 1
+                and not isinstance(participants[groups[-1][0]], BlockParticipant) and not reads & written):
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+            written = set()
+        written |= set(outputs[i].tolist())
+    return groups
+
+
+class Iterative(Algorithm):
+    """Each step repeated from the participants' saved states (fmi2GetFMUstate / the blocks'
+    get_state) until the exchanged values converge. Each pass steps the participants in order
+    (Gauss-Seidel within the pass: a participant sees the outputs at ``t + h`` of those before it
+    in this pass, of the others from the last pass); every FMU steps with its inputs interpolated
+    linearly from their values at ``t`` to those at ``t + h`` (fmi2SetRealInputDerivatives; an
+    FMU that cannot interpolate holds their mean), an implicit, second-order coupling; blocks get
+    the guess at ``t + h``. The guess moves ``relaxation`` of the way to the new outputs, and the
+    step is accepted when no exchanged value changed by more than ``tolerance`` x (1 + |value|).
+    Non-convergence within ``max_iterations`` passes is a RunError naming the step and the
+    signals still moving. Steps in Python (it saves and restores states between passes)."""
+
+    name = "iterative"
+    explicit = False
+
+    def __init__(self, iteration: Iteration | None = None):
+        self.iteration = iteration or Iteration()
+        self.passes = 0       # total passes, for the statistics
+        self.steps = 0
+        self.exchanged = np.zeros(0, int)
+        self.holds: list[str] = []
+
+    def prepare(self, execution: Execution) -> None:
+        inputs = execution.inputs
+        exchanged = np.unique(np.concatenate([slots for slots in inputs if len(slots)] or [np.zeros(0, int)]))
+        self.exchanged = exchanged.astype(int)
+        # FMUs that can interpolate inputs get them linearly from t to the guess at t + h; other
+        # FMUs hold the mean of the two (trapezoidal); blocks compute their outputs at t + h from
+        # the inputs there (the guess).
+        self.holds = ["end" if isinstance(p, BlockParticipant)
+                      else "interpolate" if getattr(p, "can_interpolate", False) else "mean"
+                      for p in execution.participants]
+
+    def step(self, execution: Execution, values: np.ndarray, t: float, h: float) -> None:
+        # The first step of a run is taken in START_SUBSTEPS pieces: inputs switched on at the
+        # start (a torque step from rest) make the exchanged values jump within it, which no
+        # interpolation over the whole step follows.
+        pieces = START_SUBSTEPS if self.steps == 0 else 1
+        for piece in range(pieces):
+            self._iterate(execution, values, t + piece * h / pieces, h / pieces)
+        self.steps += 1
+
+    def _pass(self, execution: Execution, start: np.ndarray, guess: np.ndarray, t: float, h: float) -> np.ndarray:
+        """One pass over the participants in order; returns the new values."""
+        clock = time.perf_counter
+        new = guess.copy()  # filled in order: later participants see this pass's outputs
+        for participant, inputs, outputs, hold in zip(execution.participants, execution.inputs, execution.outputs,
+                                                      self.holds):
+            begin = clock()
+            if hold == "interpolate":
+                participant.do_step(t, h, start[inputs], (new[inputs] - start[inputs]) / h)
+            elif hold == "mean":
+                participant.do_step(t, h, 0.5 * (start[inputs] + new[inputs]))
+            else:
+                participant.do_step(t, h, new[inputs])
+            new[outputs] = participant.get_outputs(t + h)
+            execution.step_seconds[participant.name] += clock() - begin
+        return new
+
+    def _iterate(self, execution: Execution, values: np.ndarray, t: float, h: float) -> None:
+        settings, participants = self.iteration, execution.participants
+        start = values.copy()
+        guess = values.copy()
+        states = [p.get_state(t) for p in participants]
+        try:
+            for attempt in range(1, settings.max_iterations + 1):
+                new = self._pass(execution, start, guess, t, h)
+                change = np.abs(new[self.exchanged] - guess[self.exchanged])
+                scale = settings.tolerance * (1.0 + np.abs(new[self.exchanged]))
+                self.passes += 1
+                if np.all(change <= scale) and attempt > 1:
+                    values[:] = new
+                    return
+                guess += settings.relaxation * (new - guess)
+                if attempt < settings.max_iterations:
+                    for participant, state in zip(participants, states):
+                        participant.set_state(state, t)
+            worst = np.argsort(-(change / scale))[:3]
+            signals = ", ".join(f"{execution.slot_names[self.exchanged[i]]} (changed {change[i]:.3g})" for i in worst
+                                if change[i] > scale[i])
+            raise RunError(f"iterative master: the step from t = {t:.6g} s did not converge in "
+                           f"{settings.max_iterations} passes (tolerance {settings.tolerance:g}); still moving: "
+                           f"{signals}")
+        finally:
+            for participant, state in zip(participants, states):
+                participant.free_state(state)
+
+
+def algorithm_of(name: str, iteration: Iteration | None = None) -> Algorithm:
+    """The algorithm called ``name`` (a system's ``algorithm``)."""
+    if name == "iterative":
+        return Iterative(iteration)
+    if name == "jacobi":
+        return Jacobi()
+    if name == "gauss-seidel":
+        return GaussSeidel()
+    raise ValueError(f"algorithm {name!r}: expected jacobi, gauss-seidel or iterative")

@@ -1,0 +1,475 @@
+"""Building a :class:`~rover_cosim.orchestrator.model.System` in code, checked as it is built.
+
+```python
+from rover_cosim.orchestrator import SystemBuilder, run
+from rover_cosim.orchestrator.blocks import Constant
+
+system = (SystemBuilder("one wheel")
+          .simulation(stop_time=2.0, step=1e-3, algorithm="jacobi")
+          .add_fmu("wheel", "fmus/SingleWheel.fmu", parameters={"W": 424.0})
+          .add_block("torque", Constant("torque", 20.0, unit="N.m"))
+          .connect("torque.y", "wheel.tau")
+          .record("wheel.slip", "wheel.Fx")
+          .build())
+result = run(system)
+```
+
+Every problem is a :class:`SystemFileError` naming the system and the call (or, for a system
+file, the entry: the TOML reader in ``system`` passes its own labels): an unknown instance or
+variable, a parameter that is not one, a connection not from an output to an input, a unit
+mismatch, an input connected twice or left undriven, an algebraic loop an explicit master cannot
+run.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import zipfile
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import fmpy
+
+from rover_cosim.common.units import base_units
+
+from .blocks import BLOCK_TYPES, Block
+from .loops import describe, find_loop
+from .model import ALGORITHMS, BlockEntry, Connection, FmuEntry, Iteration, Port, System, SystemFileError
+
+#: Instance names: identifiers, so that a name is never a path or a port separator.
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+#: The simulation settings and their defaults (stop_time and step have none).
+SIMULATION_DEFAULTS: dict[str, Any] = {"start_time": 0.0, "algorithm": "gauss-seidel", "order": None,
+                                       "allow_algebraic_loops": False, "threads": None, "native": True}
+ITERATION_KEYS = ("tolerance", "max_iterations", "relaxation")
+
+
+def number(value: Any, where: str) -> float:
+    """``value`` as a float; SystemFileError (``where``: its label, with the system's name) for
+    anything that is not a real number."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SystemFileError(f"{where}: {value!r}: expected a number")
+    return float(value)
+
+
+def parse_port(text: Any, where: str) -> Port:
+    """``"instance.variable"`` (or a Port) as a Port."""
+    if isinstance(text, Port):
+        return text
+    if not isinstance(text, str) or "." not in text:
+        raise SystemFileError(f"{where}: {text!r}: expected \"instance.variable\"")
+    return Port.parse(text)
+
+
+def read_fmu(fmu_path: Path, where: str) -> Any:
+    """The model description of an FMI 2.0 Co-Simulation FMU file (``where``: the label of messages)."""
+    if not fmu_path.is_file():
+        raise SystemFileError(f"{where}: FMU file {fmu_path} not found (run `make fmus`?)")
+    try:
+        description = fmpy.read_model_description(str(fmu_path))
+    except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds
+        raise SystemFileError(f"{where}: {fmu_path} is not a readable FMU: {failure}") from None
+    if description.fmiVersion != "2.0" or description.coSimulation is None:
+        raise SystemFileError(f"{where}: {fmu_path}: expected an FMI 2.0 Co-Simulation FMU (got FMI "
+                              f"{description.fmiVersion}, CS {'yes' if description.coSimulation else 'no'})")
+    return description
+
+
+def optional_inputs(fmu_path: Path) -> set[str]:
+    """Inputs an FMU built by rover-cosim declares optional (``optional_inputs`` of its
+    documentation/build.json): they keep their start value when left unconnected. Other FMUs: none."""
+    try:
+        with zipfile.ZipFile(fmu_path) as archive:
+            return set(json.loads(archive.read("documentation/build.json")).get("optional_inputs", []))
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return set()
+
+
+def dependency_graph(fmus: list[FmuEntry], blocks: list[BlockEntry],
+                     connections: list[Connection]) -> dict[Port, list[Port]]:
+    """port -> the ports that depend on it directly: connections, and each participant's outputs
+    on its inputs (FMUs: ModelStructure, an output without a dependency list on every input;
+    blocks: their ``feedthrough``, True by default for a block with inputs)."""
+    graph: dict[Port, list[Port]] = {}
+    for connection in connections:
+        graph.setdefault(connection.source, []).append(connection.target)
+    for fmu in fmus:
+        inputs = [v.name for v in fmu.description.modelVariables if v.causality == "input"]
+        for unknown in fmu.description.outputs:
+            sources = inputs if unknown.dependencies is None else [d.name for d in unknown.dependencies
+                                                                   if d.causality == "input"]
+            for name in sources:
+                graph.setdefault(Port(fmu.name, name), []).append(Port(fmu.name, unknown.variable.name))
+    for entry in blocks:
+        block = entry.block
+        if getattr(block, "feedthrough", bool(block.inputs)):
+            for name in block.inputs:
+                graph.setdefault(Port(entry.name, name), []).extend(Port(entry.name, o) for o in block.outputs)
+    return graph
+
+
+@dataclass
+class _Settings:
+    """The simulation settings being built, with the label their messages use."""
+
+    values: dict[str, Any]
+    iteration: dict[str, Any]
+    where: str = "simulation"
+
+
+class SystemBuilder:
+    """A system built call by call, each call checked against what is there (see the module
+    docstring). ``name`` names the system in messages; relative FMU paths start at ``base``
+    (default: the working folder). Methods return the builder, so calls chain."""
+
+    def __init__(self, name: str = "system", *, base: Path | None = None, path: Path | None = None):
+        self.name = name
+        self.base = Path(base) if base is not None else None
+        self.path = path
+        self._settings = _Settings(dict(SIMULATION_DEFAULTS), {})
+        self._fmus: dict[str, FmuEntry] = {}
+        self._blocks: dict[str, BlockEntry] = {}
+        self._where: dict[str, str] = {}      # instance -> the label of the call that added it
+        self._claimed: set[str] = set()
+        self._connections: list[Connection] = []
+        self._driven: dict[Port, str] = {}     # input -> the label of the connection driving it
+        self._record: list[Port] | None = None
+
+    # --- messages -------------------------------------------------------------------------------
+    def error(self, where: str, message: str) -> SystemFileError:
+        return SystemFileError(f"{self.name}: {where}: {message}")
+
+    def _number(self, value: Any, where: str) -> float:
+        return number(value, f"{self.name}: {where}")
+
+    # --- settings -------------------------------------------------------------------------------
+    def simulation(self, *, where: str | None = None, **settings: Any) -> SystemBuilder:
+        """Set simulation settings (the others keep their values): ``stop_time``, ``step``,
+        ``start_time`` [s]; ``algorithm`` (jacobi, gauss-seidel, iterative); ``order`` (instance
+        names, Gauss-Seidel order; default: sources, FMUs, other blocks); ``tolerance``,
+        ``max_iterations``, ``relaxation`` (iterative only); ``allow_algebraic_loops``;
+        ``threads`` (FMUs stepped at the same time; None: the cores); ``native`` (FMUs stepped from C)."""
+        if where is not None:
+            self._settings.where = where
+        accepted = {"stop_time", "step", *SIMULATION_DEFAULTS, *ITERATION_KEYS}
+        unknown = set(settings) - accepted
+        if unknown:
+            raise self.error(self._settings.where, f"unknown setting(s) {sorted(unknown)}; expected {sorted(accepted)}")
+        for key, value in settings.items():
+            (self._settings.iteration if key in ITERATION_KEYS else self._settings.values)[key] = value
+        self._check_times()
+        self._check_switches()
+        return self
+
+    def _check_times(self) -> None:
+        values, where = self._settings.values, self._settings.where
+        if "step" not in values or "stop_time" not in values:
+            return  # checked once both are there (build() says which is missing)
+        step = self._number(values["step"], f"{where} step")
+        stop_time = self._number(values["stop_time"], f"{where} stop_time")
+        start_time = self._number(values["start_time"], f"{where} start_time")
+        if not step > 0:
+            raise self.error(f"{where} step", f"{step!r}: expected a communication step > 0 s")
+        if not stop_time > start_time:
+            raise self.error(f"{where} stop_time", f"{stop_time!r}: expected a stop time > start time {start_time} s")
+        if step > stop_time - start_time:
+            raise self.error(f"{where} step", f"{step!r} s is longer than the run ({stop_time - start_time!r} s)")
+
+    def _check_switches(self) -> None:
+        values, where = self._settings.values, self._settings.where
+        if values["algorithm"] not in ALGORITHMS:
+            raise self.error(f"{where} algorithm", f"{values['algorithm']!r}: expected one of {', '.join(ALGORITHMS)}")
+        self._iteration()
+        allow = values["allow_algebraic_loops"]
+        if not isinstance(allow, bool):
+            raise self.error(f"{where} allow_algebraic_loops", f"{allow!r}: expected true or false")
+        threads = values["threads"]
+        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
+            raise self.error(f"{where} threads", f"{threads!r}: expected a whole number >= 1 (FMUs stepped "
+                             "at the same time)")
+        if not isinstance(values["native"], bool):
+            raise self.error(f"{where} native", f"{values['native']!r}: expected true or false (FMUs stepped from C)")
+
+    def _iteration(self) -> Iteration:
+        given, algorithm, where = self._settings.iteration, self._settings.values["algorithm"], self._settings.where
+        if given and algorithm != "iterative":
+            raise self.error(where, f"{', '.join(sorted(given))} only apply to algorithm = \"iterative\" "
+                             f"(this system uses {algorithm!r})")
+        default = Iteration()
+        tolerance = self._number(given.get("tolerance", default.tolerance), f"{where} tolerance")
+        relaxation = self._number(given.get("relaxation", default.relaxation), f"{where} relaxation")
+        bound = given.get("max_iterations", default.max_iterations)
+        if not tolerance > 0:
+            raise self.error(f"{where} tolerance", f"{tolerance!r}: expected > 0")
+        if not 0 < relaxation <= 1:
+            raise self.error(f"{where} relaxation", f"{relaxation!r}: expected 0 < relaxation <= 1")
+        if isinstance(bound, bool) or not isinstance(bound, int) or bound < 1:
+            raise self.error(f"{where} max_iterations", f"{bound!r}: expected a whole number >= 1")
+        return Iteration(tolerance, bound, relaxation)
+
+    # --- components -----------------------------------------------------------------------------
+    def claim(self, instance: Any, where: str) -> str:
+        """Reserve the instance name ``instance`` (an identifier used once)."""
+        if not isinstance(instance, str) or not IDENTIFIER.fullmatch(instance):
+            raise self.error(where, f"name = {instance!r}: expected an identifier (letters, digits and _, not "
+                             "starting with a digit; it names the instance and its folder)")
+        if instance in self._claimed:
+            raise self.error(where, f"name {instance!r} is used twice")
+        self._claimed.add(instance)
+        return instance
+
+    def _claim_for(self, name: str, where: str) -> None:
+        if name not in self._claimed or name in self._where:
+            self.claim(name, where)
+
+    def add_fmu(self, name: str, path: str | Path, *, parameters: Mapping[str, Any] | None = None,
+                start: Mapping[str, Any] | None = None, where: str | None = None) -> SystemBuilder:
+        """An FMU instance ``name`` of the FMU file ``path`` (relative: to the builder's base), with
+        parameter values and start values (inputs, and states with an exact start) by variable name."""
+        where = where or f"add_fmu({name!r})"
+        self._claim_for(name, where)
+        if not isinstance(path, (str, Path)):
+            raise self.error(where, f"path = {path!r}: expected a file name")
+        fmu_path = Path(path)
+        if not fmu_path.is_absolute() and self.base is not None:
+            fmu_path = self.base / fmu_path
+        entry = FmuEntry(name, fmu_path, {}, {}, read_fmu(fmu_path, f"{self.name}: {where}"))
+        self._fmus[name] = entry
+        self._where[name] = where
+        self.set_parameters(name, parameters or {}, where=where)
+        self.set_start(name, start or {}, where=where)
+        return self
+
+    def _values(self, instance: str, key: str, values: Mapping[str, Any], where: str | None) -> dict[str, float]:
+        if instance not in self._fmus:
+            raise self.error(where or f"set_{key}({instance!r})", f"no FMU {instance!r}; expected one of "
+                             f"{', '.join(self._fmus) or '(none yet)'}")
+        fmu = self._fmus[instance]
+        where = where or self._where[instance]
+        if not isinstance(values, Mapping):
+            raise self.error(f"{where} {key}", "expected a table, e.g. { \"name\" = 1.0 }")
+        variables = fmu.variables()
+        checked: dict[str, float] = {}
+        for variable, value in values.items():
+            if variable not in variables:
+                raise self.error(f"{where} {key}", f"{fmu.name} has no variable {variable!r}")
+            v = variables[variable]
+            if key == "parameters" and v.causality != "parameter":
+                raise self.error(f"{where} parameters", f"{fmu.name}.{variable} is not a parameter "
+                                 f"(causality {v.causality}); inputs and states go under start")
+            if key == "start" and not (v.causality == "input" or v.initial in ("exact", "approx")):
+                raise self.error(f"{where} start", f"{fmu.name}.{variable} cannot be given a start value "
+                                 f"(causality {v.causality}, initial {v.initial})")
+            checked[variable] = self._number(value, f"{where} {key} {variable}")
+        return checked
+
+    def set_parameters(self, instance: str, values: Mapping[str, Any], *, where: str | None = None) -> SystemBuilder:
+        """Parameter values of the FMU ``instance`` (they override those given before)."""
+        self._fmus_entry(instance, where).parameters.update(self._values(instance, "parameters", values, where))
+        return self
+
+    def set_start(self, instance: str, values: Mapping[str, Any], *, where: str | None = None) -> SystemBuilder:
+        """Start values of the FMU ``instance``'s inputs (and states with an exact start)."""
+        self._fmus_entry(instance, where).start.update(self._values(instance, "start", values, where))
+        return self
+
+    def _fmus_entry(self, instance: str, where: str | None) -> FmuEntry:
+        if instance not in self._fmus:
+            raise self.error(where or f"FMU {instance!r}", f"no FMU {instance!r}; expected one of "
+                             f"{', '.join(self._fmus) or '(none yet)'}")
+        return self._fmus[instance]
+
+    def parameter_names(self, instance: str) -> set[str]:
+        """The parameters the FMU ``instance`` has (to give it only those of a set it has)."""
+        return {v.name for v in self._fmus_entry(instance, None).description.modelVariables
+                if v.causality == "parameter"}
+
+    def fmu_names(self) -> list[str]:
+        return list(self._fmus)
+
+    def add_block(self, name: str, block: Block, *, kind: str | None = None, keys: dict[str, Any] | None = None,
+                  where: str | None = None) -> SystemBuilder:
+        """A Python block ``name`` (any object with the block interface, ``blocks``). ``kind`` and
+        ``keys``: the block type and keys it was made from, when it came from a system file."""
+        where = where or f"add_block({name!r})"
+        self._claim_for(name, where)
+        for attribute in ("inputs", "outputs", "start", "step"):
+            if not hasattr(block, attribute):
+                raise self.error(where, f"{block!r} is not a block: it has no {attribute!r}")
+        if not hasattr(block, "units"):
+            block.units = {}
+        if kind is None:
+            kind = next((k for k, cls in BLOCK_TYPES.items() if type(block) is cls), "python")
+        self._blocks[name] = BlockEntry(name, kind, block, keys)
+        self._where[name] = where
+        return self
+
+    # --- connections and recording --------------------------------------------------------------
+    def _lookup(self, port: Port, where: str) -> tuple[str, str | None]:
+        """(causality, unit) of ``port``; errors for unknown instances and variables."""
+        if port.instance in self._fmus:
+            fmu = self._fmus[port.instance]
+            variables = fmu.variables()
+            if port.variable not in variables:
+                raise self.error(where, f"{fmu.name} ({fmu.path.name}) has no variable {port.variable!r}")
+            v = variables[port.variable]
+            return v.causality, v.unit
+        if port.instance not in self._blocks:
+            names = sorted([*self._fmus, *self._blocks])
+            raise self.error(where, f"no instance {port.instance!r}; expected one of {', '.join(names)}")
+        block = self._blocks[port.instance].block
+        if port.variable in block.inputs:
+            return "input", block.units.get(port.variable)
+        if port.variable in block.outputs:
+            return "output", block.units.get(port.variable)
+        raise self.error(where, f"block {port.instance} has no variable {port.variable!r} "
+                         f"(inputs {list(block.inputs)}, outputs {list(block.outputs)})")
+
+    def connect(self, source: str | Port, target: str | Port, *, where: str | None = None,
+                label: str | None = None) -> SystemBuilder:
+        """A connection from the output ``source`` to the input ``target`` (``"instance.variable"``),
+        of the same unit; each input is driven once."""
+        where = where or f"connect({str(source)!r}, {str(target)!r})"
+        number_ = len(self._connections) + 1
+        label = label or f"connection {number_}"
+        source_port = parse_port(source, f"{self.name}: {where} from")
+        target_port = parse_port(target, f"{self.name}: {where} to")
+        source_causality, source_unit = self._lookup(source_port, where)
+        target_causality, target_unit = self._lookup(target_port, where)
+        if source_causality != "output":
+            raise self.error(where, f"{source_port} is not an output (causality {source_causality}); "
+                             "a connection goes from an output to an input")
+        if target_causality != "input":
+            raise self.error(where, f"{target_port} is not an input (causality {target_causality}); "
+                             "a connection goes from an output to an input")
+        if source_unit is not None and target_unit is not None and base_units(source_unit) != base_units(target_unit):
+            raise self.error(where, f"unit mismatch: {source_port} is in {source_unit}, {target_port} in {target_unit}")
+        if target_port in self._driven:
+            raise self.error(where, f"input {target_port} is connected twice (also by {self._driven[target_port]})")
+        self._driven[target_port] = label
+        self._connections.append(Connection(number_, source_port, target_port))
+        return self
+
+    def record(self, *ports: str | Port, where: str | None = None) -> SystemBuilder:
+        """Record these ports (in addition to those recorded before); without any call to
+        record, every output of every participant is recorded."""
+        where = where or "record"
+        recorded = self._record if self._record is not None else []
+        for text in ports:
+            port = parse_port(text, f"{self.name}: {where}")
+            self._lookup(port, f"{where} {str(text)!r}")
+            recorded.append(port)
+        self._record = recorded
+        return self
+
+    # --- the system -----------------------------------------------------------------------------
+    def _check_inputs_driven(self) -> None:
+        """Every FMU input connected or given a start value (unless the FMU's build record marks it
+        optional: an input its Modelica source gives a default); every block input connected."""
+        for fmu in self._fmus.values():
+            optional = optional_inputs(fmu.path)
+            for v in fmu.description.modelVariables:
+                if (v.causality == "input" and Port(fmu.name, v.name) not in self._driven and v.name not in fmu.start
+                        and v.name not in optional):
+                    raise self.error(self._where[fmu.name], f"input {fmu.name}.{v.name} is neither connected nor "
+                                     "given a value (connect it, or give it a start value)")
+        for entry in self._blocks.values():
+            for variable in entry.block.inputs:
+                if Port(entry.name, variable) not in self._driven:
+                    raise self.error(self._where[entry.name], f"input {entry.name}.{variable} is not connected")
+
+    def _order(self) -> list[str]:
+        order, where = self._settings.values["order"], self._settings.where
+        blocks = list(self._blocks.values())
+        if order is None:
+            return ([b.name for b in blocks if not b.block.inputs] + list(self._fmus)
+                    + [b.name for b in blocks if b.block.inputs])
+        names = sorted([*self._fmus, *self._blocks])
+        if not isinstance(order, (list, tuple)) or sorted(map(str, order)) != names:
+            raise self.error(f"{where} order", f"{order!r}: expected every instance once: {names}")
+        return [str(name) for name in order]
+
+    def _outputs(self, instance: str) -> list[Port]:
+        if instance in self._fmus:
+            return [Port(instance, v.name) for v in self._fmus[instance].description.modelVariables
+                    if v.causality == "output"]
+        return [Port(instance, o) for o in self._blocks[instance].block.outputs]
+
+    def _loop(self) -> list[Port] | None:
+        values = self._settings.values
+        loop = find_loop(dependency_graph(list(self._fmus.values()), list(self._blocks.values()), self._connections))
+        if loop and values["algorithm"] != "iterative" and not values["allow_algebraic_loops"]:
+            raise self.error("connections", f"algebraic loop (direct feedthrough all the way round): {describe(loop)}; "
+                             "use algorithm = \"iterative\" to solve it, or allow_algebraic_loops = true in "
+                             "the simulation settings to break it with a one-step delay in the order of the "
+                             "participants")
+        return loop
+
+    def build(self) -> System:
+        """The checked System (the builder can go on and build another)."""
+        values, where = self._settings.values, self._settings.where
+        for key in ("stop_time", "step"):
+            if key not in values:
+                raise self.error(where, f"{key} is missing (seconds)")
+        if not self._fmus and not self._blocks:
+            raise self.error("components", "the system has no FMU and no block")
+        self._check_inputs_driven()
+        order = self._order()
+        record = self._record if self._record is not None else [p for i in order for p in self._outputs(i)]
+        iteration = self._iteration()
+        loop = self._loop()
+        return System(self.path, [_copy_fmu(f) for f in self._fmus.values()],
+                      [BlockEntry(b.name, b.kind, b.block, b.keys) for b in self._blocks.values()],
+                      list(self._connections), float(values["step"]), float(values["stop_time"]),
+                      float(values["start_time"]), values["algorithm"], order, list(record), iteration, loop,
+                      values["threads"], values["native"], values["allow_algebraic_loops"], self.name)
+
+    @classmethod
+    def from_system(cls, system: System, name: str | None = None) -> SystemBuilder:
+        """A builder holding ``system`` (its FMUs' descriptions are not read again): change it
+        (``simulation``, ``set_parameters``, more components and connections) and build anew."""
+        builder = cls(name or system.name, path=system.path)
+        settings: dict[str, Any] = {"stop_time": system.stop_time, "step": system.step, "start_time": system.start_time,
+                    "algorithm": system.algorithm, "order": list(system.order),
+                    "allow_algebraic_loops": system.allow_algebraic_loops, "threads": system.threads_setting,
+                    "native": system.native}
+        if system.algorithm == "iterative":
+            settings.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,
+                            relaxation=system.iteration.relaxation)
+        builder.simulation(**settings)
+        for fmu in system.fmus:
+            builder.claim(fmu.name, f"FMU {fmu.name!r}")
+            builder._fmus[fmu.name] = _copy_fmu(fmu)
+            builder._where[fmu.name] = f"FMU {fmu.name!r}"
+        for entry in system.blocks:
+            builder.add_block(entry.name, entry.block, kind=entry.kind, keys=entry.keys)
+        for connection in system.connections:
+            builder.connect(connection.source, connection.target)
+        builder._record = list(system.record)
+        return builder
+
+
+def _copy_fmu(fmu: FmuEntry) -> FmuEntry:
+    return FmuEntry(fmu.name, fmu.path, dict(fmu.parameters), dict(fmu.start), fmu.description)
+
+
+def replace_settings(system: System, name: str | None = None, **settings: Any) -> System:
+    """``system`` with other simulation settings (checked as when it was built: the step against
+    the run, an algebraic loop against the algorithm)."""
+    return SystemBuilder.from_system(system, name).simulation(**settings).build()
+
+
+def with_parameters(system: System, values: Mapping[str, float], *, only_known: bool = True,
+                    instances: Iterable[str] | None = None) -> System:
+    """``system`` with parameter ``values`` given to its FMUs (``instances``: these only; default
+    all). ``only_known``: each FMU gets those of the values it has as parameters (a soil to every
+    wheel, none to the body); else every value must be a parameter of every FMU named."""
+    builder = SystemBuilder.from_system(system)
+    for instance in instances if instances is not None else builder.fmu_names():
+        names = builder.parameter_names(instance)
+        given = {k: v for k, v in values.items() if k in names} if only_known else dict(values)
+        builder.set_parameters(instance, given)
+    return builder.build()
