@@ -75,8 +75,9 @@ report: $(STAMP)
 cosim-study: fmus
 	$(VENV)/bin/rover-cosim cosim-study --out $(RESULTS)/cosim_study --fmu-dir fmus
 
-## test: the test suite (python -P: the checkout's folders are not importable as top-level
-## packages; everything is imported as rover_cosim.*, as from an installed wheel)
+## test: the test suite (python -P keeps the checkout's folder off sys.path, as for an installed
+## wheel; without it the layer folders still import only as rover_cosim.*: `import orchestrator`
+## fails with a message, so `python -m pytest` works the same)
 test: $(STAMP)
 	$(PY) -P -m pytest
 

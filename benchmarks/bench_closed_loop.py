@@ -31,8 +31,8 @@ from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.fmubuild import build
 from rover_cosim.jobs.simulate import STEP, STOP_TIME, cosim_system, monolithic_system
+from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
-from rover_cosim.orchestrator.system import system_from_dict
 
 GOALS_S = {"monolithic": 1.0, "cosim": 2.0}  # wall seconds for 20 s simulated (issue 18)
 STATISTICS = ("evaluations", "reusedEvaluations", "jacobians", "steps", "rejectedSteps")
@@ -50,11 +50,11 @@ def model_file(given: Path, fmu_dir: Path) -> Path:
 
 
 def system(plant: str, fmu_dir: Path, model: Path, stop_time: float, record: list[str] | None = None) -> Any:
-    data = BUILDERS[plant](fmu_dir, model)
-    data["simulation"]["stop_time"] = stop_time
+    builder = SystemBuilder.from_system(BUILDERS[plant](fmu_dir, model), f"bench closed loop ({plant})")
+    builder.simulation(stop_time=stop_time)
     if record is not None:
-        data["record"] = {"variables": record}
-    return system_from_dict(data, name=f"bench closed loop ({plant})", base=fmu_dir)
+        builder.record(*record, replace=True)
+    return builder.build()
 
 
 def recorded_costs(plant: str) -> tuple[list[str], dict[str, list[str]]]:

@@ -105,19 +105,6 @@ class IdentifiedModel:
     def time_constant_at(self, load: float, torque: float) -> float:
         return float(np.exp(self._t(self._point(load, torque))[0]))
 
-    def rows_at(self, loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Settled slip K tau and T over the torque axis at each of ``loads`` (shape (n, torques)),
-        by the same interpolation in 1/W as settled_slip_at, for whole rows at once."""
-        loads = np.atleast_1d(np.asarray(loads, float))
-        if np.any(~(loads > 0)):
-            raise ValueError(f"loads = {loads!r} N: expected > 0")
-        inverse = self._inverse_loads
-        j = np.clip(np.searchsorted(-inverse, -1.0 / loads), 1, len(inverse) - 1)
-        weight = ((1.0 / loads - inverse[j - 1]) / (inverse[j] - inverse[j - 1]))[:, None]
-        settled, log_t = self._settled_table, self._log_t_table
-        return ((1 - weight) * settled[j - 1] + weight * settled[j],
-                np.exp((1 - weight) * log_t[j - 1] + weight * log_t[j]))
-
     def fx(self, load: float | np.ndarray, slip: float | np.ndarray) -> np.ndarray:
         """Fx(W, slip) [N] (Eq. 14, or its higher-degree variant)."""
         load, slip = np.asarray(load, float), np.asarray(slip, float)

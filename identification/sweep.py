@@ -29,7 +29,8 @@ from rover_cosim.common.outputs import file_sha256
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.common.paper import TARGET_VELOCITY
 from rover_cosim.common.parallel import parallel_map
-from rover_cosim.terramechanics.library import from_fmu_parameters
+from rover_cosim.terramechanics import Soil, Wheel
+from rover_cosim.terramechanics.library import fmu_parameters
 
 from .cache import discard, read_run, remove_partial_files, write_run
 from .testbed import RECORDED, TorqueProfile, shared_test_bed
@@ -59,9 +60,9 @@ class SweepPlan:
     stop_time: float = 0.1      # s; slip and Fx settle within a millisecond on this test bed
     sample_time: float = 1e-4   # s; fixed sample time = communication step
     tolerance: float = 1e-8     # integrator tolerance inside the FMU
-    #: FMU parameters of every run, e.g. a soil and a wheel (terramechanics.library.fmu_parameters),
-    #: as (name, value) pairs; part of the cache key.
-    parameters: tuple[tuple[str, float], ...] = ()
+    #: The soil and wheel of every run (part of the cache key); None: the plant's own (the paper's).
+    soil: Soil | None = None
+    wheel: Wheel | None = None
     #: m/s; every run starts rolling at this speed with zero slip (omega = v/r): the regime where
     #: the paper's model applies. From rest a torque below the rolling resistance does not drive
     #: the wheel (it stays in the static regime), which the identified model is not made for.
@@ -86,8 +87,15 @@ class SweepPlan:
                                        "tolerance": self.tolerance, "start_speed": self.start_speed,
                                        "recorded": list(RECORDED)}
         if self.parameters:
-            settings["parameters"] = sorted(self.parameters)
+            settings["parameters"] = sorted(self.parameters.items())
         return hashlib.sha256(json.dumps(settings, sort_keys=True).encode()).hexdigest()[:12]
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The soil and wheel as FMU parameters, by name (empty: the plant's own)."""
+        if self.soil is None and self.wheel is None:
+            return {}
+        return dict(sorted(fmu_parameters(self.soil or Soil(), self.wheel or Wheel()).items()))
 
     def cases(self) -> list[Case]:
         return [Case(w, tau, b) for b in self.slip_angles_deg for w in self.loads for tau in self.torques]
@@ -116,27 +124,29 @@ def run_file(folder: Path, load: float, torque: float, slip_angle_deg: float = 0
 
 
 def compute_run(fmu_path: str | None, case: Case, stop_time: float, sample_time: float,
-                tolerance: float, start_speed: float, target: str,
-                parameters: tuple[tuple[str, float], ...] = ()) -> tuple[Case, str | None, float]:
-    """Run one case and write it to ``target`` atomically. Returns (case, error, seconds);
-    never raises, so one failing case does not stop the others (runs in worker processes).
-    ``fmu_path`` None runs the numpy reference test bed instead of the FMU."""
+                tolerance: float, start_speed: float, target: str, soil: Soil | None = None,
+                wheel: Wheel | None = None) -> tuple[Case, str | None, float]:
+    """Run one case on the ``soil`` and ``wheel`` (None: the plant's own) and write it to
+    ``target`` atomically. Returns (case, error, seconds); never raises, so one failing case does
+    not stop the others (runs in worker processes). ``fmu_path`` None runs the numpy reference
+    test bed instead of the FMU."""
     started = time.perf_counter()
     case = Case(*case)
     try:
         profile = TorqueProfile.step(case.torque)
         slip_angle = math.radians(case.slip_angle_deg)
+        plan = SweepPlan(soil=soil, wheel=wheel)
         if fmu_path is None:
             from .reference_plant import StartState, run_reference_test_bed
 
-            soil, wheel = from_fmu_parameters(dict(parameters))
+            soil, wheel = soil or Soil(), wheel or Wheel()
             start = StartState(v=start_speed, omega=start_speed * math.cos(slip_angle) / wheel.r)
             data = run_reference_test_bed(case.load, profile, stop_time, sample_time, start=start,
                                           slip_angle=slip_angle, soil=soil, wheel=wheel)
         else:
             data = shared_test_bed(Path(fmu_path)).run(case.load, profile, stop_time, sample_time, tolerance,
                                                        start_speed=start_speed, slip_angle=slip_angle,
-                                                       parameters=dict(parameters))
+                                                       parameters=plan.parameters)
         write_run(Path(target), data)
         return case, None, time.perf_counter() - started
     except Exception as error:  # noqa: BLE001 - reported per run, the sweep goes on
@@ -153,7 +163,7 @@ def _plant_key(fmu_path: Path | None) -> str:
     return "reference-" + hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:12]
 
 
-Arguments = tuple[str | None, Case, float, float, float, float, str, tuple[tuple[str, float], ...]]
+Arguments = tuple[str | None, Case, float, float, float, float, str, Soil | None, Wheel | None]
 Result = tuple[Case, str | None, float]
 
 
@@ -216,7 +226,7 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
     if progress:
         progress(done / len(cases))
     arguments = [(str(fmu_path) if fmu_path else None, c, plan.stop_time, plan.sample_time, plan.tolerance,
-                  plan.start_speed, str(run_file(folder, *c)), plan.parameters) for c in missing]
+                  plan.start_speed, str(run_file(folder, *c)), plan.soil, plan.wheel) for c in missing]
     for case, error, seconds in _results(arguments, workers, scheduler):
         case = Case(*case)
         run_seconds[case] = seconds

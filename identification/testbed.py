@@ -4,7 +4,10 @@ slip angle to the wheel plane (``slip_angle``, Ishigami's test bed), recorded at
 time (= communication step).
 
 One FMU instance per process is kept and reset between runs (:func:`shared_test_bed`), so a sweep
-pays for unpacking and loading the FMU once per worker.
+pays for unpacking and loading the FMU once per worker. The FMU is driven through the engine's FMU
+participant (``orchestrator.participants.FmuParticipant``: the one FMU driver, with its logger
+and its error messages naming the call and the time); the bed only decides the calls: inputs set
+when their level changes, one fmi2DoStep per sample.
 """
 
 from __future__ import annotations
@@ -17,7 +20,9 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pandas as pd
-from fmpy.fmi2 import FMU2Slave, defaultCallbacks, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+
+from rover_cosim.orchestrator.model import FmuEntry
+from rover_cosim.orchestrator.participants import FmuParticipant
 
 #: What every run records besides time and torque (SingleWheel outputs, SI units).
 RECORDED = ("slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v", "Fy", "beta")
@@ -54,52 +59,38 @@ class WheelTestBed:
     def __init__(self, fmu_path: Path):
         self.path = Path(fmu_path)
         self._folder = tempfile.TemporaryDirectory(prefix="testbed-")
-        fmpy.extract(str(self.path), self._folder.name)
-        md = fmpy.read_model_description(str(self.path))
-        self.refs = {v.name: v.valueReference for v in md.modelVariables}
-        self.radius = float(next((v.start for v in md.modelVariables if v.name == "wheel.r"), 0.355))
-        missing = [n for n in ("W", "tau", "slipAngle", "trackAngle", *RECORDED) if n not in self.refs]
+        self.description = fmpy.read_model_description(str(self.path))
+        names = {v.name for v in self.description.modelVariables}
+        self.radius = float(next((v.start for v in self.description.modelVariables if v.name == "wheel.r"), 0.355))
+        missing = [n for n in ("W", "tau", "slipAngle", "trackAngle", *RECORDED) if n not in names]
         if missing:
             raise ValueError(f"{self.path}: not a SingleWheel FMU (no variables {missing})")
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self._folder.name,
-                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName="testbed")
-        # Own callbacks (FMPy's default ones log through a proxy that may point at the logger of
-        # an earlier simulate_fmu call that no longer exists); errors are kept for the messages.
-        self.messages: list[str] = []
-        self._callbacks = fmi2CallbackFunctions()
-        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
-        self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
-        self._callbacks.freeMemory = defaultCallbacks.freeMemory
-        self.fmu.instantiate(callbacks=self._callbacks)
+        self.names = names
+        self.fmu = FmuParticipant(FmuEntry("testbed", self.path, {}, {}, self.description), Path(self._folder.name))
+        self.fmu.configure([], list(RECORDED))  # inputs are set by name when they change; RECORDED read each step
         self._fresh = True
         #: FMU parameters set before every run (e.g. a soil and wheel: terramechanics.library.fmu_parameters)
         self.parameters: dict[str, float] = {}
 
-    def _log(self, env, instance, status, category, message) -> None:  # noqa: ANN001 - ctypes callback
-        if status >= 2:  # discard, error, fatal
-            self.messages.append(message.decode(errors="replace"))
-
     def _start(self, load: float, tau: float, turn: float, tolerance: float, start_speed: float, slip_angle: float,
-               parameters: dict[str, float]) -> None:
-        """Reset (after the first run), set up and initialize the FMU for a run."""
+               parameters: dict[str, float], stop_time: float) -> np.ndarray:
+        """Reset (after the first run), set up and initialize the FMU for a run; the recorded
+        variables at the start."""
         fmu = self.fmu
         if not self._fresh:
             fmu.reset()
         self._fresh = False
-        fmu.setupExperiment(startTime=0.0)
-        unknown = sorted(set(parameters) - set(self.refs))
+        unknown = sorted(set(parameters) - self.names)
         if unknown:
             raise ValueError(f"{self.path}: no parameters {unknown}")
-        if parameters:
-            fmu.setReal([self.refs[name] for name in parameters], [float(v) for v in parameters.values()])
-        fmu.setReal([self.refs["W"], self.refs["tau"], self.refs["solver.tolerance"], self.refs["slipAngle"],
-                     self.refs["trackAngle"]], [load, tau, tolerance, slip_angle, turn])
+        start = {"W": load, "tau": tau, "solver.tolerance": tolerance, "slipAngle": slip_angle, "trackAngle": turn}
         if start_speed:
             radius = float(parameters.get("wheel.r", self.radius))
-            fmu.setReal([self.refs["v"], self.refs["omega"]],
-                        [start_speed, start_speed * math.cos(slip_angle + turn) / radius])
-        fmu.enterInitializationMode()
-        fmu.exitInitializationMode()
+            start.update(v=start_speed, omega=start_speed * math.cos(slip_angle + turn) / radius)
+        fmu.entry = FmuEntry(fmu.name, self.path, {k: float(v) for k, v in parameters.items()}, start,
+                             self.description)
+        fmu.enter_initialization(0.0, stop_time)
+        return fmu.exit_initialization(0.0, np.zeros(0))
 
     def run(self, load: float, torque: TorqueProfile, stop_time: float, sample_time: float,
             tolerance: float = 1e-8, *, start_speed: float = 0.0, slip_angle: float = 0.0,
@@ -122,20 +113,18 @@ class WheelTestBed:
         turns = track_angle(times) if track_angle is not None else np.zeros(n + 1)
         if not np.all(np.abs(slip_angle + turns) < math.pi / 2):
             raise ValueError(f"track_angle = {track_angle!r}: the slip angle must stay in (-pi/2, pi/2) rad")
-        self._start(load, float(taus[0]), float(turns[0]), tolerance, start_speed, slip_angle,
-                    self.parameters if parameters is None else parameters)
-        fmu = self.fmu
-        outputs = [self.refs[name] for name in RECORDED]
-        tau_ref, turn_ref = [self.refs["tau"]], [self.refs["trackAngle"]]
         rows = np.empty((n + 1, len(RECORDED)))
-        rows[0] = fmu.getReal(outputs)
+        rows[0] = self._start(load, float(taus[0]), float(turns[0]), tolerance, start_speed, slip_angle,
+                              self.parameters if parameters is None else parameters, float(times[-1]))
+        fmu = self.fmu
+        nothing = np.zeros(0)
         for k in range(n):
             if k and taus[k] != taus[k - 1]:
-                fmu.setReal(tau_ref, [taus[k]])
+                fmu.set_values({"tau": float(taus[k])})
             if k and turns[k] != turns[k - 1]:
-                fmu.setReal(turn_ref, [turns[k]])
-            fmu.doStep(times[k], sample_time)
-            rows[k + 1] = fmu.getReal(outputs)
+                fmu.set_values({"trackAngle": float(turns[k])})
+            fmu.do_step(float(times[k]), sample_time, nothing)
+            rows[k + 1] = fmu.get_outputs(float(times[k + 1]))
         fmu.terminate()
         data = pd.DataFrame(rows, columns=list(RECORDED))
         data.insert(0, "tau", taus)

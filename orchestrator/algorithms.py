@@ -18,15 +18,27 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
 from .model import Iteration
 from .participants import BlockParticipant, Participant, RunError
 
-if TYPE_CHECKING:
-    from .execution import Execution
+
+class Stepping(Protocol):
+    """What an algorithm (and an observer) sees of the execution carrying it out
+    (``execution.Execution``): the participants in order, their slots, the time inside each."""
+
+    participants: list[Participant]
+    inputs: list[np.ndarray]
+    outputs: list[np.ndarray]
+    stages: list[list[int]]
+    step_seconds: dict[str, float]
+    slot_names: list[str]                 # "instance.variable" of each slot of the value vector
+    output_names: dict[str, list[str]]    # per participant, its outputs in the order of its slots
+
+    def run_stage(self, stage: Sequence[int], values: np.ndarray, t: float, h: float) -> None: ...
 
 #: Pieces of the iterative master's first communication step (see Iterative.step).
 START_SUBSTEPS = 10
@@ -47,10 +59,10 @@ class Algorithm:
         """The stages of one communication step, as lists of participant positions."""
         return [[i] for i in range(len(participants))]
 
-    def prepare(self, execution: Execution) -> None:
+    def prepare(self, execution: Stepping) -> None:
         """Called once the execution is set up (before the first step)."""
 
-    def step(self, execution: Execution, values: np.ndarray, t: float, h: float) -> None:
+    def step(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         """Advance every participant from ``t`` to ``t + h``; ``values`` then holds the outputs at ``t + h``."""
         for stage in execution.stages:
             execution.run_stage(stage, values, t, h)
@@ -119,7 +131,7 @@ class Iterative(Algorithm):
         self.exchanged = np.zeros(0, int)
         self.holds: list[str] = []
 
-    def prepare(self, execution: Execution) -> None:
+    def prepare(self, execution: Stepping) -> None:
         inputs = execution.inputs
         exchanged = np.unique(np.concatenate([slots for slots in inputs if len(slots)] or [np.zeros(0, int)]))
         self.exchanged = exchanged.astype(int)
@@ -130,7 +142,7 @@ class Iterative(Algorithm):
                       else "interpolate" if getattr(p, "can_interpolate", False) else "mean"
                       for p in execution.participants]
 
-    def step(self, execution: Execution, values: np.ndarray, t: float, h: float) -> None:
+    def step(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         # The first step of a run is taken in START_SUBSTEPS pieces: inputs switched on at the
         # start (a torque step from rest) make the exchanged values jump within it, which no
         # interpolation over the whole step follows.
@@ -139,7 +151,7 @@ class Iterative(Algorithm):
             self._iterate(execution, values, t + piece * h / pieces, h / pieces)
         self.steps += 1
 
-    def _pass(self, execution: Execution, start: np.ndarray, guess: np.ndarray, t: float, h: float) -> np.ndarray:
+    def _pass(self, execution: Stepping, start: np.ndarray, guess: np.ndarray, t: float, h: float) -> np.ndarray:
         """One pass over the participants in order; returns the new values."""
         clock = time.perf_counter
         new = guess.copy()  # filled in order: later participants see this pass's outputs
@@ -156,7 +168,7 @@ class Iterative(Algorithm):
             execution.step_seconds[participant.name] += clock() - begin
         return new
 
-    def _iterate(self, execution: Execution, values: np.ndarray, t: float, h: float) -> None:
+    def _iterate(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         settings, participants = self.iteration, execution.participants
         start = values.copy()
         guess = values.copy()

@@ -38,7 +38,9 @@ class Block(Protocol):
     name: str
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
-    units: Mapping[str, str]
+
+    @property
+    def units(self) -> Mapping[str, str]: ...
 
     def start(self, t0: float, u0: np.ndarray) -> np.ndarray: ...
 
@@ -191,7 +193,7 @@ def _python_block(name: str, params: Mapping[str, Any], folder: Path | None = No
         if not hasattr(block, attribute):
             raise ValueError(f"block {name!r}: {factory} made an object without {attribute!r}")
     if not hasattr(block, "units"):
-        block.units = {}
+        setattr(block, "units", {})  # noqa: B010 - the protocol reads it as a property
     return block
 
 

@@ -266,8 +266,14 @@ class SystemBuilder:
             checked[variable] = self._number(value, f"{where} {key} {variable}")
         return checked
 
-    def set_parameters(self, instance: str, values: Mapping[str, Any], *, where: str | None = None) -> SystemBuilder:
-        """Parameter values of the FMU ``instance`` (they override those given before)."""
+    def set_parameters(self, instance: str, values: Mapping[str, Any], *, where: str | None = None,
+                       only_known: bool = False) -> SystemBuilder:
+        """Parameter values of the FMU ``instance`` (they override those given before);
+        ``only_known``: those of ``values`` the FMU has as parameters (a soil to each wheel, none
+        to a body), else every name must be one."""
+        if only_known:
+            names = self.parameter_names(instance)
+            values = {k: v for k, v in values.items() if k in names}
         self._fmus_entry(instance, where).parameters.update(self._values(instance, "parameters", values, where))
         return self
 
@@ -300,7 +306,7 @@ class SystemBuilder:
             if not hasattr(block, attribute):
                 raise self.error(where, f"{block!r} is not a block: it has no {attribute!r}")
         if not hasattr(block, "units"):
-            block.units = {}
+            setattr(block, "units", {})  # noqa: B010 - the protocol reads it as a property
         if kind is None:
             kind = next((k for k, cls in BLOCK_TYPES.items() if type(block) is cls), "python")
         self._blocks[name] = BlockEntry(name, kind, block, keys)
@@ -353,11 +359,11 @@ class SystemBuilder:
         self._connections.append(Connection(number_, source_port, target_port))
         return self
 
-    def record(self, *ports: str | Port, where: str | None = None) -> SystemBuilder:
-        """Record these ports (in addition to those recorded before); without any call to
-        record, every output of every participant is recorded."""
+    def record(self, *ports: str | Port, where: str | None = None, replace: bool = False) -> SystemBuilder:
+        """Record these ports (in addition to those recorded before, unless ``replace``); without
+        any call to record, every output of every participant is recorded."""
         where = where or "record"
-        recorded = self._record if self._record is not None else []
+        recorded = self._record if self._record is not None and not replace else []
         for text in ports:
             port = parse_port(text, f"{self.name}: {where}")
             self._lookup(port, f"{where} {str(text)!r}")
@@ -456,7 +462,7 @@ def _copy_fmu(fmu: FmuEntry) -> FmuEntry:
     return FmuEntry(fmu.name, fmu.path, dict(fmu.parameters), dict(fmu.start), fmu.description)
 
 
-def replace_settings(system: System, name: str | None = None, **settings: Any) -> System:
+def replace_settings(system: System, *, name: str | None = None, **settings: Any) -> System:
     """``system`` with other simulation settings (checked as when it was built: the step against
     the run, an algebraic loop against the algorithm)."""
     return SystemBuilder.from_system(system, name).simulation(**settings).build()
@@ -469,7 +475,5 @@ def with_parameters(system: System, values: Mapping[str, float], *, only_known: 
     wheel, none to the body); else every value must be a parameter of every FMU named."""
     builder = SystemBuilder.from_system(system)
     for instance in instances if instances is not None else builder.fmu_names():
-        names = builder.parameter_names(instance)
-        given = {k: v for k, v in values.items() if k in names} if only_known else dict(values)
-        builder.set_parameters(instance, given)
+        builder.set_parameters(instance, values, only_known=only_known)
     return builder.build()

@@ -127,7 +127,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
         execution = make_execution(system, participants, wiring)
         stack.callback(execution.close)
         recorder = Recorder(system.record, wiring.record_slots, times)
-        watchers: list[Watcher] = [FiniteCheck(execution), Recording(recorder)]
+        watchers: list[Watcher] = [FiniteCheck(execution, execution.checked_in_python), Recording(recorder)]
         offset = 0
         for observer in observers:
             count = len(observer.ports)

@@ -25,16 +25,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
+from .algorithms import Stepping
 from .model import System
 from .participants import RunError
 from .recorder import Recorder, RunResult
-
-if TYPE_CHECKING:
-    from .execution import Execution
 
 
 @dataclass(frozen=True)
@@ -86,7 +84,7 @@ class StopWhen(Observer):
         return None
 
 
-def check_finite(execution: Execution, values: np.ndarray, t: float, which: Sequence[int] | None = None) -> None:
+def check_finite(execution: Stepping, values: np.ndarray, t: float, which: Sequence[int] | None = None) -> None:
     """A RunError naming the participant, the signal and the time of the first non-finite output
     (of the participants ``which``, default all)."""
     for i in range(len(execution.participants)) if which is None else which:
@@ -113,9 +111,9 @@ class FiniteCheck(Watcher):
     """Outputs must be finite: every participant's at the start, then those of the participants
     stepped in Python (the native stepper checks its own)."""
 
-    def __init__(self, execution: Execution):
+    def __init__(self, execution: Stepping, checked: list[int]):
         self.execution = execution
-        self.checked = execution.checked_in_python
+        self.checked = checked
 
     def sampled(self, k: int, t: float, values: np.ndarray) -> Any:
         check_finite(self.execution, values, t, None if k == 0 else self.checked)

@@ -291,6 +291,14 @@ class FmuParticipant:
                                                                     self._orders, self._slope_pointer), t)
         self._call("fmi2DoStep", lambda: self.fmu.fmi2DoStep(self.fmu.component, t, h, 1), t)
 
+    def reset(self) -> None:
+        """fmi2Reset: back to the state after instantiation (a new run on the same instance)."""
+        self._call("fmi2Reset", self.fmu.reset)
+
+    def terminate(self) -> None:
+        """fmi2Terminate at the end of a run (the instance may then be reset)."""
+        self._call("fmi2Terminate", self.fmu.terminate)
+
     def get_state(self, t: float) -> Any:
         """fmi2GetFMUstate: a copy of the whole instance (integrator memory included)."""
         return self._call("fmi2GetFMUstate", self.fmu.getFMUstate, t)

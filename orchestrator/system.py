@@ -180,15 +180,19 @@ def system_to_dict(system: System, folder: Path | None = None) -> dict[str, Any]
         simulation.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,
                           relaxation=system.iteration.relaxation)
     data: dict[str, Any] = {"simulation": simulation}
-    data["fmu"] = [{"name": f.name, "path": _relative(f.path, folder), "parameters": dict(f.parameters),
-                    "start": dict(f.start)} for f in system.fmus]
+    data["fmu"] = []
+    for f in system.fmus:
+        entry: dict[str, Any] = {"name": f.name, "path": _relative(f.path, folder)}
+        entry.update({key: dict(values) for key, values in (("parameters", f.parameters), ("start", f.start))
+                      if values})
+        data["fmu"].append(entry)
     blocks = []
-    for entry in system.blocks:
-        if entry.keys is None:
-            raise SystemFileError(f"{system.name}: block {entry.name!r} ({type(entry.block).__name__}) was built in "
+    for block in system.blocks:
+        if block.keys is None:
+            raise SystemFileError(f"{system.name}: block {block.name!r} ({type(block.block).__name__}) was built in "
                                   "code from an object: a system file holds a block's type and keys, so it cannot "
                                   "be written")
-        blocks.append({"name": entry.name, "type": entry.kind, **entry.keys})
+        blocks.append({"name": block.name, "type": block.kind, **block.keys})
     if blocks:
         data["block"] = blocks
     if system.connections:

@@ -14,9 +14,12 @@ keeps.
 
 from __future__ import annotations
 
+import copy
 import math
 import tomllib
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields, replace
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -53,6 +56,16 @@ def _tables(path: Path) -> dict[str, Any]:
         raise ValueError(f"{path}: not a readable TOML file ({error})") from None
 
 
+@lru_cache(maxsize=4)
+def _shipped_tables(path: Path) -> dict[str, Any]:
+    return _tables(path)
+
+
+def _shipped(path: Path) -> dict[str, Any]:
+    """A shipped file's tables, read once per process (a copy: callers may change it)."""
+    return copy.deepcopy(_shipped_tables(path))
+
+
 def names(kind: str) -> list[str]:
     """The shipped soils (``kind = "soil"``) or wheels."""
     return list(_tables(SOILS if kind == "soil" else WHEELS))
@@ -60,7 +73,7 @@ def names(kind: str) -> list[str]:
 
 def entry(kind: str, spec: str) -> tuple[str, dict[str, Any]]:
     """(name, table) of a shipped name, a TOML file (one soil, or one table of them), or ``FILE:NAME``."""
-    library = _tables(SOILS if kind == "soil" else WHEELS)
+    library = _shipped(SOILS if kind == "soil" else WHEELS)
     if spec in library:
         return spec, dict(library[spec])
     path, name = spec, ""
@@ -106,9 +119,9 @@ def build(kind: str, name: str, table: dict[str, Any]) -> Soil | Wheel:
     """The Soil or Wheel of a table: the paper's values for what it leaves out, xc = 45 deg - phi/2."""
     values = _values(kind, name, table)
     if kind == "wheel":
-        base_wheel = Wheel(**_values("wheel", DEFAULT, _tables(WHEELS)[DEFAULT]))
+        base_wheel = Wheel(**_values("wheel", DEFAULT, _shipped(WHEELS)[DEFAULT]))
         return replace(base_wheel, **values)
-    base = _values("soil", DEFAULT, _tables(SOILS)[DEFAULT])
+    base = _values("soil", DEFAULT, _shipped(SOILS)[DEFAULT])
     if "phi" in values and "xc" not in values:
         base["xc"] = math.radians(45.0) - values["phi"] / 2
     try:
@@ -137,17 +150,35 @@ def choose(soil: str | None = None, wheel: str | None = None, assignments: list[
     changes = parse_set(assignments)
     soil_name, soil_table = entry("soil", soil or DEFAULT)
     wheel_name, wheel_table = entry("wheel", wheel or DEFAULT)
-    for field in changes["soil"]:
+    return _changed(soil_name, soil_table, wheel_name, wheel_table, changes["soil"], changes["wheel"],
+                    tuple(assignments))
+
+
+def vary(choice: Choice, soil: Mapping[str, float] | None = None, wheel: Mapping[str, float] | None = None) -> Choice:
+    """``choice`` with some values changed, exactly as ``--set`` changes them (SI; angles in
+    degrees under ``phi_deg``, ``xc_deg``): ``vary(choice, soil={"c": 500.0, "phi_deg": 30.0})``.
+    ValueError with the library's message for a soil or wheel it refuses."""
+    soil, wheel = dict(soil or {}), dict(wheel or {})
+    overrides = tuple(f"{kind}.{key}={float(value)!r}" for kind, values in (("soil", soil), ("wheel", wheel))
+                      for key, value in values.items())
+    return _changed(choice.soil_name, dict(choice.soil_entry), choice.wheel_name, dict(choice.wheel_entry), soil,
+                    wheel, choice.overrides + overrides)
+
+
+def _changed(soil_name: str, soil_table: dict[str, Any], wheel_name: str, wheel_table: dict[str, Any],
+             soil: Mapping[str, float], wheel: Mapping[str, float], overrides: tuple[str, ...]) -> Choice:
+    """The Choice of the tables with ``soil`` and ``wheel`` values changed (the tables are changed)."""
+    for field in soil:
         if field in DEGREES:
             soil_table.pop(DEGREES[field], None)
         elif field in DEGREES.values():
             soil_table.pop(f"{field}_deg", None)
-    soil_table.update(changes["soil"])
-    wheel_table.update(changes["wheel"])
+    soil_table.update({key: float(value) for key, value in soil.items()})
+    wheel_table.update({key: float(value) for key, value in wheel.items()})
     chosen_soil = build("soil", soil_name, soil_table)
     chosen_wheel = build("wheel", wheel_name, wheel_table)
     assert isinstance(chosen_soil, Soil) and isinstance(chosen_wheel, Wheel)
-    return Choice(chosen_soil, chosen_wheel, soil_name, wheel_name, soil_table, wheel_table, tuple(assignments))
+    return Choice(chosen_soil, chosen_wheel, soil_name, wheel_name, soil_table, wheel_table, overrides)
 
 
 def fmu_parameters(soil: Soil, wheel: Wheel) -> dict[str, float]:

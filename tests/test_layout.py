@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ast
 import os
+import shutil
 import site
 import subprocess
 import sys
@@ -104,9 +105,11 @@ def test_no_import_cycles(graph):
 
 def test_the_layer_test_sees_the_engine_and_would_catch_a_wrong_import(graph):
     """Guards the test itself: it parses the linked folders and flags an import across layers."""
-    assert "rover_cosim.orchestrator.master" in graph and "rover_cosim.orchestrator.system" in graph[
+    assert "rover_cosim.orchestrator.master" in graph and "rover_cosim.orchestrator.model" in graph[
         "rover_cosim.orchestrator.master"]
-    assert "rover_cosim.common.units" in graph["rover_cosim.orchestrator.system"]
+    assert "rover_cosim.common.units" in graph["rover_cosim.orchestrator.builder"]
+    for module in ("builder", "system", "ssp", "algorithms", "executors", "execution", "observers", "unpacking"):
+        assert f"rover_cosim.orchestrator.{module}" in graph, module
     assert "control" not in ALLOWED["orchestrator"] and "identification" not in ALLOWED["orchestrator"]
 
 
@@ -125,14 +128,27 @@ def run(command: list[str], cwd: Path, env: dict[str, str] | None = None, timeou
     return result.stdout
 
 
+#: What the wheel's build does not need from a checkout (build outputs, environments, results).
+NOT_BUILT_FROM = shutil.ignore_patterns(".git", ".venv", "results", "build", "dist", "*.egg-info", "__pycache__",
+                                        ".pytest_cache", ".mypy_cache", ".ruff_cache", "*.fmu")
+
+
 @pytest.fixture(scope="module")
 def wheel(tmp_path_factory) -> Path:
-    """The project's wheel, built from the checkout (offline: setuptools from the test extra)."""
+    """The project's wheel, built from a copy of the checkout in a scratch folder, so that the
+    build leaves nothing in the checkout (offline: setuptools from the test extra)."""
     out = tmp_path_factory.mktemp("wheel")
+    source = tmp_path_factory.mktemp("source") / "rover-cosim"
+    shutil.copytree(REPOSITORY, source, symlinks=True, ignore=NOT_BUILT_FROM)
     run([sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "--no-build-isolation", "-w", str(out),
-         str(REPOSITORY)], cwd=out)
+         str(source)], cwd=out)
     (built,) = out.glob("rover_cosim-*.whl")
     return built
+
+
+def test_building_the_wheel_leaves_nothing_in_the_checkout(wheel):
+    assert wheel.is_file()
+    assert not (REPOSITORY / "build").exists(), "the wheel's build left build/ in the checkout"
 
 
 def test_the_wheel_has_only_rover_cosim_at_the_top_level(wheel):

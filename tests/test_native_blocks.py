@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import ctypes
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -16,9 +17,10 @@ from scipy.linalg import expm
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.jobs.simulate import cosim_system, monolithic_system
 from rover_cosim.orchestrator import native
+from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.master import RunError, make_master, participants_of, run
+from rover_cosim.orchestrator.model import System
 from rover_cosim.orchestrator.participants import BlockParticipant
-from rover_cosim.orchestrator.system import system_from_dict
 from rover_cosim.orchestrator.wiring import wire
 
 pytestmark = pytest.mark.skipif(native.unavailable_reason() is not None,
@@ -102,19 +104,18 @@ def test_the_filter_is_discretised_exactly(model):
         np.testing.assert_allclose(bd, np.linalg.solve(a, (exact - np.eye(2)) @ b), rtol=1e-10, atol=1e-13)
 
 
-def short(system: dict, stop_time: float, **simulation: object) -> dict:
-    system["simulation"].update(stop_time=stop_time, **simulation)
-    return system
+def short(system: System, stop_time: float, **simulation: Any) -> System:
+    return replace_settings(system, stop_time=stop_time, **simulation)
 
 
 @pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
 @pytest.mark.parametrize("plant", [monolithic_system, cosim_system], ids=["Rover.fmu", "co-simulated"])
 def test_the_closed_loop_with_the_c_twin_is_the_python_closed_loop(fmu_dir, model, plant, algorithm):
-    def system(native_stepping: bool) -> dict:
+    def system(native_stepping: bool) -> System:
         return short(plant(fmu_dir, model), 0.4, algorithm=algorithm, native=native_stepping)
 
-    python = run(system_from_dict(system(False), name="python", base=fmu_dir))
-    ours = system_from_dict(system(True), name="native", base=fmu_dir)
+    python = run(system(False))
+    ours = system(True)
     wiring = wire(ours)
     with participants_of(ours, wiring) as participants:
         master = make_master(ours, participants, wiring)
@@ -124,10 +125,10 @@ def test_the_closed_loop_with_the_c_twin_is_the_python_closed_loop(fmu_dir, mode
 
 
 def test_a_failing_c_twin_is_named_with_its_message(fmu_dir, model):
-    data = short(monolithic_system(fmu_dir, model, step=5e-4), 0.1)  # made for a shorter step than the system's
+    system = short(monolithic_system(fmu_dir, model, step=5e-4), 0.1)  # made for a shorter step than the system's
     with pytest.raises(RunError, match=r"ctrl \(block\): step at t = 0 s failed: communication step 0.001 s: "
                                        r"expected at most its step = 0.0005 s") as info:
-        run(system_from_dict(data, name="t", base=fmu_dir))
+        run(system)
     assert len(info.value.partial) == 1  # the start only
 
 
@@ -137,7 +138,7 @@ def test_without_a_compiler_the_controller_steps_in_python(fmu_dir, model, tmp_p
     native.load_library.cache_clear()  # the stepper stays loaded; the controller's source is new to the cache
     try:
         assert InverseModelController("ctrl", str(model)).native() is None
-        system = system_from_dict(short(monolithic_system(fmu_dir, model), 0.05), name="t", base=fmu_dir)
+        system = short(monolithic_system(fmu_dir, model), 0.05)
         wiring = wire(system)
         with participants_of(system, wiring) as participants:
             master = make_master(system, participants, wiring)

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator import native as native_code
 
 from .longitudinal import LongitudinalInverse, read_model
@@ -34,9 +35,10 @@ C_SOURCE = Path(__file__).with_name("inverse_controller.c")
 
 
 class InverseModelController:
-    """Orchestrator block: inputs x, v, W[1..6]; outputs tau[1..6], Fx_des[1..6], F_all."""
+    """Orchestrator block: inputs x, v, W[1..6]; outputs tau[1..6], Fx_des[1..6], F_all.
+    ``model``: the identified models (a ModelSet, or the model.json to read)."""
 
-    def __init__(self, name: str, model: str, mass: float = 1570.0, v_target: float = 1.0, kv: float = 1.0,
+    def __init__(self, name: str, model: ModelSet | str, mass: float = 1570.0, v_target: float = 1.0, kv: float = 1.0,
                  kp: float = 0.001, a_max: float = 0.1, wn: float = 342.0, step: float = 1e-3,
                  fixed_load: float | None = None, model_label: str | None = None):
         _, self.model, self.model_label = read_model(model, name, model_label)

@@ -1,31 +1,38 @@
 """The inverse of the identified longitudinal model (paper Sec. 4.1, steps 3-4), per wheel:
 Fx_des -> slip by the Fx(W, slip) block, the filter of Eq. (17) on that slip, and the inverse
-of the first-order tau -> slip block at the wheel's load, tau = (slip_f + T slip_f') / K."""
+of the first-order tau -> slip block at the wheel's load, tau = (slip_f + T slip_f') / K.
+
+One law, written once in Python wheel by wheel in plain floats, and its C twin
+(``inverse_controller.c``, stepped by the native stepper) with the same arithmetic in the same
+order, so that their torques agree to the last bit (tests); ``torques_for_slips`` applies the
+same law to each wheel. Plain floats rather than numpy: on six wheels numpy's cost per call
+dominates (a whole-array numpy version of this law, bit for bit the same, took 7.5x as long per
+step: 405 against 54 us, measured side by side); where no C compiler works the blocks step this
+law in Python (``make bench``: results/bench/controller.json has its cost per step).
+"""
 
 from __future__ import annotations
 
 import bisect
-import json
 import math
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from rover_cosim.identification.fits import IdentifiedModel
+from rover_cosim.identification.model_set import ModelFileError, ModelSet
 
 
-def read_model(model: str | Path, name: str, label: str | None = None) -> tuple[dict[str, Any], IdentifiedModel, str]:
-    """(model.json's content, the identified longitudinal model ``label`` (default: the
-    recommended one), its label), with errors that name the block and the file."""
-    path = Path(model)
-    if not path.is_file():
-        raise ValueError(f"block {name!r}: identified model {path} not found (run `make identify`)")
-    data = json.loads(path.read_text())
-    label = label or data["recommended"]
-    if label not in data["models"]:
-        raise ValueError(f"block {name!r}: model {label!r} not in {path} (has {sorted(data['models'])})")
-    return data, IdentifiedModel.from_dict(data["models"][label]), label
+def read_model(model: ModelSet | str | Path, name: str,
+               label: str | None = None) -> tuple[ModelSet, IdentifiedModel, str]:
+    """(the identified models, the longitudinal model ``label`` (default: the recommended one),
+    its label) of ``model``: a ModelSet, or the model.json to read; errors name the block and the file."""
+    try:
+        models = model if isinstance(model, ModelSet) else ModelSet.read(model)
+        chosen = models.model(label)
+    except ModelFileError as error:
+        raise ValueError(f"block {name!r}: {error}") from None
+    return models, chosen, label or models.recommended
 
 
 class LongitudinalInverse:
@@ -37,8 +44,7 @@ class LongitudinalInverse:
         self.model, self.name, self.wn, self.step = model, name, wn, step
         self.ad, self.bd = self.discretised(step)
         self.filter_state = np.zeros((wheels, 2))
-        # The tables as plain Python floats for the per-step path (``torques``): on six wheels,
-        # list arithmetic is several times faster than numpy's per-call overhead.
+        # The tables as plain Python floats (see the module docstring).
         self._inverse = [float(v) for v in 1.0 / np.asarray(model.loads, float)]   # decreasing
         self._negated_inverse = [-v for v in self._inverse]                          # increasing, for bisect
         self._torques = [float(v) for v in model.torques]
@@ -47,7 +53,7 @@ class LongitudinalInverse:
         self._coefficients = [[float(v) for v in row] for row in model.fx_coefficients]
 
     def tables(self) -> tuple[list[float], list[float], list[list[float]], list[list[float]], list[list[float]]]:
-        """The tables of the per-step path, for the controller's C twin: 1/W of the loads
+        """The law's tables, for the controller's C twin: 1/W of the loads
         [1/N] (decreasing), the torques [N·m], per load the settled slips and log T [log s], and
         the Fx model's coefficient rows."""
         return self._inverse, self._torques, self._settled, self._log_t, self._coefficients
@@ -64,7 +70,10 @@ class LongitudinalInverse:
 
     def slips_for_forces(self, loads: np.ndarray, forces: np.ndarray) -> np.ndarray:
         """The slip at which the Fx(W, slip) block gives each force (for the quadratic model, the
-        root nearest the linear solution)."""
+        root nearest the linear solution), for whole arrays at once: the path controller's force
+        allocation uses it. The same inverse as the law's first step up to round-off (the law
+        evaluates c_k(W) term by term, this a matrix product); moving the path controller onto
+        the law changes its results in the last printed digit, so that waits for its C twin."""
         powers = np.vstack([np.ones_like(loads), loads, loads**2])
         c = self.model.fx_coefficients @ powers  # (degree + 1, wheels): c_k(W)
         linear = (forces - c[0]) / c[1]
@@ -80,40 +89,22 @@ class LongitudinalInverse:
         nearest = np.where(np.abs(plus - linear) <= np.abs(minus - linear), plus, minus)
         return np.where(safe, nearest, linear)
 
-    def torques_for_slips(self, loads: np.ndarray, slips: np.ndarray,
-                          rows: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """(torque whose settled slip K(W, tau) tau is each slip, T there): the exact inverse of
-        the tables as the identified model reads them (settled slip linear in tau between the
-        table's torques, extended linearly beyond them). ``rows``: model.rows_at(loads), if known."""
-        torques = self.model.torques
-        settled_rows, constants = rows if rows is not None else self.model.rows_at(loads)
-        result, time_constants = np.empty(len(loads)), np.empty(len(loads))
-        for i, (row, slip) in enumerate(zip(settled_rows, slips)):
-            j = int(np.clip(np.searchsorted(row, slip), 1, len(torques) - 1))
-            torque = torques[j - 1] + (slip - row[j - 1]) * (torques[j] - torques[j - 1]) / (row[j] - row[j - 1])
-            result[i] = torque
-            time_constants[i] = np.interp(torque, torques, constants[i])
-        return result, time_constants
-
-    def reference_torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool) -> np.ndarray:
-        """``torques`` by whole-array numpy operations (the first implementation; kept as the
-        reference the plain-float path is tested and benchmarked against)."""
-        targets = self.slips_for_forces(loads, forces)
-        if advance:
-            self.filter_state = self.filter_state @ self.ad.T + np.outer(targets, self.bd)
-        else:
-            self.filter_state = np.column_stack([targets, np.zeros(len(targets))])
-        slip, rate = self.filter_state[:, 0], self.filter_state[:, 1]
-        rows = self.model.rows_at(loads)
-        _, constants = self.torques_for_slips(loads, slip, rows)
-        torque, _ = self.torques_for_slips(loads, slip + constants * rate, rows)
-        return torque
+    def torques_for_slips(self, loads: np.ndarray, slips: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(torque whose settled slip K(W, tau) tau is each slip, T there [s]): the exact inverse
+        of the tables as the law reads them (settled slip linear in tau between the table's
+        torques, extended linearly beyond them; T linear between them, held beyond)."""
+        torques, constants = [], []
+        for load, slip in zip(np.asarray(loads, float).tolist(), np.asarray(slips, float).tolist()):
+            settled, log_t = self._rows(load)
+            torque = self._torque_for(settled, slip)
+            torques.append(torque)
+            constants.append(self._time_constant(torque, log_t))
+        return np.array(torques), np.array(constants)
 
     def torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
         """The torques for ``forces`` at ``loads``; ``advance`` moves the filter one step on (else
         it starts settled at the targets); ``step`` [s]: a step other than the one it was made for
-        (the shorter last step of a run). The same arithmetic as slips_for_forces,
-        model.rows_at and torques_for_slips, wheel by wheel in plain floats."""
+        (the shorter last step of a run)."""
         ad, bd = self.ad, self.bd
         if advance and step is not None and abs(step - self.step) > 1e-12:
             ad, bd = self.discretised(step)
@@ -136,7 +127,7 @@ class LongitudinalInverse:
         return result
 
     def _slip_for_force(self, load: float, force: float) -> float:
-        """slips_for_forces for one wheel."""
+        """The slip at which the Fx(W, slip) model gives ``force`` at ``load``."""
         c = [row[0] + row[1] * load + row[2] * load * load for row in self._coefficients]
         linear = (force - c[0]) / c[1]
         if self.model.degree == 1:
@@ -151,7 +142,7 @@ class LongitudinalInverse:
         return plus if abs(plus - linear) <= abs(minus - linear) else minus
 
     def _rows(self, load: float) -> tuple[list[float], list[float]]:
-        """model.rows_at for one load: the settled-slip row and the log T row (interpolated in 1/W)."""
+        """The settled-slip row and the log T row at ``load`` (interpolated linearly in 1/W)."""
         if not load > 0:
             raise ValueError(f"loads = {load!r} N: expected > 0")
         inverse, x = self._inverse, 1.0 / load
@@ -163,7 +154,7 @@ class LongitudinalInverse:
         return settled, [(1 - weight) * a + weight * b for a, b in zip(low_t, high_t)]
 
     def _torque_for(self, row: list[float], slip: float) -> float:
-        """torques_for_slips for one wheel: the torque whose settled slip is ``slip``."""
+        """The torque whose settled slip (in ``row``) is ``slip``."""
         torques = self._torques
         j = min(max(bisect.bisect_left(row, slip), 1), len(torques) - 1)
         return torques[j - 1] + (slip - row[j - 1]) * (torques[j] - torques[j - 1]) / (row[j] - row[j - 1])

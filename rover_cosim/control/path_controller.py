@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from rover_cosim.identification.lateral import LateralModel
+from rover_cosim.identification.model_set import ModelSet
 
 from .allocation import allocate, allocation_matrix
 from .longitudinal import LongitudinalInverse, read_model
@@ -53,16 +53,16 @@ class PathFollowingController:
     (wheels). Outputs: tau[1..6], steer[1..6], Fx_des[1..6], Fy_des[1..6], s, s_ref,
     cross_track, heading_error."""
 
-    def __init__(self, name: str, model: str, path: str = "turn", v_target: float = 0.5, steering: str = "inverse",
-                 mass: float = 1570.0, yaw_inertia: float = 1980.0,
+    def __init__(self, name: str, model: ModelSet | str, path: str = "turn", v_target: float = 0.5,
+                 steering: str = "inverse", mass: float = 1570.0, yaw_inertia: float = 1980.0,
                  x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5), y_limb: float = 1.5,
                  kv: float = 1.0, kp: float = 0.01, a_max: float = 0.1,
                  k_e: float = 0.25, k_de: float = 1.0, a_n_max: float = 0.3,
                  k_psi: float = 1.0, k_r: float = 2.0, alpha_max: float = 0.5,
                  wn: float = 342.0, step: float = 1e-3):
-        data, longitudinal, _ = read_model(model, name)
-        if "lateral" not in data:
-            raise ValueError(f"block {name!r}: {model} has no lateral model (run `make identify`)")
+        models, longitudinal, _ = read_model(model, name)
+        if models.lateral is None:
+            raise ValueError(f"block {name!r}: {models.source} has no lateral model (run `make identify`)")
         if path not in PATHS:
             raise ValueError(f"block {name!r}: path = {path!r}: expected one of {sorted(PATHS)}")
         if steering not in ("inverse", "kinematic"):
@@ -73,7 +73,7 @@ class PathFollowingController:
                 raise ValueError(f"block {name!r}: {key} = {value!r}: expected > 0")
         self.name, self.steering, self.step_size = name, steering, step
         self.path: Path = PATHS[path]()
-        self.lateral = LateralModel.from_dict(data["lateral"])
+        self.lateral = models.lateral
         self.inverse = LongitudinalInverse(longitudinal, WHEELS, wn, step, name)
         self.v_target, self.mass, self.yaw_inertia = v_target, mass, yaw_inertia
         self.gains = dict(kv=kv, kp=kp, a_max=a_max, k_e=k_e, k_de=k_de, a_n_max=a_n_max, k_psi=k_psi, k_r=k_r,

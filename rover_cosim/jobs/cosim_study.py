@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import io
 import time
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,9 +20,10 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.master import run
-from rover_cosim.orchestrator.system import System, system_from_dict
+from rover_cosim.orchestrator.system import System, load_system
 
 STEPS = (1e-3, 2e-3, 5e-3, 10e-3)  # s
 ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
@@ -39,9 +39,7 @@ class CosimStudyResult:
 
 def _system(name: str, fmu_dir: Path, **simulation: object) -> System:
     path = example(name)
-    data = tomllib.loads(path.read_text())
-    data["simulation"].update(simulation)
-    return system_from_dict(data, name=f"{path.name} {simulation}", base=fmu_dir, path=path)
+    return replace_settings(load_system(path, fmu_dir=fmu_dir), name=f"{path.name} {simulation}", **simulation)
 
 
 def coupling_errors(fmu_dir: Path, steps: tuple[float, ...] = STEPS, stop_time: float = 6.0) -> pd.DataFrame:

@@ -46,10 +46,11 @@ from rover_cosim.identification.lateral import (
     training_rms,
 )
 from rover_cosim.identification.lateral_validation import LateralValidation, validate_lateral
+from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.identification.sweep import SweepOutcome, SweepPlan, run_sweep
 from rover_cosim.identification.testbed import RECORDED, shared_test_bed
 from rover_cosim.identification.validate import validate
-from rover_cosim.terramechanics.library import Choice, choose, describe, fmu_parameters
+from rover_cosim.terramechanics.library import Choice, choose, describe
 
 MODELS = {"quadratic": 2, "linear": 1}  # label -> degree in slip; the first is recommended
 RECOMMENDED = "quadratic"
@@ -127,9 +128,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     soil and wheel of ``choice`` (default: the paper's)."""
     started = time.perf_counter()
     choice = choice or choose()
-    parameters = tuple(sorted(fmu_parameters(choice.soil, choice.wheel).items()))
-    plan = replace(plan or SweepPlan(), parameters=parameters)
-    lateral_plan = replace(lateral_plan or LATERAL_PLAN, parameters=parameters)
+    plan = replace(plan or SweepPlan(), soil=choice.soil, wheel=choice.wheel)
+    lateral_plan = replace(lateral_plan or LATERAL_PLAN, soil=choice.soil, wheel=choice.wheel)
     cache_dir = cache_dir or out_dir / "cache"
     first, second = len(plan.cases()), len(lateral_plan.cases())
 
@@ -144,7 +144,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     models = {label: identify(table, degree) for label, degree in MODELS.items()}
     per_load = fx_per_load(table, 1)
     bed = shared_test_bed(Path(fmu_path))
-    bed.parameters = dict(parameters)
+    bed.parameters = plan.parameters
     validation = validate(bed, models)
     lateral_table_ = lateral_table(lateral_sweep.runs)
     lateral_models = {form.name: identify_lateral(lateral_table_, form) for form in FORMS}
@@ -157,19 +157,17 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
                             columns=["load_N", "torque_N_m", "slip_angle_deg", "error"])
     recommended_lateral = lateral_models[FORMS[0].name]
     fmu_sha = file_sha256(Path(fmu_path))
-    model_json = {
-        "recommended": RECOMMENDED,
-        "models": {label: model.to_dict() for label, model in models.items()},
+    model_set = ModelSet(RECOMMENDED, models, recommended_lateral, {
         "lut_interpolation": "linear in 1/W and tau, extended linearly beyond the grid",
         "fx_fit": {"torque_max_N_m": FIT_TORQUE_MAX, "slip_range": list(SLIP_FIT_RANGE)},
         "plan": asdict(plan),
         "fmu": {"path": str(fmu_path), "sha256": fmu_sha},
         **describe(choice),
         "failures": len(sweep.failures),
-        "lateral": {**recommended_lateral.to_dict(), "plan": asdict(lateral_plan),
-                    "inputs": "load W [N], slip angle beta [rad], slip ratio (fit rule as fx_fit)",
-                    "failures": len(lateral_sweep.failures)},
-    }
+        "lateral_details": {"plan": asdict(lateral_plan),
+                            "inputs": "load W [N], slip angle beta [rad], slip ratio (fit rule as fx_fit)",
+                            "failures": len(lateral_sweep.failures)},
+    })
     fit_models = validation.fit.drop(columns=["fit_percent"])
     record = run_record("rover-cosim identify", {"plan": asdict(plan), "lateral_plan": asdict(lateral_plan),
                                                  "workers": workers, "scheduler": scheduler})
@@ -181,7 +179,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     files = {
         out / "runs.csv": long.to_csv(index=False, float_format="%.10g").encode(),
         out / "steps.csv": table.to_csv(index=False, float_format="%.10g").encode(),
-        out / "model.json": json_bytes(model_json),
+        out / "model.json": model_set.to_json(),
         out / "fit_table.csv":
             validation.fit[["load_N", "fit_percent"]].to_csv(index=False, float_format="%.3f").encode(),
         out / "fit_models.csv": fit_models.to_csv(index=False, float_format="%.3f").encode(),

@@ -1,6 +1,7 @@
 """``make simulate`` (after the paper's straight run): the steerable rover following a curved
 path with the identified longitudinal and lateral wheel models, on SteerableRover.fmu and on the
-co-simulated SteerableRoverBody + 6 Wheel (wired by the shipped steerable_rover_cosim.toml),
+co-simulated SteerableRoverBody + 6 Wheel (wired as the shipped steerable_rover_cosim.toml is,
+by ``plants``),
 and the same paths with kinematic steering (the ablation).
 
 The controller's steering reaches the wheels' slip angles, which it reads, within the same
@@ -25,7 +26,6 @@ results/simulation/
 from __future__ import annotations
 
 import time
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -35,14 +35,16 @@ import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 from rover_cosim.control import path_figures
-from rover_cosim.control.path_controller import PATHS
-from rover_cosim.orchestrator.examples import example
+from rover_cosim.control.path_controller import PATHS, PathFollowingController
+from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
-from rover_cosim.orchestrator.system import system_from_dict
+from rover_cosim.orchestrator.model import System
 from rover_cosim.terramechanics import Wheel
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
-from .soil import soil_parameters
+from .plants import add_plant_fmu, add_rover
+from .simulate import models_of
 
 STEP = 1e-3  # s
 WHEELS = range(1, 7)
@@ -68,62 +70,58 @@ def stop_time(scenario: str) -> float:
     return float(np.floor(PATHS[scenario]().length / SCENARIOS[scenario] / STEP) * STEP)
 
 
-def controller_block(model: Path, scenario: str, steering: str) -> dict[str, Any]:
-    return {"name": "ctrl", "type": "python", "factory": "rover_cosim.control.path_controller:PathFollowingController",
-            "model": str(model), "path": scenario, "v_target": SCENARIOS[scenario], "steering": steering,
-            "step": STEP}
+def controller(models: ModelSet, scenario: str, steering: str) -> PathFollowingController:
+    """The path-following controller block ``ctrl`` of ``scenario``."""
+    return PathFollowingController("ctrl", models, path=scenario, v_target=SCENARIOS[scenario], steering=steering,
+                                   step=STEP)
 
 
-def _controller_connections(body: str, wheel: Any) -> list[dict[str, str]]:
+def _connect_controller(builder: SystemBuilder, body: str, wheel: Any) -> None:
     """Body state, loads and slip angles to the controller (``wheel(i, name)``: a wheel output)."""
-    connections = [{"from": f"{body}.{name}", "to": f"ctrl.{name}"} for name in BODY]
+    for name in BODY:
+        builder.connect(f"{body}.{name}", f"ctrl.{name}")
     for i in WHEELS:
-        connections += [{"from": wheel(i, "Fz"), "to": f"ctrl.W[{i}]"},
-                        {"from": wheel(i, "slipAngle"), "to": f"ctrl.slipAngle[{i}]"}]
-    return connections
+        builder.connect(wheel(i, "Fz"), f"ctrl.W[{i}]").connect(wheel(i, "slipAngle"), f"ctrl.slipAngle[{i}]")
 
 
-def monolithic_system(fmu_dir: Path, model: Path, scenario: str, steering: str = "inverse",
-                      choice: Choice | None = None) -> dict[str, Any]:
+def _path_run(name: str, scenario: str) -> SystemBuilder:
+    # The controller's steering reaches the slip angles it reads within the instant: an algebraic
+    # loop, broken by the order (the controller first sees the slip angles of the step before).
+    return SystemBuilder(name).simulation(stop_time=stop_time(scenario), step=STEP, algorithm="gauss-seidel",
+                                          allow_algebraic_loops=True)
+
+
+def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, steering: str = "inverse",
+                      choice: Choice | None = None) -> System:
+    """``scenario`` on SteerableRover.fmu, started rolling at its speed."""
     speed = SCENARIOS[scenario]
+    builder = _path_run(f"path {scenario} ({steering})", scenario)
     start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
-    connections = _controller_connections("rover", lambda i, name: f"rover.{name}[{i}]")
+    add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
+    builder.add_block("ctrl", controller(models_of(model), scenario, steering))
+    _connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
     for i in WHEELS:
-        connections += [{"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"},
-                        {"from": f"ctrl.steer[{i}]", "to": f"rover.steer[{i}]"}]
-    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel",
-                           "allow_algebraic_loops": True},
-            "fmu": [{"name": "rover", "path": str(fmu_dir / "SteerableRover.fmu"), "start": start,
-                     "parameters": soil_parameters(fmu_dir / "SteerableRover.fmu", choice)}],
-            "block": [controller_block(model, scenario, steering)], "connection": connections}
+        builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
+    return builder.build()
 
 
 def _radius(choice: Choice | None) -> float:
     return (choice.wheel if choice else Wheel()).r
 
 
-def cosim_system(fmu_dir: Path, model: Path, scenario: str, choice: Choice | None = None) -> dict[str, Any]:
-    """The shipped steerable_rover_cosim.toml's FMUs and hub wiring, its open-loop blocks
-    replaced by the controller, started at the scenario's speed."""
-    shipped = tomllib.loads(example("steerable_rover_cosim").read_text())
+def cosim_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: Choice | None = None) -> System:
+    """``scenario`` on SteerableRoverBody + 6 Wheel (the hubs of the shipped
+    steerable_rover_cosim.toml), started rolling at its speed, the controller first in the order."""
     speed = SCENARIOS[scenario]
-    fmus = []
-    for entry in shipped["fmu"]:
-        path = fmu_dir / entry["path"]
-        start = {"v": speed} if entry["name"] == "body" else {"omega": speed / _radius(choice)}
-        fmus.append({"name": entry["name"], "path": str(path), "start": start,
-                     "parameters": soil_parameters(path, choice)})
-    names = {entry["name"] for entry in fmus}
-    hubs = [c for c in shipped["connection"] if c["from"].split(".")[0] in names and c["to"].split(".")[0] in names]
-    connections = hubs + _controller_connections("body", lambda i, name: f"wheel{i}.{name}")
-    for i in WHEELS:
-        connections += [{"from": f"ctrl.tau[{i}]", "to": f"wheel{i}.tau"},
-                        {"from": f"ctrl.tau[{i}]", "to": f"body.tau[{i}]"},
-                        {"from": f"ctrl.steer[{i}]", "to": f"body.steer[{i}]"}]
-    order = ["ctrl", "body", *[f"wheel{i}" for i in WHEELS]]
-    return {"simulation": {"stop_time": stop_time(scenario), "step": STEP, "algorithm": "gauss-seidel", "order": order,
-                           "allow_algebraic_loops": True},
-            "fmu": fmus, "block": [controller_block(model, scenario, "inverse")], "connection": connections}
+    builder = _path_run(f"path {scenario} (cosim)", scenario)
+    wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(WHEELS),
+                       choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": speed / _radius(choice)})
+    builder.add_block("ctrl", controller(models_of(model), scenario, "inverse"))
+    _connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
+    for i, wheel in zip(WHEELS, wheels):
+        builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
+        builder.connect(f"ctrl.steer[{i}]", f"body.steer[{i}]")
+    return builder.simulation(order=["ctrl", "body", *wheels]).build()
 
 
 def trajectories(data: pd.DataFrame, cosim: bool) -> pd.DataFrame:
@@ -172,13 +170,13 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     fmu_dir = Path(fmu_dir).resolve()
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     walls: dict[str, float] = {}
-    builds = {"inverse": lambda s: monolithic_system(fmu_dir, model, s, choice=choice),
-              "cosim": lambda s: cosim_system(fmu_dir, model, s, choice),
-              "kinematic": lambda s: monolithic_system(fmu_dir, model, s, "kinematic", choice)}
+    models = ModelSet.read(model)
+    builds = {"inverse": lambda s: monolithic_system(fmu_dir, models, s, choice=choice),
+              "cosim": lambda s: cosim_system(fmu_dir, models, s, choice),
+              "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice)}
     for scenario in scenarios:
         for label, build in builds.items():
-            system = system_from_dict(build(scenario), name=f"path {scenario} ({label})", base=fmu_dir)
-            outcome = run(system)
+            outcome = run(build(scenario))
             tables[scenario, label] = trajectories(outcome.data, cosim=label == "cosim")
             walls[f"{scenario}/{label}"] = outcome.wall_seconds
     rows = [{"scenario": s, "run": label, "target_speed_m_s": SCENARIOS[s], **metrics(tables[s, label], SCENARIOS[s])}

@@ -22,12 +22,15 @@ import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
+from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
+from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
-from rover_cosim.orchestrator.system import system_from_dict
+from rover_cosim.orchestrator.model import System
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
-from .soil import soil_parameters
+from .plants import add_plant_fmu, add_rover, wire_hub
 
 STOP_TIME = 20.0  # s
 STEP = 1e-3       # s
@@ -46,34 +49,43 @@ class SimulationResult:
     ablation: pd.DataFrame              # limb, rms_lut_N, rms_fixed_load_N
 
 
-def controller_block(model: Path, **options: Any) -> dict[str, Any]:
-    return {"name": "ctrl", "type": "python", "factory": "rover_cosim.control.controller:InverseModelController",
-            "model": str(model), "step": STEP, **options}
+def models_of(model: ModelSet | Path) -> ModelSet:
+    """The identified models: ``model`` itself, or the model.json it names (read once here)."""
+    return model if isinstance(model, ModelSet) else ModelSet.read(model)
 
 
-def monolithic_system(fmu_dir: Path, model: Path, choice: Choice | None = None, **options: Any) -> dict[str, Any]:
-    connections = [{"from": "rover.x", "to": "ctrl.x"}, {"from": "rover.v", "to": "ctrl.v"}]
+def controller(models: ModelSet, **options: Any) -> InverseModelController:
+    """The paper's controller block ``ctrl`` at the run's step (``options``: its keyword arguments)."""
+    return InverseModelController("ctrl", models, **{"step": STEP, **options})
+
+
+def _closed_loop(name: str) -> SystemBuilder:
+    return SystemBuilder(name).simulation(stop_time=STOP_TIME, step=STEP, algorithm="gauss-seidel")
+
+
+def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
+    """The closed loop on Rover.fmu (``options``: the controller's keyword arguments)."""
+    builder = _closed_loop("closed loop (monolithic)")
+    add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
+    builder.add_block("ctrl", controller(models_of(model), **options))
+    builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
     for i in LIMBS:
-        connections += [{"from": f"rover.Fz[{i}]", "to": f"ctrl.W[{i}]"},
-                        {"from": f"ctrl.tau[{i}]", "to": f"rover.tau[{i}]"}]
-    return {"simulation": {"stop_time": STOP_TIME, "step": STEP, "algorithm": "gauss-seidel"},
-            "fmu": [{"name": "rover", "path": str(fmu_dir / "Rover.fmu"),
-                     "parameters": soil_parameters(fmu_dir / "Rover.fmu", choice)}],
-            "block": [controller_block(model, **options)], "connection": connections}
+        builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
+    return builder.build()
 
 
-def cosim_system(fmu_dir: Path, model: Path, choice: Choice | None = None, **options: Any) -> dict[str, Any]:
-    fmus: list[dict[str, Any]] = [{"name": "body", "path": str(fmu_dir / "RoverBody.fmu")}]
-    connections = [{"from": "body.x", "to": "ctrl.x"}, {"from": "body.v", "to": "ctrl.v"}]
-    for i in LIMBS:
-        fmus.append({"name": f"wheel{i}", "path": str(fmu_dir / "Wheel.fmu"),
-                     "parameters": soil_parameters(fmu_dir / "Wheel.fmu", choice)})
-        connections += [
-            {"from": f"body.W[{i}]", "to": f"wheel{i}.W"}, {"from": f"body.v_hub[{i}]", "to": f"wheel{i}.v_hub"},
-            {"from": f"wheel{i}.Fx", "to": f"body.Fx[{i}]"}, {"from": f"body.W[{i}]", "to": f"ctrl.W[{i}]"},
-            {"from": f"ctrl.tau[{i}]", "to": f"wheel{i}.tau"}, {"from": f"ctrl.tau[{i}]", "to": f"body.tau[{i}]"}]
-    return {"simulation": {"stop_time": STOP_TIME, "step": STEP, "algorithm": "gauss-seidel"},
-            "fmu": fmus, "block": [controller_block(model, **options)], "connection": connections}
+def cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
+    """The closed loop on RoverBody + 6 Wheel (``options``: the controller's keyword arguments)."""
+    builder = _closed_loop("closed loop (cosim)")
+    wheels = add_rover(builder, Path(fmu_dir) / "RoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", WHEELS, choice,
+                       wire=False)
+    builder.add_block("ctrl", controller(models_of(model), **options))
+    builder.connect("body.x", "ctrl.x").connect("body.v", "ctrl.v")
+    for i, wheel in zip(LIMBS, wheels):
+        wire_hub(builder, "body", wheel, i)
+        builder.connect(f"body.W[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"{wheel}.tau")
+        builder.connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
+    return builder.build()
 
 
 def trajectories(data: pd.DataFrame, plant: str) -> pd.DataFrame:
@@ -119,15 +131,14 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
     tables: dict[str, pd.DataFrame] = {}
     walls: dict[str, float] = {}
     fmu_dir = Path(fmu_dir).resolve()
+    models = ModelSet.read(model)
     for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
-        system = system_from_dict(build(fmu_dir, model, choice), name=f"closed loop ({plant})", base=fmu_dir)
-        outcome = run(system)
+        outcome = run(build(fmu_dir, models, choice))
         tables[plant] = trajectories(outcome.data, plant)
         walls[plant] = outcome.wall_seconds
         results[plant] = checks(tables[plant])
-    ablation_system = system_from_dict(monolithic_system(fmu_dir, model, choice, fixed_load=STATIC_LOAD),
-                                       name="closed loop, fixed-load model", base=fmu_dir)
-    ablation = rms(trajectories(run(ablation_system).data, "monolithic"))
+    ablation = rms(trajectories(run(monolithic_system(fmu_dir, models, choice, fixed_load=STATIC_LOAD)).data,
+                                "monolithic"))
     rms_mono, rms_cosim = rms(tables["monolithic"]), rms(tables["cosim"])
     ablation_table = pd.DataFrame({"limb": list(LIMBS), "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})

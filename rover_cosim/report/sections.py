@@ -15,6 +15,7 @@ from typing import Any
 import pandas as pd
 
 from rover_cosim.common.paper import TABLE_3_RMS as PAPER_RMS
+from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.terramechanics import Soil, Wheel
 
 from .page import image, missing, provenance, table
@@ -81,9 +82,9 @@ def identification_section(identification: Path) -> list[str]:
     sections.append(table(shown, {"load [N]": "{:.0f}"}, default="{:.1f}"))
     model_file = identification / "model.json"
     if model_file.exists():
-        model = json.loads(model_file.read_text())
-        recommended = model["recommended"]
-        coefficients = model["models"][recommended]["fx_coefficients_N"]
+        identified = ModelSet.read(model_file)
+        recommended = identified.recommended
+        coefficients = identified.model().fx_coefficients.tolist()
         rows = [{"term": f"slip^{k}", "p0 [N]": c[0], "p1 [-]": c[1], "p2 [1/N]": c[2]}
                 for k, c in enumerate(coefficients)]
         sections += [f"<p>The recommended ({recommended}) model, Fx = Σ c<sub>k</sub>(W) slip<sup>k</sup> with "

@@ -32,7 +32,8 @@ import pandas as pd
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 from rover_cosim.common.parallel import parallel_map
 from rover_cosim.identification.cache import discard, remove_partial_files
-from rover_cosim.terramechanics.library import choose, describe
+from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.terramechanics.library import Choice, choose, describe
 
 from .. import path_following
 from . import figures
@@ -61,16 +62,16 @@ def _stop_time(study: Study, scenario: str) -> float:
     return study.path_stop_time or path_following.stop_time("lane_change")
 
 
-def _specs(study: Study, samples: pd.DataFrame, fmu_dir: Path, model: Path, cache: Path,
+def _specs(study: Study, samples: pd.DataFrame, fmu_dir: Path, models: ModelSet, nominal: Choice, cache: Path,
            shared: dict[str, Any]) -> list[RunSpec]:
     specs = []
     for row in samples.to_dict("records"):
-        assignments, parameters = split({n: row[n] for n in study.names}, bool(row["nominal"]))
+        changes, parameters = split({n: row[n] for n in study.names}, bool(row["nominal"]))
         for scenario in study.scenarios:
             stop = _stop_time(study, scenario)
-            key = cache_key(shared, scenario, stop, assignments, parameters)
-            specs.append(RunSpec(int(row["sample"]), scenario, str(fmu_dir), str(model), stop, study.soil,
-                                 study.wheel, assignments, parameters, str(cache / f"{key[:24]}.csv")))
+            key = cache_key(shared, scenario, stop, changes, parameters)
+            specs.append(RunSpec(int(row["sample"]), scenario, str(fmu_dir), models, stop, nominal, changes,
+                                 parameters, str(cache / f"{key[:24]}.csv")))
     return specs
 
 
@@ -234,7 +235,7 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     cache = Path(cache_dir) if cache_dir is not None else out / "cache"
     cache.mkdir(parents=True, exist_ok=True)
     remove_partial_files(cache)
-    specs = _specs(study, samples, fmu_dir, model, cache, hashes)
+    specs = _specs(study, samples, fmu_dir, ModelSet.read(model), nominal_choice, cache, hashes)
     results, rejected = _cached(specs)
     missing = [s for s in specs if (s.sample, s.scenario) not in results]
     compute_started = time.perf_counter()

@@ -3,11 +3,11 @@ with the controller and the identified model unchanged, cached as a one-row CSV 
 
 The plant is the one ``make simulate`` runs, built by the same functions (simulate.
 monolithic_system: Rover.fmu, 1 ms, Gauss-Seidel; path_following.monolithic_system: the lane
-change on SteerableRover.fmu); the sample changes only the FMUs' parameters: soil and wheel
-values through the soil library exactly as ``--set soil.c=500`` does (so a sample the soil model
-refuses, e.g. a negative cohesion, fails with the library's message), other names (``rover.M``)
-as FMU parameters. Sample 0 changes nothing: it is the nominal run, the same system as
-``make simulate``'s.
+change on SteerableRover.fmu); the sample changes only the FMUs' parameters: its soil and wheel
+values make the sample's Soil and Wheel from the nominal ones (``library.vary``, exactly as
+``--set soil.c=500`` does, so a sample the soil model refuses, e.g. a negative cohesion, fails
+with the library's message), other names (``rover.M``) are FMU parameters. Sample 0 changes
+nothing: it is the nominal run, the same system as ``make simulate``'s.
 
 The cache file of a run is named by a key: SHA-256 of the FMU's and the model's SHA-256, the
 scenario and its stop time and step, the nominal soil and wheel, the sample's values and the
@@ -28,9 +28,11 @@ import fmpy
 import pandas as pd
 
 from rover_cosim.identification.cache import read_run, write_run
+from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
-from rover_cosim.orchestrator.system import system_from_dict
-from rover_cosim.terramechanics.library import DEGREES, Choice, choose
+from rover_cosim.orchestrator.model import System
+from rover_cosim.terramechanics.library import DEGREES, Choice, vary
 
 from .. import path_following, simulate
 from .metrics import PATH, STRAIGHT, path_metrics, straight_metrics
@@ -45,20 +47,31 @@ FMUS = {"straight": "Rover.fmu", "path": "SteerableRover.fmu"}
 COLUMNS = {"straight": [*STRAIGHT, "wall_s"], "path": [*PATH, "wall_s"]}
 
 
+#: (name, value) pairs of a sample.
+Values = tuple[tuple[str, float], ...]
+
+
 @dataclass(frozen=True)
 class RunSpec:
-    """Everything a worker needs for one run (plain values: it travels to other processes)."""
+    """Everything a worker needs for one run (it travels to other processes)."""
 
     sample: int
     scenario: str                               # "straight" or "path"
     fmu_dir: str
-    model: str
+    model: ModelSet                             # the identified models, read once by the study
     stop_time: float                            # s
-    soil: str                                   # the nominal soil and wheel (library names or files)
-    wheel: str
-    assignments: tuple[str, ...]                # the sample's soil and wheel values as --set takes them
-    parameters: tuple[tuple[str, float], ...]   # the sample's other FMU parameters (rover.M ...)
+    nominal: Choice                             # the soil and wheel the model was identified on
+    changes: Values                             # the sample's soil.X and wheel.X values (SI, X_deg in degrees)
+    parameters: Values                          # the sample's other FMU parameters (rover.M ...)
     target: str                                 # the cache file
+
+    def choice(self) -> Choice:
+        """The sample's soil and wheel (ValueError: one the soil model refuses)."""
+        kinds: dict[str, dict[str, float]] = {"soil": {}, "wheel": {}}
+        for name, value in self.changes:
+            kind, _, key = name.partition(".")
+            kinds[kind][key] = value
+        return vary(self.nominal, kinds["soil"], kinds["wheel"])
 
 
 def library_value(name: str, choice: Choice) -> float | None:
@@ -93,22 +106,21 @@ def nominal_values(study: Study, choice: Choice, fmu_dir: Path) -> dict[str, flo
     return values
 
 
-def split(values: dict[str, float], nominal: bool) -> tuple[tuple[str, ...], tuple[tuple[str, float], ...]]:
-    """A sample's values as (--set assignments, other FMU parameters); the nominal sample has none."""
+def split(values: dict[str, float], nominal: bool) -> tuple[Values, Values]:
+    """A sample's values as (soil and wheel changes, other FMU parameters); the nominal sample has none."""
     if nominal:
         return (), ()
-    assignments = tuple(f"{name}={float(value)!r}" for name, value in values.items()
-                        if name.split(".")[0] in ("soil", "wheel"))
+    changes = tuple((name, float(value)) for name, value in values.items() if name.split(".")[0] in ("soil", "wheel"))
     parameters = tuple((name, float(value)) for name, value in values.items()
                        if name.split(".")[0] not in ("soil", "wheel"))
-    return assignments, parameters
+    return changes, parameters
 
 
 def cache_key(fingerprint: dict[str, Any], scenario: str, stop_time: float,
-              assignments: tuple[str, ...], parameters: tuple[tuple[str, float], ...]) -> str:
+              changes: Values, parameters: Values) -> str:
     """The run's cache key (hex): ``fingerprint`` holds the FMUs', the model's and the nominal soil's."""
     content = {"fingerprint": fingerprint, "scenario": scenario, "fmu": fingerprint["fmus"][FMUS[scenario]],
-               "stop_time": stop_time, "step": simulate.STEP, "set": list(assignments),
+               "stop_time": stop_time, "step": simulate.STEP, "changes": [list(c) for c in changes],
                "parameters": [list(p) for p in parameters], "metrics_version": METRICS_VERSION}
     return hashlib.sha256(json.dumps(content, sort_keys=True, default=str).encode()).hexdigest()
 
@@ -118,23 +130,21 @@ def fingerprint(fmu_hashes: dict[str, str], model_hash: str, nominal: Choice) ->
     return {"fmus": fmu_hashes, "model": model_hash, "soil": asdict(nominal.soil), "wheel": asdict(nominal.wheel)}
 
 
-def _system(spec: RunSpec, choice: Choice) -> dict[str, Any]:
-    fmu_dir, model = Path(spec.fmu_dir), Path(spec.model)
+def plant(spec: RunSpec) -> System:
+    """The run's system: the scenario's plant and controller on the sample's soil, wheel and parameters."""
+    choice, fmu_dir = spec.choice(), Path(spec.fmu_dir)
     if spec.scenario == "straight":
-        system = simulate.monolithic_system(fmu_dir, model, choice)
+        system = simulate.monolithic_system(fmu_dir, spec.model, choice)
     else:
-        system = path_following.monolithic_system(fmu_dir, model, PATH_SCENARIO, "inverse", choice)
-    system["simulation"]["stop_time"] = spec.stop_time
-    system["fmu"][0]["parameters"].update(dict(spec.parameters))
-    return system
+        system = path_following.monolithic_system(fmu_dir, spec.model, PATH_SCENARIO, "inverse", choice)
+    builder = SystemBuilder.from_system(system, f"Monte Carlo sample {spec.sample} ({spec.scenario})")
+    builder.simulation(stop_time=spec.stop_time).set_parameters("rover", dict(spec.parameters))
+    return builder.build()
 
 
 def simulate_run(spec: RunSpec) -> dict[str, float | bool]:
     """The run's metrics (raises on a sample the soil library or the FMU refuses)."""
-    choice = choose(spec.soil, spec.wheel, spec.assignments)
-    system = system_from_dict(_system(spec, choice), name=f"Monte Carlo sample {spec.sample} ({spec.scenario})",
-                              base=Path(spec.fmu_dir))
-    outcome = run(system)
+    outcome = run(plant(spec))
     if spec.scenario == "straight":
         row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"))
     else:

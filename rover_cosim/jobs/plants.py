@@ -1,0 +1,61 @@
+"""The plants the jobs run, built in code through the engine's SystemBuilder from domain objects
+(the soil and wheel of a ``Choice``, the identified ``ModelSet``): the rover's hub wiring is
+written here once, for any number of wheels, with or without the lateral interface.
+
+A body FMU (RoverBody, SteerableRoverBody) and its wheel FMUs (Wheel) meet at each hub ``i``:
+the body gives wheel ``i`` its load ``W[i]`` and hub speed ``v_hub[i]`` (and, steerable, the
+lateral hub speed ``v_lat[i]``); the wheel gives the body its drawbar pull ``Fx`` (and lateral
+force ``Fy``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+from rover_cosim.orchestrator.builder import SystemBuilder
+from rover_cosim.terramechanics.library import Choice, fmu_parameters
+
+
+def soil_values(choice: Choice | None) -> dict[str, float]:
+    """The FMU parameters of the chosen soil and wheel (none without a choice: the FMUs' defaults)."""
+    return fmu_parameters(choice.soil, choice.wheel) if choice is not None else {}
+
+
+def add_plant_fmu(builder: SystemBuilder, name: str, path: str | Path, choice: Choice | None,
+                  start: Mapping[str, float] | None = None) -> None:
+    """An FMU given those of the soil and wheel parameters it has (none for a body)."""
+    builder.add_fmu(name, path, start=start)
+    builder.set_parameters(name, soil_values(choice), only_known=True)
+
+
+def wire_hub(builder: SystemBuilder, body: str, wheel: str, i: int, *, lateral: bool = False) -> None:
+    """The hub ``i`` between ``body`` and ``wheel`` (see the module docstring)."""
+    builder.connect(f"{body}.W[{i}]", f"{wheel}.W")
+    builder.connect(f"{body}.v_hub[{i}]", f"{wheel}.v_hub")
+    if lateral:
+        builder.connect(f"{body}.v_lat[{i}]", f"{wheel}.v_lat")
+    builder.connect(f"{wheel}.Fx", f"{body}.Fx[{i}]")
+    if lateral:
+        builder.connect(f"{wheel}.Fy", f"{body}.Fy[{i}]")
+
+
+def wire_hubs(builder: SystemBuilder, body: str, wheels: list[str], *, lateral: bool = False) -> None:
+    """Every hub: wheel ``wheels[i - 1]`` on the body's hub ``i``."""
+    for i, wheel in enumerate(wheels, start=1):
+        wire_hub(builder, body, wheel, i, lateral=lateral)
+
+
+def add_rover(builder: SystemBuilder, body_fmu: str | Path, wheel_fmu: str | Path, wheels: int,
+              choice: Choice | None, *,
+              body: str = "body", lateral: bool = False, body_start: Mapping[str, float] | None = None,
+              wheel_start: Mapping[str, float] | None = None, wire: bool = True) -> list[str]:
+    """A body and ``wheels`` wheel instances (``wheel1`` ...) on the chosen soil, their hubs wired
+    unless ``wire`` is False (to wire them in another order); returns the wheels' names."""
+    add_plant_fmu(builder, body, body_fmu, None, body_start)
+    names = [f"wheel{i}" for i in range(1, wheels + 1)]
+    for name in names:
+        add_plant_fmu(builder, name, wheel_fmu, choice, wheel_start)
+    if wire:
+        wire_hubs(builder, body, names, lateral=lateral)
+    return names
