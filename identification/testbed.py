@@ -21,7 +21,7 @@ import fmpy
 import numpy as np
 import pandas as pd
 
-from rover_cosim.orchestrator.model import FmuEntry
+from rover_cosim.orchestrator.model import FmuEntry, Value
 from rover_cosim.orchestrator.participants import FmuParticipant
 
 #: What every run records besides time and torque (SingleWheel outputs, SI units).
@@ -83,7 +83,8 @@ class WheelTestBed:
         unknown = sorted(set(parameters) - self.names)
         if unknown:
             raise ValueError(f"{self.path}: no parameters {unknown}")
-        start = {"W": load, "tau": tau, "solver.tolerance": tolerance, "slipAngle": slip_angle, "trackAngle": turn}
+        start: dict[str, Value] = {"W": load, "tau": tau, "solver.tolerance": tolerance, "slipAngle": slip_angle,
+                                   "trackAngle": turn}
         if start_speed:
             radius = float(parameters.get("wheel.r", self.radius))
             start.update(v=start_speed, omega=start_speed * math.cos(slip_angle + turn) / radius)

@@ -37,7 +37,19 @@ from rover_cosim.common.units import base_units
 
 from .blocks import BLOCK_TYPES, Block
 from .loops import describe, find_loop
-from .model import ALGORITHMS, BlockEntry, Connection, FmuEntry, Iteration, Port, System, SystemFileError
+from .model import (
+    ALGORITHMS,
+    BlockEntry,
+    Connection,
+    FmuEntry,
+    Iteration,
+    Port,
+    System,
+    SystemFileError,
+    Value,
+    compatible_types,
+    typed_value,
+)
 
 #: Instance names: identifiers, so that a name is never a path or a port separator.
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -78,13 +90,18 @@ def read_fmu(fmu_path: Path, where: str) -> Any:
     return description
 
 
-def optional_inputs(fmu_path: Path) -> set[str]:
-    """Inputs an FMU built by rover-cosim declares optional (``optional_inputs`` of its
-    documentation/build.json): they keep their start value when left unconnected. Other FMUs: none."""
+def optional_inputs(fmu_path: Path, description: Any = None) -> set[str]:
+    """Inputs that keep their start value when left unconnected: for an FMU built by rover-cosim
+    those its build record (documentation/build.json) declares optional (its other inputs are
+    couplings a system must make); for any other FMU every input whose model description declares
+    a start value (FMI 2.0 gives every input one), as FMPy and libcosim treat them."""
     try:
         with zipfile.ZipFile(fmu_path) as archive:
             return set(json.loads(archive.read("documentation/build.json")).get("optional_inputs", []))
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+    except KeyError:  # not built by rover-cosim
+        variables = description.modelVariables if description is not None else []
+        return {v.name for v in variables if v.causality == "input" and v.start is not None}
+    except (OSError, ValueError, zipfile.BadZipFile):
         return set()
 
 
@@ -243,7 +260,7 @@ class SystemBuilder:
         self.set_start(name, start or {}, where=where)
         return self
 
-    def _values(self, instance: str, key: str, values: Mapping[str, Any], where: str | None) -> dict[str, float]:
+    def _values(self, instance: str, key: str, values: Mapping[str, Any], where: str | None) -> dict[str, Value]:
         if instance not in self._fmus:
             raise self.error(where or f"set_{key}({instance!r})", f"no FMU {instance!r}; expected one of "
                              f"{', '.join(self._fmus) or '(none yet)'}")
@@ -252,7 +269,7 @@ class SystemBuilder:
         if not isinstance(values, Mapping):
             raise self.error(f"{where} {key}", "expected a table, e.g. { \"name\" = 1.0 }")
         variables = fmu.variables()
-        checked: dict[str, float] = {}
+        checked: dict[str, Value] = {}
         for variable, value in values.items():
             if variable not in variables:
                 raise self.error(f"{where} {key}", f"{fmu.name} has no variable {variable!r}")
@@ -263,7 +280,13 @@ class SystemBuilder:
             if key == "start" and not (v.causality == "input" or v.initial in ("exact", "approx")):
                 raise self.error(f"{where} start", f"{fmu.name}.{variable} cannot be given a start value "
                                  f"(causality {v.causality}, initial {v.initial})")
-            checked[variable] = self._number(value, f"{where} {key} {variable}")
+            if v.variability == "constant":
+                raise self.error(f"{where} {key}", f"{fmu.name}.{variable} is a constant (variability constant): "
+                                 "it cannot be given a value")
+            try:
+                checked[variable] = typed_value(value, v.type)
+            except ValueError as problem:
+                raise self.error(f"{where} {key} {variable}", str(problem)) from None
         return checked
 
     def set_parameters(self, instance: str, values: Mapping[str, Any], *, where: str | None = None,
@@ -322,7 +345,7 @@ class SystemBuilder:
             if port.variable not in variables:
                 raise self.error(where, f"{fmu.name} ({fmu.path.name}) has no variable {port.variable!r}")
             v = variables[port.variable]
-            return v.causality, v.unit
+            return v.causality, v.unit if v.type == "Real" else None
         if port.instance not in self._blocks:
             names = sorted([*self._fmus, *self._blocks])
             raise self.error(where, f"no instance {port.instance!r}; expected one of {', '.join(names)}")
@@ -333,6 +356,12 @@ class SystemBuilder:
             return "output", block.units.get(port.variable)
         raise self.error(where, f"block {port.instance} has no variable {port.variable!r} "
                          f"(inputs {list(block.inputs)}, outputs {list(block.outputs)})")
+
+    def _type(self, port: Port) -> str:
+        """The FMI type of ``port`` (a block's ports are Real)."""
+        if port.instance in self._fmus:
+            return self._fmus[port.instance].variable_type(port.variable)
+        return "Real"
 
     def connect(self, source: str | Port, target: str | Port, *, where: str | None = None,
                 label: str | None = None) -> SystemBuilder:
@@ -351,6 +380,13 @@ class SystemBuilder:
         if target_causality != "input":
             raise self.error(where, f"{target_port} is not an input (causality {target_causality}); "
                              "a connection goes from an output to an input")
+        source_type, target_type = self._type(source_port), self._type(target_port)
+        if not compatible_types(source_type, target_type):
+            raise self.error(where, f"type mismatch: {source_port} is {source_type}, {target_port} is {target_type} "
+                             "(a connection joins variables of the same type; Integer and Enumeration may meet)")
+        if "String" in (source_type, target_type):
+            raise self.error(where, f"{source_port} -> {target_port}: String connections are not supported yet "
+                             "(String parameters and start values are)")
         if source_unit is not None and target_unit is not None and base_units(source_unit) != base_units(target_unit):
             raise self.error(where, f"unit mismatch: {source_port} is in {source_unit}, {target_port} in {target_unit}")
         if target_port in self._driven:
@@ -367,6 +403,9 @@ class SystemBuilder:
         for text in ports:
             port = parse_port(text, f"{self.name}: {where}")
             self._lookup(port, f"{where} {str(text)!r}")
+            if self._type(port) == "String":
+                raise self.error(f"{where} {str(text)!r}", f"{port} is a String: String variables cannot be recorded "
+                                 "yet (numbers of every other type can)")
             recorded.append(port)
         self._record = recorded
         return self
@@ -376,7 +415,7 @@ class SystemBuilder:
         """Every FMU input connected or given a start value (unless the FMU's build record marks it
         optional: an input its Modelica source gives a default); every block input connected."""
         for fmu in self._fmus.values():
-            optional = optional_inputs(fmu.path)
+            optional = optional_inputs(fmu.path, fmu.description)
             for v in fmu.description.modelVariables:
                 if (v.causality == "input" and Port(fmu.name, v.name) not in self._driven and v.name not in fmu.start
                         and v.name not in optional):
@@ -399,9 +438,10 @@ class SystemBuilder:
         return [str(name) for name in order]
 
     def _outputs(self, instance: str) -> list[Port]:
+        """What is recorded by default: every output (of every type but String, which cannot be yet)."""
         if instance in self._fmus:
             return [Port(instance, v.name) for v in self._fmus[instance].description.modelVariables
-                    if v.causality == "output"]
+                    if v.causality == "output" and v.type != "String"]
         return [Port(instance, o) for o in self._blocks[instance].block.outputs]
 
     def _loop(self) -> list[Port] | None:

@@ -13,7 +13,7 @@ from .algorithms import Algorithm, algorithm_of
 from .executors import NativeExecutor, PythonExecutor, ThreadExecutor
 from .model import System
 from .observers import check_finite
-from .participants import BlockParticipant, Participant, RunError
+from .participants import BlockParticipant, FmuParticipant, Participant, RunError
 from .wiring import Wiring
 
 
@@ -44,9 +44,12 @@ class Execution:
         algorithm.prepare(self)
 
     def _steppable(self, i: int) -> bool:
-        """Whether participant ``i`` can be stepped natively: an FMU, or a block that has a C twin."""
+        """Whether participant ``i`` can be stepped natively: an FMU whose exchanged variables are
+        all Real, or a block that has a C twin."""
         participant = self.participants[i]
-        return not isinstance(participant, BlockParticipant) or participant.make_native()
+        if isinstance(participant, FmuParticipant):
+            return participant.real_only  # the stepper calls fmi2SetReal and fmi2GetReal only
+        return isinstance(participant, BlockParticipant) and participant.make_native()
 
     def _native(self, threads: int) -> NativeExecutor | None:
         """The native executor of the stages whose participants can all be stepped natively

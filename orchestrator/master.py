@@ -28,7 +28,7 @@ from .observers import (
     check_finite,
     watches_every_step,
 )
-from .participants import BlockParticipant, FmuParticipant, Participant, RunError
+from .participants import BlockParticipant, FmuParticipant, Participant, RunError, Terminated
 from .recorder import Recorder, RunResult, communication_points
 from .unpacking import UNZIP_PREFIX, remove_stale_folders, run_folder
 from .wiring import Wiring, wire
@@ -111,6 +111,13 @@ def _observed_ports(system: System, observers: Sequence[Observer]) -> list[Port]
     return ports
 
 
+def _types(system: System, ports: Sequence[Port]) -> list[str]:
+    """The FMI type of each port (a block's ports are Real)."""
+    entries = system.participants()
+    return [entry.variable_type(port.variable) if isinstance(entry := entries[port.instance], FmuEntry) else "Real"
+            for port in ports]
+
+
 def run(system: System, *, progress: Callable[[float], None] | None = None,
         observers: Sequence[Observer] = ()) -> RunResult:
     """Run ``system``; raises :class:`RunError` naming the participant, call and time on failure,
@@ -126,7 +133,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
         initialize(participants, wiring, values, system.start_time, system.stop_time)
         execution = make_execution(system, participants, wiring)
         stack.callback(execution.close)
-        recorder = Recorder(system.record, wiring.record_slots, times)
+        recorder = Recorder(system.record, wiring.record_slots, times, _types(system, system.record))
         watchers: list[Watcher] = [FiniteCheck(execution, execution.checked_in_python), Recording(recorder)]
         offset = 0
         for observer in observers:
@@ -144,6 +151,8 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
                 steps = _run_stretches(execution, values, times, recorder, watchers)
             else:
                 steps, stopped = _run_steps(execution, values, times, watchers)
+        except Terminated as end:  # an FMU ended the simulation: a clean end at the start of that step
+            steps, stopped = recorder.filled - 1, str(end)
         except RunError as error:
             error.partial = recorder.frame()
             for observer in observers:
@@ -186,7 +195,12 @@ def _run_stretches(execution: Execution, values: np.ndarray, times: np.ndarray, 
     record = np.ascontiguousarray(recorder.slots, dtype=np.int64)
     for first in range(0, n_steps, NATIVE_STRETCH):
         last = min(first + NATIVE_STRETCH, n_steps)
-        reached, failed = execution.run_stretch(values, times, first, last, record, recorder.rows)
+        try:
+            reached, failed = execution.run_stretch(values, times, first, last, record, recorder.rows)
+        except RunError:
+            assert execution.native is not None
+            recorder.filled = execution.native.reached + 1  # the rows before the failed step
+            raise
         recorder.filled = reached + 1
         execution.check_native(failed, values, float(times[reached + 1]) if failed >= 0 else 0.0)
         for watcher in watchers:

@@ -18,6 +18,67 @@ from typing import Any
 from .blocks import Block
 
 ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
+#: The FMI 2.0 variable types, and the Python type of a value of each.
+VARIABLE_TYPES = {"Real": float, "Integer": int, "Enumeration": int, "Boolean": bool, "String": str}
+#: A parameter or start value, typed as its variable (Real: float, Integer and Enumeration: int,
+#: Boolean: bool, String: str).
+Value = float | int | bool | str
+
+
+def _whole(value: object, variable_type: str) -> int:
+    if isinstance(value, float) and value.is_integer():
+        value = int(value)
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"{value!r}: expected a whole number ({variable_type})")
+    if not -2**31 <= value < 2**31:
+        raise ValueError(f"{value!r}: expected a whole number within the 32-bit range of an FMI {variable_type}")
+    return value
+
+
+def typed_value(value: object, variable_type: str) -> Value:
+    """``value`` as a value of an FMI variable of ``variable_type``; ValueError saying what was
+    expected (a number for Real, a whole number for Integer and Enumeration, true or false for
+    Boolean, text for String)."""
+    if variable_type in ("Integer", "Enumeration"):
+        return _whole(value, variable_type)
+    expected = {"Real": (float, "a number"), "Boolean": (bool, "true or false"), "String": (str, "text")}
+    if variable_type not in expected:
+        raise ValueError(f"a variable of type {variable_type!r}: expected one of {', '.join(VARIABLE_TYPES)}")
+    kind, text = expected[variable_type]
+    if kind is float and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    if not isinstance(value, kind) or (kind is float and isinstance(value, bool)):
+        raise ValueError(f"{value!r}: expected {text} ({variable_type})")
+    return value  # type: ignore[return-value]
+
+
+def numeric(value: Value) -> float:
+    """A value of a Real, Integer, Enumeration or Boolean variable as it is held in the value
+    vector of a run (a float: whole numbers up to 2^53 and true/false as 1.0/0.0 exactly)."""
+    if isinstance(value, str):
+        raise ValueError(f"{value!r}: a String has no place in the value vector")
+    return float(value)
+
+
+def declared_start(variable: Any) -> Value | None:
+    """The start value a model description declares for ``variable`` (FMPy keeps it as text),
+    typed as the variable; None where it declares none."""
+    text = variable.start
+    if text is None:
+        return None
+    if variable.type == "Real":
+        return float(text)
+    if variable.type in ("Integer", "Enumeration"):
+        return int(text)
+    if variable.type == "Boolean":
+        return str(text).strip().lower() in ("true", "1")
+    return str(text)
+
+
+def compatible_types(source: str, target: str) -> bool:
+    """Whether an output of type ``source`` may drive an input of type ``target`` (the same type;
+    Integer and Enumeration either way, as FMI allows)."""
+    return source == target or {source, target} == {"Integer", "Enumeration"}
 
 
 class SystemFileError(ValueError):
@@ -57,16 +118,20 @@ class Iteration:
 @dataclass
 class FmuEntry:
     """An FMU component: its instance name, file, parameter and start values (by variable name,
-    in the variables' units) and its model description (FMPy's)."""
+    in the variables' units, typed as the variables: ``Value``) and its model description (FMPy's)."""
 
     name: str
     path: Path
-    parameters: dict[str, float]
-    start: dict[str, float]
+    parameters: dict[str, Value]
+    start: dict[str, Value]
     description: Any  # fmpy ModelDescription
 
     def variables(self) -> dict[str, Any]:
         return {v.name: v for v in self.description.modelVariables}
+
+    def variable_type(self, name: str) -> str:
+        """The FMI type of the variable ``name`` (Real, Integer, Enumeration, Boolean, String)."""
+        return str(self.variables()[name].type)
 
 
 @dataclass

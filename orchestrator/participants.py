@@ -17,6 +17,7 @@ from __future__ import annotations
 import copy
 import ctypes
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
@@ -27,10 +28,11 @@ from fmpy.fmi2 import (
     defaultCallbacks,
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
+    fmi2Terminated,
 )
 
 from .blocks import Block
-from .model import FmuEntry
+from .model import FmuEntry, Value
 from .native import NativeBlock, NativeCalls, function_address
 
 T = TypeVar("T")
@@ -41,6 +43,15 @@ class RunError(RuntimeError):
     ``partial``: the rows recorded before the failure (a DataFrame), when the run got that far."""
 
     partial: Any = None
+
+
+class Terminated(RunError):
+    """An FMU ended the simulation (fmi2DoStep returned fmi2Discard with fmi2Terminated true):
+    the run stops at the start of that step, cleanly, with every row recorded before it."""
+
+    def __init__(self, message: str, t: float):
+        super().__init__(message)
+        self.t = t
 
 
 class Participant(Protocol):
@@ -105,7 +116,7 @@ class BlockParticipant:
         assert self.native is not None
         return self.native.calls(len(self.inputs), len(self.outputs))
 
-    def fail(self, what: str, t: float | None, error: str) -> None:
+    def fail(self, what: str, t: float | None, error: str, status: int | None = None) -> None:
         """Raise the RunError of a failed native step, with the C twin's message."""
         detail = (self.native.message() if self.native is not None else "") or error
         at = f" at t = {t:.6g} s" if t is not None else ""
@@ -185,6 +196,7 @@ class FmuParticipant:
         fmpy.extract(str(entry.path), str(folder))
         md = entry.description
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
+        self.types = {v.name: str(v.type) for v in md.modelVariables}
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=str(folder),
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=entry.name)
         self._callbacks = fmi2CallbackFunctions()
@@ -206,18 +218,39 @@ class FmuParticipant:
         try:
             return action()
         except Exception as error:  # noqa: BLE001 - FMPy raises plain Exceptions on fmi2Error
-            self.fail(what, t, str(error))
+            self.fail(what, t, str(error), getattr(error, "status", None))
             raise  # not reached
 
-    def fail(self, what: str, t: float | None, error: str) -> None:
-        """Raise the RunError of the failed call ``what``, with what the FMU logged (else ``error``)."""
+    def fail(self, what: str, t: float | None, error: str, status: int | None = None) -> None:
+        """Raise the RunError of the failed call ``what``, with what the FMU logged (else
+        ``error``); :class:`Terminated` when a step was discarded because the FMU ended the
+        simulation (fmi2Terminated)."""
+        if what == "fmi2DoStep" and status == DISCARD and self._terminated():
+            at = f" at t = {t:.6g} s" if t is not None else ""
+            said = f" ({'; '.join(self.messages[-1:])})" if self.messages else ""
+            raise Terminated(f"{self.name} ({self.entry.path.name}) ended the simulation{at}{said}", t or 0.0)
         detail = "; ".join(self.messages[-3:]) or error
         at = f" at t = {t:.6g} s" if t is not None else ""
         raise RunError(f"{self.name} ({self.entry.path.name}): {what}{at} failed: {detail}") from None
 
+    def _terminated(self) -> bool:
+        """fmi2GetBooleanStatus(fmi2Terminated), False where the FMU cannot say."""
+        try:
+            return bool(self.fmu.getBooleanStatus(fmi2Terminated))
+        except Exception:  # noqa: BLE001 - an FMU without the status: an ordinary discard
+            return False
+
+    @property
+    def real_only(self) -> bool:
+        """Whether every input set and variable read is a Real (one fmi2SetReal and one
+        fmi2GetReal per step; the native stepper can step it)."""
+        return self._inputs.real_only and self._reads.real_only
+
     def configure(self, inputs: list[str], reads: list[str]) -> None:
         """Fix the inputs set and the variables read at every step (preallocated arrays)."""
         self.inputs, self.outputs = list(inputs), list(reads)
+        self._inputs = _Typed(self.inputs, self.types, self.refs)
+        self._reads = _Typed(self.outputs, self.types, self.refs)
         self._in_refs = (ctypes.c_uint * max(1, len(inputs)))(*[self.refs[n] for n in inputs])
         self._read_refs = (ctypes.c_uint * max(1, len(reads)))(*[self.refs[n] for n in reads])
         self.input_values = np.zeros(len(inputs))
@@ -245,9 +278,15 @@ class FmuParticipant:
         """Value references of the variables read, in the order of configure."""
         return list(self._read_refs)[:len(self.outputs)]
 
-    def set_values(self, names: dict[str, float]) -> None:
-        if names:
-            self._call("fmi2SetReal", lambda: self.fmu.setReal([self.refs[n] for n in names], list(names.values())))
+    def set_values(self, names: dict[str, Value]) -> None:
+        """Set variables by name, one call per FMI type (fmi2SetReal, fmi2SetInteger, ...)."""
+        by_type: dict[str, dict[str, Value]] = {}
+        for name, value in names.items():
+            kind = "Integer" if self.types[name] == "Enumeration" else self.types[name]
+            by_type.setdefault(kind, {})[name] = value
+        for kind, values in by_type.items():
+            self._call(f"fmi2Set{kind}", partial(getattr(self.fmu, f"set{kind}"), [self.refs[n] for n in values],
+                                                 list(values.values())))
 
     def enter_initialization(self, t0: float, stop_time: float) -> None:
         """fmi2SetupExperiment, the parameters and start values, fmi2EnterInitializationMode."""
@@ -266,25 +305,32 @@ class FmuParticipant:
         return self.get_outputs(t0)
 
     def set_inputs(self, values: np.ndarray, t: float) -> None:
-        """Set all connected inputs in one call (values in the order given to configure)."""
+        """Set all connected inputs (values in the order given to configure): one fmi2SetReal
+        for Real inputs, one call per other type present."""
         if not self.inputs:
             return
         self.input_values[:] = values
-        self._call("fmi2SetReal", lambda: self.fmu.fmi2SetReal(self.fmu.component, self._in_refs, len(self.inputs),
-                                                               self._in_pointer), t)
+        if self._inputs.real_only:
+            self._call("fmi2SetReal", lambda: self.fmu.fmi2SetReal(self.fmu.component, self._in_refs,
+                                                                   len(self.inputs), self._in_pointer), t)
+        else:
+            self._inputs.set(self, self.input_values, t)
 
     def get_outputs(self, t: float) -> np.ndarray:
-        """All read variables in one call; the returned array is reused by the next call."""
-        if self.outputs:
+        """All read variables (one fmi2GetReal for Real ones, one call per other type present);
+        the returned array is reused by the next call."""
+        if self.outputs and self._reads.real_only:
             self._call("fmi2GetReal", lambda: self.fmu.fmi2GetReal(self.fmu.component, self._read_refs,
                                                                    len(self.outputs), self._read_pointer), t)
+        elif self.outputs:
+            self._reads.get(self, self.read_values, t)
         return self.read_values
 
     def do_step(self, t: float, h: float, u: np.ndarray, slopes: np.ndarray | None = None) -> None:
         """Set the inputs at ``t`` (held over the step, or interpolated with ``slopes`` [1/s] where
         the FMU can interpolate inputs), then fmi2DoStep from ``t`` to ``t + h``."""
         self.set_inputs(u, t)
-        if slopes is not None and self.inputs:
+        if slopes is not None and self.inputs and self._inputs.real_only:
             self.input_slopes[:] = slopes
             self._call("fmi2SetRealInputDerivatives",
                        lambda: self.fmu.fmi2SetRealInputDerivatives(self.fmu.component, self._in_refs, len(self.inputs),
@@ -320,3 +366,48 @@ class FmuParticipant:
             self.fmu.freeLibrary()
         except Exception as error:  # noqa: BLE001 - unloading is best effort
             self.messages.append(f"freeLibrary: {error}")
+
+
+#: fmi2Status fmi2Discard.
+DISCARD = 2
+
+
+class _Typed:
+    """Variables of an FMU grouped by FMI type for the fmi2Set/Get calls: value references and
+    positions (in the caller's order) per type. Integer and Enumeration share fmi2Get/SetInteger;
+    Booleans travel as fmi2Boolean (an int) and are held as 1.0 / 0.0."""
+
+    def __init__(self, names: list[str], types: dict[str, str], refs: dict[str, int]):
+        unknown = [n for n in names if types[n] not in ("Real", "Integer", "Enumeration", "Boolean")]
+        if unknown:
+            raise RunError(f"variables {unknown}: type {types[unknown[0]]} cannot be exchanged at every step")
+        self.groups: dict[str, tuple[Any, np.ndarray]] = {}
+        for kind in ("Real", "Integer", "Boolean"):
+            positions = [k for k, n in enumerate(names) if _call_type(types[n]) == kind]
+            if positions:
+                references = (ctypes.c_uint * len(positions))(*[refs[names[k]] for k in positions])
+                self.groups[kind] = (references, np.array(positions, dtype=int))
+        self.real_only = set(self.groups) <= {"Real"}
+
+    def set(self, participant: FmuParticipant, values: np.ndarray, t: float) -> None:
+        fmu = participant.fmu
+        for kind, (references, positions) in self.groups.items():
+            if kind == "Real":
+                buffer: Any = (ctypes.c_double * len(positions))(*values[positions].tolist())
+            else:
+                buffer = (ctypes.c_int * len(positions))(*[int(round(v)) for v in values[positions].tolist()])
+            participant._call(f"fmi2Set{kind}", partial(getattr(fmu, f"fmi2Set{kind}"), fmu.component, references,
+                                                         len(references), buffer), t)
+
+    def get(self, participant: FmuParticipant, out: np.ndarray, t: float) -> None:
+        fmu = participant.fmu
+        for kind, (references, positions) in self.groups.items():
+            buffer: Any = ((ctypes.c_double if kind == "Real" else ctypes.c_int) * len(positions))()
+            participant._call(f"fmi2Get{kind}", partial(getattr(fmu, f"fmi2Get{kind}"), fmu.component, references,
+                                                         len(references), buffer), t)
+            out[positions] = np.array(list(buffer), dtype=float)
+
+
+def _call_type(variable_type: str) -> str:
+    """The type whose fmi2Get/Set functions a variable uses (Enumeration: Integer's)."""
+    return "Integer" if variable_type == "Enumeration" else variable_type

@@ -25,10 +25,12 @@ def communication_points(t0: float, stop_time: float, h: float) -> np.ndarray:
 class Recorder:
     """One row per communication point ``times``; :meth:`sample` copies the recorded slots of the
     value vector into row ``k``; :meth:`frame` gives time [s] and one column per port (the rows
-    sampled so far, when a run stops early)."""
+    sampled so far, when a run stops early), typed as the variables (``types``: their FMI types;
+    Integer and Enumeration columns as whole numbers, Boolean ones as true/false; default Real)."""
 
-    def __init__(self, ports: list[Port], slots: np.ndarray, times: np.ndarray):
+    def __init__(self, ports: list[Port], slots: np.ndarray, times: np.ndarray, types: list[str] | None = None):
         self.columns = [str(port) for port in ports]
+        self.types = types or ["Real"] * len(ports)
         self.slots = slots
         self.times = times
         self.rows = np.empty((len(times), slots.size))
@@ -40,6 +42,11 @@ class Recorder:
 
     def frame(self) -> pd.DataFrame:
         data = pd.DataFrame(self.rows[:self.filled], columns=self.columns)
+        for column, kind in zip(self.columns, self.types):
+            if kind in ("Integer", "Enumeration"):
+                data[column] = data[column].astype("int64")
+            elif kind == "Boolean":
+                data[column] = data[column] != 0.0
         data.insert(0, "time", self.times[:self.filled])
         return data
 

@@ -31,7 +31,7 @@ from rover_cosim.common.units import base_units
 
 from .blocks import make_block
 from .builder import SystemBuilder
-from .model import BlockEntry, Connection, System
+from .model import BlockEntry, Connection, System, Value
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -56,11 +56,15 @@ def _q(namespace: str, tag: str) -> str:
     return f"{{{namespace}}}{tag}"
 
 
-def _connector(parent: etree._Element, name: str, kind: str, unit: str | None) -> None:
+#: The SSP element of each FMI type (an Enumeration travels as its number, an Integer).
+SSP_TYPES = {"Real": "Real", "Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean", "String": "String"}
+
+
+def _connector(parent: etree._Element, name: str, kind: str, unit: str | None, variable_type: str = "Real") -> None:
     connector = etree.SubElement(parent, _q(SSD, "Connector"), name=name, kind=kind)
-    real = etree.SubElement(connector, _q(SSC, "Real"))
-    if unit:
-        real.set("unit", unit)
+    typed = etree.SubElement(connector, _q(SSC, SSP_TYPES[variable_type]))
+    if unit and variable_type == "Real":
+        typed.set("unit", unit)
 
 
 def _units(parent: etree._Element, units: set[str]) -> None:
@@ -111,7 +115,7 @@ class _SsdWriter:
         self.external = external
         self.outside = {e.name for e in external}
         self.units: set[str] = set()
-        self.parameters: dict[str, list[tuple[str, float, str | None]]] = {name: [] for name in self.fmus}
+        self.parameters: dict[str, list[tuple[str, Value, str | None]]] = {name: [] for name in self.fmus}
         self.root = etree.Element(_q(SSD, "SystemStructureDescription"), nsmap={"ssd": SSD, "ssc": SSC},
                                   version="1.0", name=system.path.stem if system.path else "system")
         self.top = etree.SubElement(self.root, _q(SSD, "System"), name="system")
@@ -159,10 +163,10 @@ class _SsdWriter:
         for variable in sorted(self._used(name), key=lambda v: variables[v].valueReference):
             v = variables[variable]
             _connector(connectors, variable, v.causality if v.causality in ("input", "parameter") else "output",
-                       v.unit)
+                       v.unit, v.type)
             self.units.update([v.unit] if v.unit else [])
         for variable, value in {**fmu.parameters, **fmu.start}.items():
-            self.parameters[name].append((variable, float(value), variables[variable].unit))
+            self.parameters[name].append((variable, value, variables[variable].unit))
             self.units.update([variables[variable].unit] if variables[variable].unit else [])
         return component
 
@@ -216,14 +220,21 @@ def parameter_file(instance: str) -> str:
     return f"resources/{instance}.ssv"
 
 
-def _parameter_set(parameters: list[tuple[str, float, str | None]], name: str) -> bytes:
+def _parameter_set(parameters: list[tuple[str, Value, str | None]], name: str) -> bytes:
     root = etree.Element(_q(SSV, "ParameterSet"), nsmap={"ssv": SSV, "ssc": SSC}, version="1.0", name=name)
     values = etree.SubElement(root, _q(SSV, "Parameters"))
     for name, value, unit in parameters:
-        real = etree.SubElement(etree.SubElement(values, _q(SSV, "Parameter"), name=name), _q(SSV, "Real"),
-                                value=repr(value))
-        if unit:
-            real.set("unit", unit)
+        parameter = etree.SubElement(values, _q(SSV, "Parameter"), name=name)
+        if isinstance(value, bool):
+            etree.SubElement(parameter, _q(SSV, "Boolean"), value="true" if value else "false")
+        elif isinstance(value, int):
+            etree.SubElement(parameter, _q(SSV, "Integer"), value=str(value))
+        elif isinstance(value, str):
+            etree.SubElement(parameter, _q(SSV, "String"), value=value)
+        else:
+            real = etree.SubElement(parameter, _q(SSV, "Real"), value=repr(float(value)))
+            if unit:
+                real.set("unit", unit)
     return etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
 
 
@@ -344,9 +355,10 @@ def _settings(root: etree._Element, ns: dict[str, str]) -> dict[str, Any]:
     return settings
 
 
-def _bound_values(element: etree._Element, folder: Path, ns: dict[str, str]) -> dict[str, float]:
-    """name -> value of the parameter sets (files in the archive) bound to ``element``."""
-    values: dict[str, float] = {}
+def _bound_values(element: etree._Element, folder: Path, ns: dict[str, str]) -> dict[str, Value]:
+    """name -> value of the parameter sets (files in the archive) bound to ``element`` (Real,
+    Integer, Boolean and String values; the others are not read)."""
+    values: dict[str, Value] = {}
     for binding in element.findall("ssd:ParameterBindings/ssd:ParameterBinding", ns):
         source = binding.get("source")
         prefix = binding.get("prefix", "")
@@ -354,10 +366,16 @@ def _bound_values(element: etree._Element, folder: Path, ns: dict[str, str]) -> 
             continue
         parameter_set = etree.parse(str(folder / source)).getroot()  # noqa: S320 - our own archive, validated
         for parameter in parameter_set.findall("ssv:Parameters/ssv:Parameter", ns):
-            real = parameter.find("ssv:Real", ns)
-            if real is not None:
-                values[prefix + parameter.get("name")] = float(real.get("value"))
+            for kind, read in SSV_READERS.items():
+                found = parameter.find(f"ssv:{kind}", ns)
+                if found is not None:
+                    values[prefix + parameter.get("name")] = read(found.get("value"))
     return values
+
+
+#: How a value of each SSV element is read.
+SSV_READERS: dict[str, Any] = {"Real": float, "Integer": int, "Boolean": lambda text: text.strip() in ("true", "1"),
+                               "String": str}
 
 
 def fmpy_parameter_set(archive: Path) -> Any:

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import FmuEntry, Port, System
+from .model import FmuEntry, Port, System, declared_start, numeric
 
 
 @dataclass
@@ -71,7 +71,8 @@ class _Builder:
             variable = entry.variables()[port.variable]
             if variable.causality == "input":  # not connected: its start value, constant in time
                 slot = self.slots(port)
-                self.constants[slot] = entry.start.get(port.variable, float(variable.start or 0.0))
+                start = entry.start.get(port.variable, declared_start(variable))
+                self.constants[slot] = numeric(start) if start is not None else 0.0
                 return slot
             if port.variable not in self.reads[port.instance]:
                 self.reads[port.instance].append(port.variable)

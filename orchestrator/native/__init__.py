@@ -232,7 +232,7 @@ class NativeStepper:
             return failed
         unit = self.units[failed]
         status = self.library.stepper_status(self._handle, failed)
-        unit.fail(CALLS[call], t, f"status {status}")
+        unit.fail(CALLS[call], t, f"status {status}", status)
         return failed  # not reached: fail raises
 
     def seconds(self) -> dict[str, float]:

@@ -1,0 +1,148 @@
+"""Every FMI 2.0 variable type through the engine, on a test FMU of our own (tests/fmus/typed.c):
+typed parameters and start values (TOML numbers, booleans, strings), value references resolved
+per type (they are shared across types in this FMU), type checks of connections at load, typed
+recorded columns, a feedthrough chain across types, the Python path for FMUs that exchange other
+types than Real (the native stepper sets and gets Reals only), and the clean end of a run when
+an FMU ends the simulation (fmi2Discard with fmi2Terminated), from Python and from C."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pytest
+from typed_fmu import build_typed_fmu
+
+from rover_cosim.cli import main
+from rover_cosim.orchestrator import SystemBuilder, run
+from rover_cosim.orchestrator.execution import make_execution
+from rover_cosim.orchestrator.master import participants_of
+from rover_cosim.orchestrator.model import SystemFileError
+from rover_cosim.orchestrator.system import system_from_dict, system_to_toml
+from rover_cosim.orchestrator.wiring import wire
+
+
+@pytest.fixture(scope="module")
+def typed(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    built = build_typed_fmu(tmp_path_factory.mktemp("typed"))
+    if isinstance(built, str):
+        pytest.skip(f"the test FMU cannot be built here: {built}")
+    return built
+
+
+def one(typed: Path, **fmu: Any) -> dict[str, Any]:
+    return {"simulation": {"stop_time": 1.0, "step": 0.1, "algorithm": "jacobi"},
+            "fmu": [{"name": "a", "path": str(typed), **fmu}]}
+
+
+def test_shared_value_references_are_resolved_per_type(typed):
+    data = run(system_from_dict(one(typed), name="t", base=typed.parent)).data
+    np.testing.assert_allclose(data["a.x"], data["time"], rtol=0, atol=1e-12)   # Real 0
+    assert data["a.counter"].tolist() == list(range(11))                       # Integer 0, not Real 0
+    assert data["a.even"].tolist() == [k % 2 == 0 for k in range(11)]            # Boolean 0
+    assert data["a.mode"].tolist() == [1 + k % 3 for k in range(11)]             # Enumeration (Integer 4)
+    assert str(data["a.counter"].dtype) == "int64" and str(data["a.even"].dtype) == "bool"
+    assert "a.label" not in data  # a String output would not be recorded by default (none here)
+
+
+def test_typed_parameters_and_start_values_from_a_file(typed, tmp_path):
+    data = one(typed, parameters={"gain": 3, "label": "hello", "stopAfter": 0}, start={"u": 2.0, "k": 5, "b": True})
+    system = system_from_dict(data, name="t", base=typed.parent)
+    assert system.fmus[0].parameters == {"gain": 3.0, "label": "hello", "stopAfter": 0}
+    assert system.fmus[0].start == {"u": 2.0, "k": 5, "b": True}
+    recorded = run(system).data
+    assert (recorded["a.y"] == 6.0).all() and recorded["a.k2"].tolist() == [5 + k for k in range(11)]
+    assert not recorded["a.notb"].any()
+    written = tmp_path / "typed.toml"
+    written.write_text(system_to_toml(system, tmp_path))
+    assert 'label = "hello"' in written.read_text() and "b = true" in written.read_text()
+
+
+BAD_VALUES: dict[str, tuple[dict[str, Any], str]] = {
+    "a number for a Boolean": ({"start": {"b": 1}}, "start b: 1: expected true or false (Boolean)"),
+    "a fraction for an Integer": ({"start": {"k": 2.5}}, "start k: 2.5: expected a whole number (Integer)"),
+    "a number for a String": ({"parameters": {"label": 3}}, "parameters label: 3: expected text (String)"),
+    "a boolean for a Real": ({"parameters": {"gain": True}}, "parameters gain: True: expected a number (Real)"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_VALUES))
+def test_a_value_of_the_wrong_type_names_the_variable_and_its_type(typed, case):
+    fmu, expected = BAD_VALUES[case]
+    with pytest.raises(SystemFileError, match=expected.replace("(", r"\(").replace(")", r"\)")):
+        system_from_dict(one(typed, **fmu), name="t", base=typed.parent)
+
+
+def chain(typed: Path, algorithm: str = "gauss-seidel") -> SystemBuilder:
+    """a -> b across every type but String: Real y -> u, Integer k2 -> k, Boolean notb -> b."""
+    builder = SystemBuilder("chain").simulation(stop_time=1.0, step=0.1, algorithm=algorithm)
+    builder.add_fmu("a", typed, start={"u": 1.5, "k": 7, "b": False}).add_fmu("b", typed)
+    return builder.connect("a.y", "b.u").connect("a.k2", "b.k").connect("a.notb", "b.b")
+
+
+@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi", "iterative"])
+def test_feedthrough_to_feedthrough_across_types(typed, algorithm):
+    if algorithm == "iterative":
+        with pytest.raises(Exception, match="no FMU state|fmi2GetFMUstate"):
+            run(chain(typed, algorithm).build())
+        return
+    data = run(chain(typed, algorithm).build()).data
+    assert (data["b.y"] == 2.0 * 2.0 * 1.5).all()                       # Real through two gains of 2
+    assert not data["b.notb"].any()                                        # not (not False)
+    counter = np.arange(11)
+    a_k2 = data["a.k2"].to_numpy()
+    assert a_k2.tolist() == (7 + counter).tolist()
+    # Gauss-Seidel: b sees a's k2 of the same instant; Jacobi: of the step before (both at the start).
+    seen = a_k2 if algorithm == "gauss-seidel" else np.concatenate([[a_k2[0]], a_k2[:-1]])
+    assert data["b.k2"].tolist() == (seen + counter).tolist()
+
+
+def test_an_integer_output_may_drive_an_enumeration_and_back_but_not_a_real(typed):
+    builder = SystemBuilder("mix").simulation(stop_time=0.3, step=0.1)
+    builder.add_fmu("a", typed).add_fmu("b", typed)
+    builder.connect("a.mode", "b.k")   # Enumeration -> Integer: allowed
+    with pytest.raises(SystemFileError, match=r"type mismatch: a\.counter is Integer, b\.u is Real"):
+        builder.connect("a.counter", "b.u")
+    with pytest.raises(SystemFileError, match=r"type mismatch: a\.y is Real, b\.b is Boolean"):
+        builder.connect("a.y", "b.b")
+    data = run(builder.build()).data
+    assert data["b.k2"].tolist() == [m + c for m, c in zip(data["a.mode"], range(4))]
+
+
+def test_an_fmu_exchanging_other_types_steps_in_python_and_a_real_only_one_natively(typed):
+    mixed = chain(typed, "jacobi").build()
+    reals = SystemBuilder("reals").simulation(stop_time=1.0, step=0.1, algorithm="jacobi")
+    reals.add_fmu("a", typed, start={"u": 1.0}).add_fmu("b", typed).connect("a.y", "b.u")
+    real_only = reals.record("a.x", "b.y").build()
+    for system, natively in ((mixed, set()), (real_only, {0, 1})):
+        wiring = wire(system)
+        with participants_of(system, wiring) as participants:
+            execution = make_execution(system, participants, wiring)
+            assert set(execution.natively) == natively
+            execution.close()
+
+
+@pytest.mark.parametrize("which", ["from Python (typed outputs)", "from C (Real outputs only)"])
+def test_an_fmu_that_ends_the_simulation_ends_the_run_cleanly(typed, which):
+    builder = SystemBuilder("stops").simulation(stop_time=1.0, step=0.1, algorithm="jacobi")
+    builder.add_fmu("a", typed, parameters={"stopAfter": 4})
+    if which.startswith("from C"):
+        builder.record("a.x")
+    result = run(builder.build())
+    assert result.stopped is not None and "a (Typed.fmu) ended the simulation at t = 0.4 s" in result.stopped
+    assert "stopAfter = 4 steps reached" in result.stopped
+    assert len(result.data) == 5 and result.steps == 4
+    np.testing.assert_allclose(result.data["time"], [0.0, 0.1, 0.2, 0.3, 0.4])
+
+
+def test_rover_cosim_run_exits_0_with_every_row_when_an_fmu_ends_the_simulation(typed, tmp_path, capsys):
+    system = tmp_path / "stops.toml"
+    system.write_text(f'[simulation]\nstop_time = 1.0\nstep = 0.1\n\n[[fmu]]\nname = "a"\npath = "{typed}"\n'
+                      "parameters = { stopAfter = 3 }\n")
+    assert main(["run", str(system), "-o", str(tmp_path / "stops.csv"), "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "stopped before the stop time: a (Typed.fmu) ended the simulation at t = 0.3 s" in out
+    data = pd.read_csv(tmp_path / "stops.csv")
+    assert data["a.counter"].tolist() == [0, 1, 2, 3]
