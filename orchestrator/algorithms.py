@@ -141,6 +141,10 @@ class Iterative(Algorithm):
         self.holds = ["end" if isinstance(p, BlockParticipant)
                       else "interpolate" if getattr(p, "can_interpolate", False) else "mean"
                       for p in execution.participants]
+        # Discrete inputs (Integer, Boolean, discrete Reals) are never interpolated nor averaged:
+        # they take the guess at t + h, as a participant after their source sees them.
+        self.discrete = [getattr(p, "discrete_inputs", np.zeros(len(p.inputs), dtype=bool))
+                         for p in execution.participants]
 
     def step(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         # The first step of a run is taken in START_SUBSTEPS pieces: inputs switched on at the
@@ -155,13 +159,14 @@ class Iterative(Algorithm):
         """One pass over the participants in order; returns the new values."""
         clock = time.perf_counter
         new = guess.copy()  # filled in order: later participants see this pass's outputs
-        for participant, inputs, outputs, hold in zip(execution.participants, execution.inputs, execution.outputs,
-                                                      self.holds):
+        for participant, inputs, outputs, hold, discrete in zip(execution.participants, execution.inputs,
+                                                                execution.outputs, self.holds, self.discrete):
             begin = clock()
             if hold == "interpolate":
-                participant.do_step(t, h, start[inputs], (new[inputs] - start[inputs]) / h)
+                held = np.where(discrete, new[inputs], start[inputs])
+                participant.do_step(t, h, held, np.where(discrete, 0.0, (new[inputs] - start[inputs]) / h))
             elif hold == "mean":
-                participant.do_step(t, h, 0.5 * (start[inputs] + new[inputs]))
+                participant.do_step(t, h, np.where(discrete, new[inputs], 0.5 * (start[inputs] + new[inputs])))
             else:
                 participant.do_step(t, h, new[inputs])
             new[outputs] = participant.get_outputs(t + h)

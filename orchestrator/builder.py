@@ -87,7 +87,23 @@ def read_fmu(fmu_path: Path, where: str) -> Any:
     if description.fmiVersion != "2.0" or description.coSimulation is None:
         raise SystemFileError(f"{where}: {fmu_path}: expected an FMI 2.0 Co-Simulation FMU (got FMI "
                               f"{description.fmiVersion}, CS {'yes' if description.coSimulation else 'no'})")
+    _check_binary(fmu_path, description.coSimulation.modelIdentifier, where)
     return description
+
+
+def _check_binary(fmu_path: Path, identifier: str, where: str) -> None:
+    """SystemFileError unless the FMU has a binary for this platform, naming the ones it has."""
+    wanted = f"binaries/{fmpy.platform}/{identifier}{fmpy.sharedLibraryExtension}"
+    with zipfile.ZipFile(fmu_path) as archive:
+        names = archive.namelist()
+    if wanted in names:
+        return
+    platforms = sorted({n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") >= 2
+                        and n.split("/")[1]})
+    sources = any(n.startswith("sources/") and n.endswith(".c") for n in names)
+    has = ", ".join(platforms) if platforms else "none"
+    raise SystemFileError(f"{where}: {fmu_path.name} has no binary for this platform ({wanted}); its binaries: {has}"
+                          + ("; it ships C sources, which `fmpy compile` can build" if sources else ""))
 
 
 def optional_inputs(fmu_path: Path, description: Any = None) -> set[str]:
@@ -154,6 +170,7 @@ class SystemBuilder:
         self._connections: list[Connection] = []
         self._driven: dict[Port, str] = {}     # input -> the label of the connection driving it
         self._record: list[Port] | None = None
+        self._settings_from: dict[str, str] = {}
 
     # --- messages -------------------------------------------------------------------------------
     def error(self, where: str, message: str) -> SystemFileError:
@@ -426,6 +443,38 @@ class SystemBuilder:
                 if Port(entry.name, variable) not in self._driven:
                     raise self.error(self._where[entry.name], f"input {entry.name}.{variable} is not connected")
 
+    def _default_experiment(self) -> None:
+        """A stop time or step the settings leave out, from the FMUs' DefaultExperiment: the
+        largest stop time and the smallest step (``settings_from`` says where each came from)."""
+        values = self._settings.values
+        for key, attribute, pick in (("stop_time", "stopTime", max), ("step", "stepSize", min)):
+            if key in values:
+                continue
+            given = [(float(getattr(f.description.defaultExperiment, attribute)), f.name) for f in self._fmus.values()
+                     if f.description.defaultExperiment is not None
+                     and getattr(f.description.defaultExperiment, attribute) is not None]
+            if given:
+                value, name = pick(given)
+                values[key] = value
+                self._settings_from[key] = f"DefaultExperiment {attribute} of {name} ({self._fmus[name].path.name})"
+        self._check_times()
+
+    def _check_capabilities(self) -> None:
+        """What the FMUs declare they cannot do, against the settings: the iterative master
+        restores states; a fixed-step FMU gets no shorter last step."""
+        values = self._settings.values
+        for fmu in self._fmus.values():
+            cs = fmu.description.coSimulation
+            if values["algorithm"] == "iterative" and not cs.canGetAndSetFMUstate:
+                raise self.error(self._where[fmu.name], f"{fmu.name} ({fmu.path.name}) cannot save and restore its "
+                                 "state (canGetAndSetFMUstate is false), which the iterative master needs to repeat a "
+                                 "step; use algorithm jacobi or gauss-seidel")
+            steps = (float(values["stop_time"]) - float(values["start_time"])) / float(values["step"])
+            if not cs.canHandleVariableCommunicationStepSize and abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
+                raise self.error(self._where[fmu.name], f"{fmu.name} ({fmu.path.name}) takes one fixed communication "
+                                 "step (canHandleVariableCommunicationStepSize is false): the run must be a whole "
+                                 f"number of steps, {steps:.6g} are not")
+
     def _order(self) -> list[str]:
         order, where = self._settings.values["order"], self._settings.where
         blocks = list(self._blocks.values())
@@ -457,12 +506,14 @@ class SystemBuilder:
     def build(self) -> System:
         """The checked System (the builder can go on and build another)."""
         values, where = self._settings.values, self._settings.where
+        self._default_experiment()
         for key in ("stop_time", "step"):
             if key not in values:
-                raise self.error(where, f"{key} is missing (seconds)")
+                raise self.error(where, f"{key} is missing (seconds; and no FMU has a DefaultExperiment that gives it)")
         if not self._fmus and not self._blocks:
             raise self.error("components", "the system has no FMU and no block")
         self._check_inputs_driven()
+        self._check_capabilities()
         order = self._order()
         record = self._record if self._record is not None else [p for i in order for p in self._outputs(i)]
         iteration = self._iteration()
@@ -471,7 +522,8 @@ class SystemBuilder:
                       [BlockEntry(b.name, b.kind, b.block, b.keys) for b in self._blocks.values()],
                       list(self._connections), float(values["step"]), float(values["stop_time"]),
                       float(values["start_time"]), values["algorithm"], order, list(record), iteration, loop,
-                      values["threads"], values["native"], values["allow_algebraic_loops"], self.name)
+                      values["threads"], values["native"], values["allow_algebraic_loops"], self.name,
+                      dict(self._settings_from))
 
     @classmethod
     def from_system(cls, system: System, name: str | None = None) -> SystemBuilder:

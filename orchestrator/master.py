@@ -152,6 +152,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
             else:
                 steps, stopped = _run_steps(execution, values, times, watchers)
         except Terminated as end:  # an FMU ended the simulation: a clean end at the start of that step
+            _last_row(participants, execution, values, times, recorder, end)
             steps, stopped = recorder.filled - 1, str(end)
         except RunError as error:
             error.partial = recorder.frame()
@@ -163,6 +164,19 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
     for observer in observers:
         observer.finish(result)
     return result
+
+
+def _last_row(participants: list[Participant], execution: Execution, values: np.ndarray, times: np.ndarray,
+              recorder: Recorder, end: Terminated) -> None:
+    """A system of one FMU that ended the simulation within a step: a last row at the time it
+    got to (fmi2LastSuccessfulTime), as FMPy records it. With other participants the run ends at
+    the start of the step, where they all agree."""
+    k = recorder.filled
+    if len(participants) != 1 or end.last is None or not end.last > end.t or k >= len(times):
+        return
+    values[execution.outputs[0]] = participants[0].get_outputs(end.last)
+    times[k] = min(end.last, times[k])
+    recorder.sample(k, values)
 
 
 def _sample(watchers: list[Watcher], k: int, t: float, values: np.ndarray) -> str | None:

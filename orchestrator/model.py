@@ -175,6 +175,8 @@ class System:
     native: bool = True  # Jacobi/Gauss-Seidel step the FMUs from C (orchestrator.native) where it builds
     allow_algebraic_loops: bool = False
     name: str = "system"        # what messages call the system
+    #: Settings taken from elsewhere than the system's own (e.g. {"step": "DefaultExperiment ..."}).
+    settings_from: dict[str, str] = field(default_factory=dict)
 
     @property
     def threads(self) -> int:

@@ -28,6 +28,7 @@ from fmpy.fmi2 import (
     defaultCallbacks,
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
+    fmi2LastSuccessfulTime,
     fmi2Terminated,
 )
 
@@ -46,12 +47,13 @@ class RunError(RuntimeError):
 
 
 class Terminated(RunError):
-    """An FMU ended the simulation (fmi2DoStep returned fmi2Discard with fmi2Terminated true):
-    the run stops at the start of that step, cleanly, with every row recorded before it."""
+    """An FMU ended the simulation (fmi2DoStep returned fmi2Discard with fmi2Terminated true)
+    in the step from ``t``: the run stops there, cleanly, with every row recorded before it.
+    ``last``: the FMU's fmi2LastSuccessfulTime, where it says (it got that far in the step)."""
 
-    def __init__(self, message: str, t: float):
+    def __init__(self, message: str, t: float, last: float | None = None):
         super().__init__(message)
-        self.t = t
+        self.t, self.last = t, last
 
 
 class Participant(Protocol):
@@ -197,6 +199,7 @@ class FmuParticipant:
         md = entry.description
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
         self.types = {v.name: str(v.type) for v in md.modelVariables}
+        self.variability = {v.name: str(v.variability) for v in md.modelVariables}
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=str(folder),
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=entry.name)
         self._callbacks = fmi2CallbackFunctions()
@@ -226,12 +229,28 @@ class FmuParticipant:
         ``error``); :class:`Terminated` when a step was discarded because the FMU ended the
         simulation (fmi2Terminated)."""
         if what == "fmi2DoStep" and status == DISCARD and self._terminated():
-            at = f" at t = {t:.6g} s" if t is not None else ""
+            last = self._last_successful_time()
+            reached = last if last is not None and t is not None and last > t else t
+            when = f" at t = {reached:.6g} s" if reached is not None else ""
             said = f" ({'; '.join(self.messages[-1:])})" if self.messages else ""
-            raise Terminated(f"{self.name} ({self.entry.path.name}) ended the simulation{at}{said}", t or 0.0)
+            raise Terminated(f"{self.name} ({self.entry.path.name}) ended the simulation{when}{said}", t or 0.0, last)
         detail = "; ".join(self.messages[-3:]) or error
         at = f" at t = {t:.6g} s" if t is not None else ""
         raise RunError(f"{self.name} ({self.entry.path.name}): {what}{at} failed: {detail}") from None
+
+    def _last_successful_time(self) -> float | None:
+        """fmi2GetRealStatus(fmi2LastSuccessfulTime) [s], None where the FMU cannot say."""
+        try:
+            return float(self.fmu.getRealStatus(fmi2LastSuccessfulTime))
+        except Exception:  # noqa: BLE001 - optional in FMI 2.0
+            return None
+
+    @property
+    def discrete_inputs(self) -> np.ndarray:
+        """Per connected input: whether it is discrete (not a continuous Real), which the
+        iterative master never interpolates."""
+        return np.array([self.types[n] != "Real" or self.variability.get(n) == "discrete" for n in self.inputs],
+                        dtype=bool)
 
     def _terminated(self) -> bool:
         """fmi2GetBooleanStatus(fmi2Terminated), False where the FMU cannot say."""

@@ -22,6 +22,8 @@ def sidecar(system: System, result: RunResult, command: str) -> dict[str, object
         **record,
         "system_file": str(system.path) if system.path else None,
         "system_sha256": file_sha256(system.path) if system.path else None,
+        "settings_from": system.settings_from,
+        "stopped": result.stopped,
         "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid}
                  for fmu in system.fmus},
         "blocks": {block.name: block.kind for block in system.blocks},

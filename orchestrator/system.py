@@ -116,10 +116,7 @@ def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path 
                             "[[block]], [[connection]], [record]")
     simulation = _table(data.get("simulation"), f"{name}: [simulation]")
     _known_keys(builder, simulation, "simulation", "[simulation]")
-    for key in ("stop_time", "step"):
-        if key not in simulation:
-            raise builder.error("[simulation]", f"{key} is missing (seconds)")
-    builder.simulation(where="[simulation]", **simulation)
+    builder.simulation(where="[simulation]", **simulation)  # a missing stop time or step: the FMUs' defaults
     for i, entry in enumerate(_tables(data.get("fmu"), f"{name}: [[fmu]]"), 1):
         _read_fmu_entry(builder, entry, i)
     folder = path.parent if path is not None else None

@@ -24,12 +24,23 @@ from rover_cosim.orchestrator.system import system_from_dict, system_to_toml
 from rover_cosim.orchestrator.wiring import wire
 
 
-@pytest.fixture(scope="module")
-def typed(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    built = build_typed_fmu(tmp_path_factory.mktemp("typed"))
+def _built(folder: Path, **variant: Any) -> Path:
+    built = build_typed_fmu(folder, **variant)
     if isinstance(built, str):
         pytest.skip(f"the test FMU cannot be built here: {built}")
     return built
+
+
+@pytest.fixture(scope="module")
+def typed(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The test FMU (no FMU state, variable communication steps)."""
+    return _built(tmp_path_factory.mktemp("typed"))
+
+
+@pytest.fixture(scope="module")
+def stateful(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The test FMU saying it can get and set its state (for the iterative master)."""
+    return _built(tmp_path_factory.mktemp("stateful"), name="TypedState", states=True)
 
 
 def one(typed: Path, **fmu: Any) -> dict[str, Any]:
@@ -83,20 +94,23 @@ def chain(typed: Path, algorithm: str = "gauss-seidel") -> SystemBuilder:
 
 
 @pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi", "iterative"])
-def test_feedthrough_to_feedthrough_across_types(typed, algorithm):
-    if algorithm == "iterative":
-        with pytest.raises(Exception, match="no FMU state|fmi2GetFMUstate"):
-            run(chain(typed, algorithm).build())
-        return
-    data = run(chain(typed, algorithm).build()).data
+def test_feedthrough_to_feedthrough_across_types(typed, stateful, algorithm):
+    """Iterative: on the FMU with states; its discrete inputs take the values at the end of the
+    step (never averaged), so it gives Gauss-Seidel's results."""
+    data = run(chain(stateful if algorithm == "iterative" else typed, algorithm).build()).data
     assert (data["b.y"] == 2.0 * 2.0 * 1.5).all()                       # Real through two gains of 2
     assert not data["b.notb"].any()                                        # not (not False)
-    counter = np.arange(11)
     a_k2 = data["a.k2"].to_numpy()
-    assert a_k2.tolist() == (7 + counter).tolist()
-    # Gauss-Seidel: b sees a's k2 of the same instant; Jacobi: of the step before (both at the start).
-    seen = a_k2 if algorithm == "gauss-seidel" else np.concatenate([[a_k2[0]], a_k2[:-1]])
-    assert data["b.k2"].tolist() == (seen + counter).tolist()
+    assert a_k2.tolist() == (7 + data["a.counter"]).tolist()   # (the iterative master's first step is in pieces)
+    # Gauss-Seidel and iterative: b sees a's k2 of the same instant; Jacobi: of the step before.
+    seen = a_k2 if algorithm != "jacobi" else np.concatenate([[a_k2[0]], a_k2[:-1]])
+    assert data["b.k2"].tolist() == (seen + data["b.counter"]).tolist()
+
+
+def test_the_iterative_master_refuses_an_fmu_without_states_by_name(typed):
+    with pytest.raises(SystemFileError, match=r"a \(Typed.fmu\) cannot save and restore its state "
+                                              r"\(canGetAndSetFMUstate is false\)"):
+        chain(typed, "iterative").build()
 
 
 def test_an_integer_output_may_drive_an_enumeration_and_back_but_not_a_real(typed):
@@ -133,8 +147,19 @@ def test_an_fmu_that_ends_the_simulation_ends_the_run_cleanly(typed, which):
     result = run(builder.build())
     assert result.stopped is not None and "a (Typed.fmu) ended the simulation at t = 0.4 s" in result.stopped
     assert "stopAfter = 4 steps reached" in result.stopped
+    # One FMU: the last row at the time it got to (fmi2LastSuccessfulTime), as FMPy records it.
     assert len(result.data) == 5 and result.steps == 4
     np.testing.assert_allclose(result.data["time"], [0.0, 0.1, 0.2, 0.3, 0.4])
+    if which.startswith("from Python"):
+        assert result.data["a.counter"].tolist() == [0, 1, 2, 3, 4]
+
+
+def test_with_other_participants_the_run_ends_where_they_all_agree(typed):
+    builder = chain(typed, "gauss-seidel")
+    builder.set_parameters("a", {"stopAfter": 4})
+    result = run(builder.build())
+    assert "a (Typed.fmu) ended the simulation at t = 0.4 s" in (result.stopped or "")
+    assert len(result.data) == 4 and result.data["time"].iloc[-1] == pytest.approx(0.3)
 
 
 def test_rover_cosim_run_exits_0_with_every_row_when_an_fmu_ends_the_simulation(typed, tmp_path, capsys):
@@ -146,3 +171,26 @@ def test_rover_cosim_run_exits_0_with_every_row_when_an_fmu_ends_the_simulation(
     assert "stopped before the stop time: a (Typed.fmu) ended the simulation at t = 0.3 s" in out
     data = pd.read_csv(tmp_path / "stops.csv")
     assert data["a.counter"].tolist() == [0, 1, 2, 3]
+
+
+def test_a_system_without_stop_time_or_step_takes_the_fmus_default_experiment(typed, tmp_path):
+    system = system_from_dict({"fmu": [{"name": "a", "path": str(typed)}]}, name="t", base=typed.parent)
+    assert (system.stop_time, system.step) == (1.0, 0.1)
+    assert system.settings_from == {"stop_time": "DefaultExperiment stopTime of a (Typed.fmu)",
+                                    "step": "DefaultExperiment stepSize of a (Typed.fmu)"}
+    assert len(run(system).data) == 11
+
+
+def test_an_fmu_without_a_binary_for_this_platform_is_named_with_the_ones_it_has(tmp_path):
+    foreign = _built(tmp_path, name="Elsewhere", platform="win64")
+    with pytest.raises(SystemFileError, match=r"Elsewhere.fmu has no binary for this platform "
+                                              r"\(binaries/linux64/Typed.so\); its binaries: win64"):
+        system_from_dict(one(foreign), name="t", base=tmp_path)
+
+
+def test_a_fixed_step_fmu_gets_no_shorter_last_step(tmp_path):
+    fixed = _built(tmp_path, name="Fixed", fixed_step=True)
+    with pytest.raises(SystemFileError, match="takes one fixed communication step"):
+        system_from_dict({"simulation": {"stop_time": 0.95, "step": 0.1}, "fmu": [{"name": "a", "path": str(fixed)}]},
+                         name="t", base=tmp_path)
+    assert len(run(system_from_dict(one(fixed), name="t", base=tmp_path)).data) == 11

@@ -34,13 +34,14 @@ VARIABLES = [
 ]
 
 
-def model_description() -> str:
+def model_description(states: bool = False, fixed_step: bool = False) -> str:
     index = {name: i for i, (name, *_rest) in enumerate(VARIABLES, start=1)}
     lines = ['<?xml version="1.0" encoding="UTF-8"?>',
              f'<fmiModelDescription fmiVersion="2.0" modelName="Typed" guid="{GUID}" '
              'variableNamingConvention="flat" numberOfEventIndicators="0">',
-             '  <CoSimulation modelIdentifier="Typed" canHandleVariableCommunicationStepSize="true" '
-             'canGetAndSetFMUstate="false" canInterpolateInputs="false"/>',
+             '  <CoSimulation modelIdentifier="Typed" canHandleVariableCommunicationStepSize='
+             f'"{str(not fixed_step).lower()}" canGetAndSetFMUstate="{str(states).lower()}" '
+             'canInterpolateInputs="false"/>',
              '  <TypeDefinitions><SimpleType name="Mode"><Enumeration>'
              '<Item name="one" value="1"/><Item name="two" value="2"/><Item name="three" value="3"/>'
              '</Enumeration></SimpleType></TypeDefinitions>',
@@ -64,21 +65,23 @@ def model_description() -> str:
     return "\n".join(lines)
 
 
-def build_typed_fmu(folder: Path) -> Path | str:
-    """``folder``/Typed.fmu, or why it could not be built."""
+def build_typed_fmu(folder: Path, name: str = "Typed", states: bool = False, fixed_step: bool = False,
+                    platform: str = "linux64") -> Path | str:
+    """``folder``/``name``.fmu, or why it could not be built. ``states``: it says it can get and
+    set its state; ``fixed_step``: that it takes one fixed step; ``platform``: where its binary goes."""
     compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
     if not compiler:
         return "no C compiler ($CC, cc or gcc) on PATH"
     headers = Path(fmpy.__file__).parent / "c-code"
-    work = folder / "typed-build"
+    work = folder / f"{name}-build"
     (work / "binaries" / "linux64").mkdir(parents=True, exist_ok=True)
     library = work / "binaries" / "linux64" / "Typed.so"
     done = subprocess.run([compiler, "-shared", "-fPIC", "-O1", f"-I{headers}", str(SOURCE), "-o", str(library)],
                           capture_output=True, text=True, check=False)
     if done.returncode != 0:
         return f"{compiler} failed: {done.stderr.strip()[:300]}"
-    fmu = folder / "Typed.fmu"
+    fmu = folder / f"{name}.fmu"
     with zipfile.ZipFile(fmu, "w") as archive:
-        archive.writestr("modelDescription.xml", model_description())
-        archive.write(library, "binaries/linux64/Typed.so")
+        archive.writestr("modelDescription.xml", model_description(states, fixed_step))
+        archive.write(library, f"binaries/{platform}/Typed.so")
     return fmu

@@ -9,8 +9,9 @@
  * Integer  0 counter  output    completed communication steps
  *          1 k        input     discrete
  *          2 k2       output    k + counter (direct feedthrough)
- *          3 stopAfter parameter  > 0: the step after that many ends the simulation
- *                                (fmi2Discard, fmi2Terminated true)
+ *          3 stopAfter parameter  > 0: the step that completes that many ends the simulation
+ *                                (its work done, fmi2Discard with fmi2Terminated true and
+ *                                fmi2LastSuccessfulTime at its end, as the Reference-FMUs' Stair)
  * Enum.    4 mode     output    1 + counter mod 3 (items one, two, three)
  * Boolean  0 even     output    counter is even
  *          1 b        input     discrete
@@ -173,6 +174,8 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h, fmi2Boole
     Instance *c = component;
     (void)no_prior;
     if (c->terminated) return refuse(c, "fmi2DoStep: the simulation has ended");
+    c->x = t + h;
+    c->counter += 1;
     if (c->stop_after > 0 && c->counter >= c->stop_after) {
         c->terminated = 1;
         /* Formatted here: a ctypes logger (FMPy's callback type) does not receive variadic arguments. */
@@ -182,8 +185,6 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h, fmi2Boole
             c->callbacks.logger(c->callbacks.componentEnvironment, c->name, fmi2Discard, "terminate", message);
         return fmi2Discard;
     }
-    c->x = t + h;
-    c->counter += 1;
     return fmi2OK;
 }
 
@@ -194,10 +195,33 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component component, const fmi2StatusKind ki
     return fmi2OK;
 }
 
+fmi2Status fmi2GetRealStatus(fmi2Component component, const fmi2StatusKind kind, fmi2Real *value) {
+    Instance *c = component;
+    if (kind != fmi2LastSuccessfulTime) return fmi2Discard;
+    *value = c->x;
+    return fmi2OK;
+}
+
+/* FMU states: a copy of the instance (the model description may say it has none: a variant). */
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *s) {
+    Instance *copy = malloc(sizeof(Instance));
+    if (!copy) return refuse(c, "out of memory");
+    memcpy(copy, c, sizeof(Instance));
+    *s = copy;
+    return fmi2OK;
+}
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s) {
+    if (!s) return refuse(c, "no FMU state given");
+    memcpy(c, s, sizeof(Instance));
+    return fmi2OK;
+}
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *s) {
+    (void)c;
+    if (s) { free(*s); *s = NULL; }
+    return fmi2OK;
+}
+
 /* Not supported: the capability flags say so. */
-fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *s) { (void)s; return refuse(c, "no FMU state"); }
-fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate s) { (void)s; return refuse(c, "no FMU state"); }
-fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *s) { (void)s; return refuse(c, "no FMU state"); }
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *n) {
     (void)s; (void)n;
     return refuse(c, "no FMU state");
@@ -228,10 +252,6 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 }
 fmi2Status fmi2CancelStep(fmi2Component c) { return refuse(c, "no asynchronous steps"); }
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind k, fmi2Status *v) {
-    (void)k; (void)v;
-    return refuse(c, "no status");
-}
-fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v) {
     (void)k; (void)v;
     return refuse(c, "no status");
 }
