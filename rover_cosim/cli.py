@@ -9,6 +9,7 @@ import tempfile
 import threading
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from rover_cosim import __version__
 from rover_cosim.orchestrator.examples import examples
@@ -85,7 +86,8 @@ def build_parser() -> argparse.ArgumentParser:
                       help="slip spacing over 0..0.9, adjusted so that 0.9 is a point (default: 0.01)")
     _add_soil_options(fig3)
     run = commands.add_parser("run", help="co-simulate a system file (TOML or SSP) -> CSV + JSON sidecar")
-    run.add_argument("system", help="system file (.toml, or an .ssp archive), or the name of a shipped example: "
+    run.add_argument("system", help="system file (.toml, or an .ssp archive), one FMU (.fmu: run alone, with its "
+                     "DefaultExperiment unless --stop-time/--step say otherwise), or the name of a shipped example: "
                      + ", ".join(EXAMPLES))
     run.add_argument("-o", "--output", type=Path, default=None,
                      help="CSV to write (default: results/<system name>.csv); a .json sidecar goes beside it")
@@ -193,11 +195,24 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
             system = load_ssp(path, unpack)
         except SspError as error:
             raise SystemFileError(str(error)) from None
+    elif path.suffix.lower() == ".fmu":
+        system = _one_fmu(path, overrides)
     else:
         system = load_system(path, fmu_dir=fmu_dir)
     if overrides:
         system = replace_settings(system, name=f"{path} (with command-line overrides)", **overrides)
     return system, path
+
+
+def _one_fmu(path: Path, settings: dict[str, Any]):  # noqa: ANN202 - System, imported lazily
+    """A system of the one FMU ``path`` (instance ``model``), every output recorded, the stop time
+    and step from ``settings`` or the FMU's DefaultExperiment."""
+    from rover_cosim.orchestrator.builder import SystemBuilder
+
+    builder = SystemBuilder(str(path))
+    if settings:
+        builder.simulation(**settings)
+    return builder.add_fmu("model", path.resolve(), where=f"FMU {path.name}").build()
 
 
 def _export_ssp(args: argparse.Namespace) -> int:

@@ -194,3 +194,14 @@ def test_a_fixed_step_fmu_gets_no_shorter_last_step(tmp_path):
         system_from_dict({"simulation": {"stop_time": 0.95, "step": 0.1}, "fmu": [{"name": "a", "path": str(fixed)}]},
                          name="t", base=tmp_path)
     assert len(run(system_from_dict(one(fixed), name="t", base=tmp_path)).data) == 11
+
+
+def test_rover_cosim_run_runs_one_fmu_file_with_its_default_experiment(typed, tmp_path, capsys):
+    out = tmp_path / "alone.csv"
+    assert main(["run", str(typed), "-o", str(out), "--quiet"]) == 0
+    data = pd.read_csv(out)
+    assert len(data) == 11 and data["model.counter"].tolist() == list(range(11))
+    assert main(["run", str(typed), "-o", str(out), "--stop-time", "0.5", "--quiet"]) == 0
+    assert len(pd.read_csv(out)) == 6
+    assert main(["run", str(typed), "-o", str(out), "--step", "0", "--quiet"]) == 2
+    assert "step: 0.0: expected a communication step > 0 s" in capsys.readouterr().err
