@@ -282,7 +282,7 @@ def _run_system(args: argparse.Namespace, system, path: Path) -> int:  # noqa: A
     for written in write_run(system, result, output):
         print(f"wrote {written}")
     if result.stopped:
-        print(f"stopped before the stop time: {result.stopped}")
+        print(f"stopped: {result.stopped}")
     print(f"{result.steps} steps of {system.step:g} s ({system.algorithm}) in {result.wall_seconds:.2f} s")
     return 0
 

@@ -168,7 +168,7 @@ def test_rover_cosim_run_exits_0_with_every_row_when_an_fmu_ends_the_simulation(
                       "parameters = { stopAfter = 3 }\n")
     assert main(["run", str(system), "-o", str(tmp_path / "stops.csv"), "--quiet"]) == 0
     out = capsys.readouterr().out
-    assert "stopped before the stop time: a (Typed.fmu) ended the simulation at t = 0.3 s" in out
+    assert "stopped: a (Typed.fmu) ended the simulation at t = 0.3 s" in out
     data = pd.read_csv(tmp_path / "stops.csv")
     assert data["a.counter"].tolist() == [0, 1, 2, 3]
 
