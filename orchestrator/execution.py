@@ -41,6 +41,8 @@ class Execution:
             self.python = ThreadExecutor(self.participants, self.outputs, self.step_seconds, threads)
         else:
             self.python = PythonExecutor(self.participants, self.outputs, self.step_seconds)
+        #: Per stage (by identity): its participants stepped natively and the others, split once.
+        self._splits: dict[int, tuple[list[int], list[int]]] = {}
         algorithm.prepare(self)
 
     def _steppable(self, i: int) -> bool:
@@ -91,12 +93,15 @@ class Execution:
 
     def run_stage(self, stage: Sequence[int], values: np.ndarray, t: float, h: float) -> None:
         """Step the participants of ``stage`` from the values as they are now."""
-        natively = [i for i in stage if i in self.natively]
+        split = self._splits.get(id(stage))
+        if split is None:
+            split = self._splits[id(stage)] = ([i for i in stage if i in self.natively],
+                                               [i for i in stage if i not in self.natively])
+        natively, rest = split
         if not natively:
             self.python.run(stage, [values[self.inputs[i]] for i in stage], values, t, h)
             return
         assert self.native is not None
-        rest = [i for i in stage if i not in self.natively]
         gathered = [values[self.inputs[i]] for i in rest]
         self.check_native(self.native.run_group(values, natively[0], t, h), values, t + h)
         self.python.run(rest, gathered, values, t, h)
