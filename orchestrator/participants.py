@@ -400,31 +400,30 @@ class _Typed:
         unknown = [n for n in names if types[n] not in ("Real", "Integer", "Enumeration", "Boolean")]
         if unknown:
             raise RunError(f"variables {unknown}: type {types[unknown[0]]} cannot be exchanged at every step")
-        self.groups: dict[str, tuple[Any, np.ndarray]] = {}
+        # kind -> (value references, positions, a buffer of the kind's C type), made once
+        self.groups: dict[str, tuple[Any, np.ndarray, Any]] = {}
         for kind in ("Real", "Integer", "Boolean"):
             positions = [k for k, n in enumerate(names) if _call_type(types[n]) == kind]
             if positions:
                 references = (ctypes.c_uint * len(positions))(*[refs[names[k]] for k in positions])
-                self.groups[kind] = (references, np.array(positions, dtype=int))
+                buffer = ((ctypes.c_double if kind == "Real" else ctypes.c_int) * len(positions))()
+                self.groups[kind] = (references, np.array(positions, dtype=int), buffer)
         self.real_only = set(self.groups) <= {"Real"}
 
     def set(self, participant: FmuParticipant, values: np.ndarray, t: float) -> None:
         fmu = participant.fmu
-        for kind, (references, positions) in self.groups.items():
-            if kind == "Real":
-                buffer: Any = (ctypes.c_double * len(positions))(*values[positions].tolist())
-            else:
-                buffer = (ctypes.c_int * len(positions))(*[int(round(v)) for v in values[positions].tolist()])
+        for kind, (references, positions, buffer) in self.groups.items():
+            chosen = values[positions].tolist()
+            buffer[:] = chosen if kind == "Real" else [int(round(v)) for v in chosen]
             participant._call(f"fmi2Set{kind}", partial(getattr(fmu, f"fmi2Set{kind}"), fmu.component, references,
                                                          len(references), buffer), t)
 
     def get(self, participant: FmuParticipant, out: np.ndarray, t: float) -> None:
         fmu = participant.fmu
-        for kind, (references, positions) in self.groups.items():
-            buffer: Any = ((ctypes.c_double if kind == "Real" else ctypes.c_int) * len(positions))()
+        for kind, (references, positions, buffer) in self.groups.items():
             participant._call(f"fmi2Get{kind}", partial(getattr(fmu, f"fmi2Get{kind}"), fmu.component, references,
                                                          len(references), buffer), t)
-            out[positions] = np.array(list(buffer), dtype=float)
+            out[positions] = buffer[:]
 
 
 def _call_type(variable_type: str) -> str:

@@ -196,7 +196,7 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
         except SspError as error:
             raise SystemFileError(str(error)) from None
     elif path.suffix.lower() == ".fmu":
-        system = _one_fmu(path, overrides)
+        return _one_fmu(path, overrides), path  # the overrides are its settings
     else:
         system = load_system(path, fmu_dir=fmu_dir)
     if overrides:
