@@ -55,7 +55,8 @@ from .model import (
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 #: The simulation settings and their defaults (stop_time and step have none).
 SIMULATION_DEFAULTS: dict[str, Any] = {"start_time": 0.0, "algorithm": "gauss-seidel", "order": None,
-                                       "allow_algebraic_loops": False, "threads": None, "native": True}
+                                       "allow_algebraic_loops": False, "threads": None, "native": True,
+                                       "relative_tolerance": 1e-6}
 ITERATION_KEYS = ("tolerance", "max_iterations", "relaxation")
 
 
@@ -77,23 +78,37 @@ def parse_port(text: Any, where: str) -> Port:
 
 
 def read_fmu(fmu_path: Path, where: str) -> Any:
-    """The model description of an FMI 2.0 Co-Simulation FMU file (``where``: the label of messages)."""
+    """The model description of an FMI 2.0 or 3.0 FMU file with a Co-Simulation or Model
+    Exchange interface (``where``: the label of messages); SystemFileError for anything else."""
     if not fmu_path.is_file():
         raise SystemFileError(f"{where}: FMU file {fmu_path} not found (run `make fmus`?)")
     try:
         description = fmpy.read_model_description(str(fmu_path))
     except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds
         raise SystemFileError(f"{where}: {fmu_path} is not a readable FMU: {failure}") from None
-    if description.fmiVersion != "2.0" or description.coSimulation is None:
-        raise SystemFileError(f"{where}: {fmu_path}: expected an FMI 2.0 Co-Simulation FMU (got FMI "
-                              f"{description.fmiVersion}, CS {'yes' if description.coSimulation else 'no'})")
-    _check_binary(fmu_path, description.coSimulation.modelIdentifier, where)
+    version = str(description.fmiVersion)
+    if version.split(".")[0] not in ("2", "3"):
+        raise SystemFileError(f"{where}: {fmu_path.name} is an FMI {version} FMU: expected FMI 2.0 or 3.0")
+    if description.coSimulation is None and description.modelExchange is None:
+        raise SystemFileError(f"{where}: {fmu_path.name} has neither a Co-Simulation nor a Model Exchange interface "
+                              "(Scheduled Execution FMUs are not supported)")
+    clocks = [v.name for v in description.modelVariables if v.type == "Clock"]
+    if clocks:
+        raise SystemFileError(f"{where}: {fmu_path.name} has clocks ({', '.join(clocks[:3])}): FMI 3.0 clocks and "
+                              "clocked variables are not supported")
     return description
 
 
-def _check_binary(fmu_path: Path, identifier: str, where: str) -> None:
+def interfaces_of(description: Any) -> list[str]:
+    """The interfaces an FMU offers (``INTERFACES`` order: Co-Simulation first)."""
+    return [name for name, section in (("co-simulation", description.coSimulation),
+                                       ("model-exchange", description.modelExchange)) if section is not None]
+
+
+def _check_binary(fmu_path: Path, identifier: str, version: int, where: str) -> None:
     """SystemFileError unless the FMU has a binary for this platform, naming the ones it has."""
-    wanted = f"binaries/{fmpy.platform}/{identifier}{fmpy.sharedLibraryExtension}"
+    folder = fmpy.platform if version == 2 else fmpy.platform_tuple
+    wanted = f"binaries/{folder}/{identifier}{fmpy.sharedLibraryExtension}"
     with zipfile.ZipFile(fmu_path) as archive:
         names = archive.namelist()
     if wanted in names:
@@ -185,7 +200,8 @@ class SystemBuilder:
         ``start_time`` [s]; ``algorithm`` (jacobi, gauss-seidel, iterative); ``order`` (instance
         names, Gauss-Seidel order; default: sources, FMUs, other blocks); ``tolerance``,
         ``max_iterations``, ``relaxation`` (iterative only); ``allow_algebraic_loops``;
-        ``threads`` (FMUs stepped at the same time; None: the cores); ``native`` (FMUs stepped from C)."""
+        ``threads`` (FMUs stepped at the same time; None: the cores); ``native`` (FMUs stepped from C);
+        ``relative_tolerance`` (of the integrator of Model Exchange FMUs, and told to every FMU)."""
         if where is not None:
             self._settings.where = where
         accepted = {"stop_time", "step", *SIMULATION_DEFAULTS, *ITERATION_KEYS}
@@ -224,6 +240,10 @@ class SystemBuilder:
         if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
             raise self.error(f"{where} threads", f"{threads!r}: expected a whole number >= 1 (FMUs stepped "
                              "at the same time)")
+        tolerance = self._number(values["relative_tolerance"], f"{where} relative_tolerance")
+        if not 0 < tolerance < 1:
+            raise self.error(f"{where} relative_tolerance", f"{tolerance!r}: expected 0 < relative_tolerance < 1 "
+                             "(of the integrator of Model Exchange FMUs)")
         if not isinstance(values["native"], bool):
             raise self.error(f"{where} native", f"{values['native']!r}: expected true or false (FMUs stepped from C)")
 
@@ -260,9 +280,12 @@ class SystemBuilder:
             self.claim(name, where)
 
     def add_fmu(self, name: str, path: str | Path, *, parameters: Mapping[str, Any] | None = None,
-                start: Mapping[str, Any] | None = None, where: str | None = None) -> SystemBuilder:
+                start: Mapping[str, Any] | None = None, interface: str | None = None,
+                where: str | None = None) -> SystemBuilder:
         """An FMU instance ``name`` of the FMU file ``path`` (relative: to the builder's base), with
-        parameter values and start values (inputs, and states with an exact start) by variable name."""
+        parameter values and start values (inputs, and states with an exact start) by variable name.
+        ``interface``: "co-simulation" or "model-exchange" (the engine integrates it); default
+        Co-Simulation where the FMU offers it, else Model Exchange."""
         where = where or f"add_fmu({name!r})"
         self._claim_for(name, where)
         if not isinstance(path, (str, Path)):
@@ -270,7 +293,14 @@ class SystemBuilder:
         fmu_path = Path(path)
         if not fmu_path.is_absolute() and self.base is not None:
             fmu_path = self.base / fmu_path
-        entry = FmuEntry(name, fmu_path, {}, {}, read_fmu(fmu_path, f"{self.name}: {where}"))
+        description = read_fmu(fmu_path, f"{self.name}: {where}")
+        offered = interfaces_of(description)
+        chosen = offered[0] if interface is None else interface
+        if chosen not in offered:
+            raise self.error(f"{where} interface", f"{interface!r}: expected one that {fmu_path.name} offers: "
+                             f"{', '.join(offered)}")
+        entry = FmuEntry(name, fmu_path, {}, {}, description, chosen)
+        _check_binary(fmu_path, entry.capabilities.modelIdentifier, entry.fmi_version, f"{self.name}: {where}")
         self._fmus[name] = entry
         self._where[name] = where
         self.set_parameters(name, parameters or {}, where=where)
@@ -291,6 +321,7 @@ class SystemBuilder:
             if variable not in variables:
                 raise self.error(f"{where} {key}", f"{fmu.name} has no variable {variable!r}")
             v = variables[variable]
+            self._scalar(fmu, v, f"{where} {key}")
             if key == "parameters" and v.causality != "parameter":
                 raise self.error(f"{where} parameters", f"{fmu.name}.{variable} is not a parameter "
                                  f"(causality {v.causality}); inputs and states go under start")
@@ -305,6 +336,15 @@ class SystemBuilder:
             except ValueError as problem:
                 raise self.error(f"{where} {key} {variable}", str(problem)) from None
         return checked
+
+    def _scalar(self, fmu: FmuEntry, variable: Any, where: str) -> None:
+        """SystemFileError for an array variable (FMI 3.0 dimensions) or a type that cannot travel."""
+        if getattr(variable, "dimensions", None):
+            raise self.error(where, f"{fmu.name}.{variable.name} is an array (FMI 3.0 dimensions): array variables "
+                             "are not supported (scalar variables are)")
+        if variable.type in ("Binary", "Clock"):
+            raise self.error(where, f"{fmu.name}.{variable.name} is a {variable.type}: FMI 3.0 Binary and Clock "
+                             "variables are not supported")
 
     def set_parameters(self, instance: str, values: Mapping[str, Any], *, where: str | None = None,
                        only_known: bool = False) -> SystemBuilder:
@@ -362,7 +402,8 @@ class SystemBuilder:
             if port.variable not in variables:
                 raise self.error(where, f"{fmu.name} ({fmu.path.name}) has no variable {port.variable!r}")
             v = variables[port.variable]
-            return v.causality, v.unit if v.type == "Real" else None
+            self._scalar(fmu, v, where)
+            return v.causality, v.unit if v.type in ("Real", "Float64", "Float32") else None
         if port.instance not in self._blocks:
             names = sorted([*self._fmus, *self._blocks])
             raise self.error(where, f"no instance {port.instance!r}; expected one of {', '.join(names)}")
@@ -401,9 +442,6 @@ class SystemBuilder:
         if not compatible_types(source_type, target_type):
             raise self.error(where, f"type mismatch: {source_port} is {source_type}, {target_port} is {target_type} "
                              "(a connection joins variables of the same type; Integer and Enumeration may meet)")
-        if "String" in (source_type, target_type):
-            raise self.error(where, f"{source_port} -> {target_port}: String connections are not supported yet "
-                             "(String parameters and start values are)")
         if source_unit is not None and target_unit is not None and base_units(source_unit) != base_units(target_unit):
             raise self.error(where, f"unit mismatch: {source_port} is in {source_unit}, {target_port} in {target_unit}")
         if target_port in self._driven:
@@ -420,9 +458,6 @@ class SystemBuilder:
         for text in ports:
             port = parse_port(text, f"{self.name}: {where}")
             self._lookup(port, f"{where} {str(text)!r}")
-            if self._type(port) == "String":
-                raise self.error(f"{where} {str(text)!r}", f"{port} is a String: String variables cannot be recorded "
-                                 "yet (numbers of every other type can)")
             recorded.append(port)
         self._record = recorded
         return self
@@ -464,13 +499,14 @@ class SystemBuilder:
         restores states; a fixed-step FMU gets no shorter last step."""
         values = self._settings.values
         for fmu in self._fmus.values():
-            cs = fmu.description.coSimulation
-            if values["algorithm"] == "iterative" and not cs.canGetAndSetFMUstate:
+            capabilities = fmu.capabilities
+            if values["algorithm"] == "iterative" and not capabilities.canGetAndSetFMUstate:
                 raise self.error(self._where[fmu.name], f"{fmu.name} ({fmu.path.name}) cannot save and restore its "
                                  "state (canGetAndSetFMUstate is false), which the iterative master needs to repeat a "
                                  "step; use algorithm jacobi or gauss-seidel")
             steps = (float(values["stop_time"]) - float(values["start_time"])) / float(values["step"])
-            if not cs.canHandleVariableCommunicationStepSize and abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
+            fixed = fmu.interface == "co-simulation" and not capabilities.canHandleVariableCommunicationStepSize
+            if fixed and abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
                 raise self.error(self._where[fmu.name], f"{fmu.name} ({fmu.path.name}) takes one fixed communication "
                                  "step (canHandleVariableCommunicationStepSize is false): the run must be a whole "
                                  f"number of steps, {steps:.6g} are not")
@@ -487,10 +523,11 @@ class SystemBuilder:
         return [str(name) for name in order]
 
     def _outputs(self, instance: str) -> list[Port]:
-        """What is recorded by default: every output (of every type but String, which cannot be yet)."""
+        """What is recorded by default: every scalar output (FMI 3.0 arrays, Binary and Clock
+        variables are left out)."""
         if instance in self._fmus:
             return [Port(instance, v.name) for v in self._fmus[instance].description.modelVariables
-                    if v.causality == "output" and v.type != "String"]
+                    if v.causality == "output" and v.type not in ("Binary", "Clock") and not v.dimensions]
         return [Port(instance, o) for o in self._blocks[instance].block.outputs]
 
     def _loop(self) -> list[Port] | None:
@@ -523,7 +560,7 @@ class SystemBuilder:
                       list(self._connections), float(values["step"]), float(values["stop_time"]),
                       float(values["start_time"]), values["algorithm"], order, list(record), iteration, loop,
                       values["threads"], values["native"], values["allow_algebraic_loops"], self.name,
-                      dict(self._settings_from))
+                      dict(self._settings_from), float(values["relative_tolerance"]))
 
     @classmethod
     def from_system(cls, system: System, name: str | None = None) -> SystemBuilder:
@@ -533,7 +570,7 @@ class SystemBuilder:
         settings: dict[str, Any] = {"stop_time": system.stop_time, "step": system.step, "start_time": system.start_time,
                     "algorithm": system.algorithm, "order": list(system.order),
                     "allow_algebraic_loops": system.allow_algebraic_loops, "threads": system.threads_setting,
-                    "native": system.native}
+                    "native": system.native, "relative_tolerance": system.relative_tolerance}
         if system.algorithm == "iterative":
             settings.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,
                             relaxation=system.iteration.relaxation)
@@ -551,7 +588,7 @@ class SystemBuilder:
 
 
 def _copy_fmu(fmu: FmuEntry) -> FmuEntry:
-    return FmuEntry(fmu.name, fmu.path, dict(fmu.parameters), dict(fmu.start), fmu.description)
+    return FmuEntry(fmu.name, fmu.path, dict(fmu.parameters), dict(fmu.start), fmu.description, fmu.interface)
 
 
 def replace_settings(system: System, *, name: str | None = None, **settings: Any) -> System:

@@ -16,7 +16,9 @@ from contextlib import ExitStack, contextmanager
 import numpy as np
 
 from .execution import Execution, make_execution
+from .fmi_access import StringTable
 from .model import FmuEntry, Port, System
+from .model_exchange import make_fmu_participant
 from .observers import (
     FiniteCheck,
     Observer,
@@ -28,7 +30,7 @@ from .observers import (
     check_finite,
     watches_every_step,
 )
-from .participants import BlockParticipant, FmuParticipant, Participant, RunError, Terminated
+from .participants import BlockParticipant, Participant, RunError, Terminated
 from .recorder import Recorder, RunResult, communication_points
 from .unpacking import UNZIP_PREFIX, remove_stale_folders, run_folder
 from .wiring import Wiring, wire
@@ -68,14 +70,17 @@ def initialize(participants: list[Participant], wiring: Wiring, values: np.ndarr
 
 
 @contextmanager
-def participants_of(system: System, wiring: Wiring) -> Iterator[list[Participant]]:
+def participants_of(system: System, wiring: Wiring,
+                    strings: StringTable | None = None) -> Iterator[list[Participant]]:
     """The participants of ``system`` in its order, FMUs unpacked into this run's temporary
-    folder (``unpacking``); every FMU is terminated and freed on leaving, whatever happened."""
+    folder (``unpacking``); every FMU is terminated and freed on leaving, whatever happened.
+    ``strings``: the run's String table (the recorder reads the recorded Strings from it)."""
+    strings = strings if strings is not None else StringTable()
     with ExitStack() as stack:
         unzip_root = stack.enter_context(run_folder())
         by_name: dict[str, Participant] = {}
         for entry in system.fmus:
-            fmu = FmuParticipant(entry, unzip_root)
+            fmu = make_fmu_participant(entry, unzip_root, strings, system.relative_tolerance)
             stack.callback(fmu.close)
             ports = wiring.participants[entry.name]
             fmu.configure(ports.inputs, ports.outputs)
@@ -128,12 +133,13 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
     wiring = wire(system, watched)
     times = communication_points(system.start_time, system.stop_time, system.step)
     n_steps = len(times) - 1
-    with participants_of(system, wiring) as participants, ExitStack() as stack:
-        values = wiring.initial_values()
+    strings = StringTable()
+    with participants_of(system, wiring, strings) as participants, ExitStack() as stack:
+        values = wiring.initial_values(strings)
         initialize(participants, wiring, values, system.start_time, system.stop_time)
         execution = make_execution(system, participants, wiring)
         stack.callback(execution.close)
-        recorder = Recorder(system.record, wiring.record_slots, times, _types(system, system.record))
+        recorder = Recorder(system.record, wiring.record_slots, times, _types(system, system.record), strings)
         watchers: list[Watcher] = [FiniteCheck(execution, execution.checked_in_python), Recording(recorder)]
         offset = 0
         for observer in observers:

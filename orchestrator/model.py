@@ -18,10 +18,19 @@ from typing import Any
 from .blocks import Block
 
 ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
-#: The FMI 2.0 variable types, and the Python type of a value of each.
-VARIABLE_TYPES = {"Real": float, "Integer": int, "Enumeration": int, "Boolean": bool, "String": str}
-#: A parameter or start value, typed as its variable (Real: float, Integer and Enumeration: int,
-#: Boolean: bool, String: str).
+#: How an FMU is run: its Co-Simulation interface (it steps itself) or its Model Exchange
+#: interface (the engine integrates it, ``model_exchange``).
+INTERFACES = ("co-simulation", "model-exchange")
+#: Whole-number FMI types and their ranges (FMI 2.0 Integer is 32-bit; FMI 3.0 has eight).
+INTEGER_RANGES = {"Integer": (-2**31, 2**31), "Int8": (-2**7, 2**7), "UInt8": (0, 2**8), "Int16": (-2**15, 2**15),
+                  "UInt16": (0, 2**16), "Int32": (-2**31, 2**31), "UInt32": (0, 2**32), "Int64": (-2**63, 2**63),
+                  "UInt64": (0, 2**64), "Enumeration": (-2**63, 2**63)}
+#: The scalar variable types of FMI 2.0 and 3.0 the engine exchanges, and the Python type of a
+#: value of each.
+VARIABLE_TYPES: dict[str, type] = {"Real": float, "Float64": float, "Float32": float,
+                                   **dict.fromkeys(INTEGER_RANGES, int), "Boolean": bool, "String": str}
+#: A parameter or start value, typed as its variable (Real and Float: float, whole-number types
+#: and Enumeration: int, Boolean: bool, String: str).
 Value = float | int | bool | str
 
 
@@ -30,21 +39,23 @@ def _whole(value: object, variable_type: str) -> int:
         value = int(value)
     if isinstance(value, bool) or not isinstance(value, int):
         raise ValueError(f"{value!r}: expected a whole number ({variable_type})")
-    if not -2**31 <= value < 2**31:
-        raise ValueError(f"{value!r}: expected a whole number within the 32-bit range of an FMI {variable_type}")
+    low, high = INTEGER_RANGES[variable_type]
+    if not low <= value < high:
+        raise ValueError(f"{value!r}: expected a whole number from {low} to {high - 1} (FMI {variable_type})")
     return value
 
 
 def typed_value(value: object, variable_type: str) -> Value:
     """``value`` as a value of an FMI variable of ``variable_type``; ValueError saying what was
-    expected (a number for Real, a whole number for Integer and Enumeration, true or false for
-    Boolean, text for String)."""
-    if variable_type in ("Integer", "Enumeration"):
+    expected (a number for Real and Float, a whole number in range for the integer types and
+    Enumeration, true or false for Boolean, text for String)."""
+    if variable_type in INTEGER_RANGES:
         return _whole(value, variable_type)
-    expected = {"Real": (float, "a number"), "Boolean": (bool, "true or false"), "String": (str, "text")}
-    if variable_type not in expected:
-        raise ValueError(f"a variable of type {variable_type!r}: expected one of {', '.join(VARIABLE_TYPES)}")
-    kind, text = expected[variable_type]
+    if variable_type not in VARIABLE_TYPES:
+        raise ValueError(f"a variable of type {variable_type!r}: expected one of {', '.join(VARIABLE_TYPES)} "
+                         "(FMI 3.0 Binary and Clock variables are not supported)")
+    kind = VARIABLE_TYPES[variable_type]
+    text = {float: "a number", bool: "true or false", str: "text"}[kind]
     if kind is float and isinstance(value, int) and not isinstance(value, bool):
         return float(value)
     if not isinstance(value, kind) or (kind is float and isinstance(value, bool)):
@@ -53,8 +64,8 @@ def typed_value(value: object, variable_type: str) -> Value:
 
 
 def numeric(value: Value) -> float:
-    """A value of a Real, Integer, Enumeration or Boolean variable as it is held in the value
-    vector of a run (a float: whole numbers up to 2^53 and true/false as 1.0/0.0 exactly)."""
+    """A value of a number, Enumeration or Boolean variable as it is held in the value vector of
+    a run (a float: whole numbers up to 2^53 and true/false as 1.0/0.0 exactly)."""
     if isinstance(value, str):
         raise ValueError(f"{value!r}: a String has no place in the value vector")
     return float(value)
@@ -62,23 +73,32 @@ def numeric(value: Value) -> float:
 
 def declared_start(variable: Any) -> Value | None:
     """The start value a model description declares for ``variable`` (FMPy keeps it as text),
-    typed as the variable; None where it declares none."""
+    typed as the variable; None where it declares none (or an array's several values)."""
     text = variable.start
     if text is None:
         return None
-    if variable.type == "Real":
-        return float(text)
-    if variable.type in ("Integer", "Enumeration"):
-        return int(text)
-    if variable.type == "Boolean":
+    kind = VARIABLE_TYPES.get(str(variable.type))
+    if kind is str:
+        return str(text)
+    if kind is bool:
         return str(text).strip().lower() in ("true", "1")
-    return str(text)
+    if len(str(text).split()) != 1:
+        return None
+    return int(text) if kind is int else float(text)
+
+
+#: Types that are one another under another name (FMI 2.0 Real is FMI 3.0 Float64, Integer Int32).
+SAME_TYPE = {"Real": "Float64", "Integer": "Int32"}
 
 
 def compatible_types(source: str, target: str) -> bool:
-    """Whether an output of type ``source`` may drive an input of type ``target`` (the same type;
-    Integer and Enumeration either way, as FMI allows)."""
-    return source == target or {source, target} == {"Integer", "Enumeration"}
+    """Whether an output of type ``source`` may drive an input of type ``target``: the same type
+    (FMI 2.0 Real and FMI 3.0 Float64 are; Integer and Int32 are), and an Enumeration with a
+    whole-number type either way, as FMI allows."""
+    source, target = SAME_TYPE.get(source, source), SAME_TYPE.get(target, target)
+    if source == target:
+        return True
+    return "Enumeration" in (source, target) and source in INTEGER_RANGES and target in INTEGER_RANGES
 
 
 class SystemFileError(ValueError):
@@ -125,12 +145,26 @@ class FmuEntry:
     parameters: dict[str, Value]
     start: dict[str, Value]
     description: Any  # fmpy ModelDescription
+    #: Which of the FMU's interfaces runs it (``INTERFACES``).
+    interface: str = "co-simulation"
 
     def variables(self) -> dict[str, Any]:
         return {v.name: v for v in self.description.modelVariables}
 
+    @property
+    def fmi_version(self) -> int:
+        """2 or 3 (the major FMI version of the model description)."""
+        return int(str(self.description.fmiVersion).split(".")[0])
+
+    @property
+    def capabilities(self) -> Any:
+        """The model description's section of the interface that runs it (FMPy's CoSimulation or
+        ModelExchange: modelIdentifier, canGetAndSetFMUstate, ...)."""
+        d = self.description
+        return d.coSimulation if self.interface == "co-simulation" else d.modelExchange
+
     def variable_type(self, name: str) -> str:
-        """The FMI type of the variable ``name`` (Real, Integer, Enumeration, Boolean, String)."""
+        """The FMI type of the variable ``name`` (Real, Integer, ..., Float64, Int8, ...)."""
         return str(self.variables()[name].type)
 
 
@@ -177,6 +211,8 @@ class System:
     name: str = "system"        # what messages call the system
     #: Settings taken from elsewhere than the system's own (e.g. {"step": "DefaultExperiment ..."}).
     settings_from: dict[str, str] = field(default_factory=dict)
+    #: Relative tolerance of the integrator of Model Exchange FMUs (CVode).
+    relative_tolerance: float = 1e-6
 
     @property
     def threads(self) -> int:

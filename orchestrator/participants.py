@@ -1,8 +1,10 @@
 """Participants of a co-simulation: the protocol the masters step, and its two kinds.
 
-- :class:`FmuParticipant`: an FMU instance, FMPy's FMI 2.0 slave with batched, preallocated value
-  exchange (one fmi2SetReal of all connected inputs and one fmi2GetReal of all needed variables
-  per step), errors turned into :class:`RunError` with the FMU's own message;
+- :class:`FmuParticipant`: an FMU instance run as Co-Simulation (FMI 2.0 or 3.0, FMPy's slave
+  classes) with batched, preallocated value exchange per type (``fmi_access``; one fmi2SetReal of
+  all connected inputs and one fmi2GetReal of all needed variables per step for an all-Real FMI
+  2.0 FMU), errors turned into :class:`RunError` with the FMU's own message; its Model Exchange
+  twin, which the engine integrates, is ``model_exchange.ModelExchangeParticipant``;
 - :class:`BlockParticipant`: a Python block (``blocks.Block``), its exceptions turned into
   :class:`RunError` naming the block.
 
@@ -17,13 +19,13 @@ from __future__ import annotations
 import copy
 import ctypes
 from collections.abc import Callable
-from functools import partial
 from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
 import fmpy
 import numpy as np
 from fmpy.fmi2 import (
+    FMU2Model,
     FMU2Slave,
     defaultCallbacks,
     fmi2CallbackFunctions,
@@ -31,8 +33,10 @@ from fmpy.fmi2 import (
     fmi2LastSuccessfulTime,
     fmi2Terminated,
 )
+from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 from .blocks import Block
+from .fmi_access import Exchange, StringTable, set_by_name
 from .model import FmuEntry, Value
 from .native import NativeBlock, NativeCalls, function_address
 
@@ -185,14 +189,17 @@ class BlockParticipant:
 
 
 class FmuParticipant:
-    """An FMU instance in a run; ``inputs`` are its connected inputs, ``outputs`` the variables
-    read from it (connected or recorded), both fixed by :meth:`configure`."""
+    """An FMU instance run through its Co-Simulation interface (FMI 2.0 or 3.0); ``inputs`` are
+    its connected inputs, ``outputs`` the variables read from it (connected or recorded), both
+    fixed by :meth:`configure`. ``strings``: the run's String table (``fmi_access``)."""
 
     iterative_start = True
 
-    def __init__(self, entry: FmuEntry, unzip_root: Path):
+    def __init__(self, entry: FmuEntry, unzip_root: Path, strings: StringTable | None = None):
         self.name = entry.name
         self.entry = entry
+        self.version = entry.fmi_version
+        self.strings = strings if strings is not None else StringTable()
         self.messages: list[str] = []
         folder = unzip_root / entry.name
         fmpy.extract(str(entry.path), str(folder))
@@ -200,26 +207,50 @@ class FmuParticipant:
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
         self.types = {v.name: str(v.type) for v in md.modelVariables}
         self.variability = {v.name: str(v.variability) for v in md.modelVariables}
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=str(folder),
-                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=entry.name)
-        self._callbacks = fmi2CallbackFunctions()
-        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
-        self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
-        self._callbacks.freeMemory = defaultCallbacks.freeMemory
-        self._call("fmi2Instantiate", lambda: self.fmu.instantiate(callbacks=self._callbacks))
+        self.fmu = self._instantiate(md, folder)
         self.inputs: list[str] = []
         self.outputs: list[str] = []
         self.input_values = np.zeros(0)
         self.read_values = np.zeros(0)
-        self.can_interpolate = bool(getattr(md.coSimulation, "canInterpolateInputs", False))
+        # FMI 3.0 has no fmi3SetRealInputDerivatives: its FMUs get the held values
+        self.can_interpolate = self.version == 2 and bool(getattr(entry.capabilities, "canInterpolateInputs", False))
+        self.configure([], [])
+
+    def _instantiate(self, md: Any, folder: Path) -> Any:
+        """The FMPy object of the FMU's interface, instantiated with a logger that keeps the
+        FMU's error messages."""
+        classes = {(2, "co-simulation"): FMU2Slave, (3, "co-simulation"): FMU3Slave,
+                   (2, "model-exchange"): FMU2Model, (3, "model-exchange"): FMU3Model}
+        cls = classes[(self.version, self.entry.interface)]
+        try:
+            fmu = cls(guid=md.guid, unzipDirectory=str(folder),
+                      modelIdentifier=self.entry.capabilities.modelIdentifier, instanceName=self.entry.name)
+        except Exception as error:  # noqa: BLE001 - FMPy: a library that does not load
+            raise RunError(f"{self.name} ({self.entry.path.name}): its binary for this platform does not load: "
+                           f"{error}") from None
+        if self.version == 2:
+            self._callbacks = fmi2CallbackFunctions()
+            self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+            self._callbacks.allocateMemory = defaultCallbacks.allocateMemory
+            self._callbacks.freeMemory = defaultCallbacks.freeMemory
+            self._call("fmi2Instantiate", lambda: fmu.instantiate(callbacks=self._callbacks))
+        else:
+            kind = "CoSimulation" if self.entry.interface == "co-simulation" else "ModelExchange"
+            self._call(f"fmi3Instantiate{kind}", lambda: fmu.instantiate(logMessage=self._log3))
+        return fmu
 
     def _log(self, env, instance, status, category, message) -> None:
         if status >= 2:  # discard, error, fatal
             self.messages.append(message.decode(errors="replace"))
 
+    def _log3(self, env, status, category, message) -> None:
+        self._log(env, None, status, category, message)
+
     def _call(self, what: str, action: Callable[[], T], t: float | None = None) -> T:
         try:
             return action()
+        except RunError:
+            raise
         except Exception as error:  # noqa: BLE001 - FMPy raises plain Exceptions on fmi2Error
             self.fail(what, t, str(error), getattr(error, "status", None))
             raise  # not reached
@@ -229,14 +260,18 @@ class FmuParticipant:
         ``error``); :class:`Terminated` when a step was discarded because the FMU ended the
         simulation (fmi2Terminated)."""
         if what == "fmi2DoStep" and status == DISCARD and self._terminated():
-            last = self._last_successful_time()
-            reached = last if last is not None and t is not None and last > t else t
-            when = f" at t = {reached:.6g} s" if reached is not None else ""
-            said = f" ({'; '.join(self.messages[-1:])})" if self.messages else ""
-            raise Terminated(f"{self.name} ({self.entry.path.name}) ended the simulation{when}{said}", t or 0.0, last)
+            self.end(t or 0.0, self._last_successful_time())
         detail = "; ".join(self.messages[-3:]) or error
         at = f" at t = {t:.6g} s" if t is not None else ""
         raise RunError(f"{self.name} ({self.entry.path.name}): {what}{at} failed: {detail}") from None
+
+    def end(self, t: float, last: float | None) -> None:
+        """Raise :class:`Terminated`: the FMU ended the simulation in the step from ``t`` (having
+        got to ``last``, where it says)."""
+        reached = last if last is not None and last > t else t
+        said = f" ({'; '.join(self.messages[-1:])})" if self.messages else ""
+        raise Terminated(f"{self.name} ({self.entry.path.name}) ended the simulation at t = {reached:.6g} s{said}",
+                         t, last)
 
     def _last_successful_time(self) -> float | None:
         """fmi2GetRealStatus(fmi2LastSuccessfulTime) [s], None where the FMU cannot say."""
@@ -247,10 +282,10 @@ class FmuParticipant:
 
     @property
     def discrete_inputs(self) -> np.ndarray:
-        """Per connected input: whether it is discrete (not a continuous Real), which the
-        iterative master never interpolates."""
-        return np.array([self.types[n] != "Real" or self.variability.get(n) == "discrete" for n in self.inputs],
-                        dtype=bool)
+        """Per connected input: whether it is discrete (not a continuous Real or Float), which
+        the iterative master never interpolates."""
+        return np.array([self.types[n] not in ("Real", "Float64", "Float32") or self.variability.get(n) == "discrete"
+                         for n in self.inputs], dtype=bool)
 
     def _terminated(self) -> bool:
         """fmi2GetBooleanStatus(fmi2Terminated), False where the FMU cannot say."""
@@ -261,15 +296,19 @@ class FmuParticipant:
 
     @property
     def real_only(self) -> bool:
-        """Whether every input set and variable read is a Real (one fmi2SetReal and one
-        fmi2GetReal per step; the native stepper can step it)."""
-        return self._inputs.real_only and self._reads.real_only
+        """Whether this is an FMI 2.0 Co-Simulation FMU whose every input set and variable read
+        is a Real (one fmi2SetReal and one fmi2GetReal per step; the native stepper can step it)."""
+        return (self.version == 2 and self.entry.interface == "co-simulation" and self._inputs.real_only
+                and self._reads.real_only)
 
     def configure(self, inputs: list[str], reads: list[str]) -> None:
         """Fix the inputs set and the variables read at every step (preallocated arrays)."""
         self.inputs, self.outputs = list(inputs), list(reads)
-        self._inputs = _Typed(self.inputs, self.types, self.refs)
-        self._reads = _Typed(self.outputs, self.types, self.refs)
+        try:
+            self._inputs = Exchange(self.version, self.inputs, self.types, self.refs, self.strings)
+            self._reads = Exchange(self.version, self.outputs, self.types, self.refs, self.strings)
+        except ValueError as problem:
+            raise RunError(f"{self.name} ({self.entry.path.name}): {problem}") from None
         self._in_refs = (ctypes.c_uint * max(1, len(inputs)))(*[self.refs[n] for n in inputs])
         self._read_refs = (ctypes.c_uint * max(1, len(reads)))(*[self.refs[n] for n in reads])
         self.input_values = np.zeros(len(inputs))
@@ -297,22 +336,29 @@ class FmuParticipant:
         """Value references of the variables read, in the order of configure."""
         return list(self._read_refs)[:len(self.outputs)]
 
-    def set_values(self, names: dict[str, Value]) -> None:
+    def set_values(self, names: dict[str, Value], t: float | None = None) -> None:
         """Set variables by name, one call per FMI type (fmi2SetReal, fmi2SetInteger, ...)."""
-        by_type: dict[str, dict[str, Value]] = {}
-        for name, value in names.items():
-            kind = "Integer" if self.types[name] == "Enumeration" else self.types[name]
-            by_type.setdefault(kind, {})[name] = value
-        for kind, values in by_type.items():
-            self._call(f"fmi2Set{kind}", partial(getattr(self.fmu, f"set{kind}"), [self.refs[n] for n in values],
-                                                 list(values.values())))
+        if names:
+            set_by_name(self.fmu, self.version, names, self.types, self.refs,
+                        lambda what, act: self._call(what, act, t))
 
     def enter_initialization(self, t0: float, stop_time: float) -> None:
-        """fmi2SetupExperiment, the parameters and start values, fmi2EnterInitializationMode."""
-        self._call("fmi2SetupExperiment", lambda: self.fmu.setupExperiment(startTime=t0, stopTime=stop_time))
+        """The parameters and start values and Initialization Mode (FMI 2.0: after
+        fmi2SetupExperiment; FMI 3.0: fmi3EnterInitializationMode with the start and stop time)."""
+        fmu = self.fmu
+        if self.version == 2:
+            self._call("fmi2SetupExperiment", lambda: fmu.setupExperiment(tolerance=self.tolerance, startTime=t0,
+                                                                          stopTime=stop_time))
         self.set_values(self.entry.parameters)
         self.set_values(self.entry.start)
-        self._call("fmi2EnterInitializationMode", self.fmu.enterInitializationMode)
+        if self.version == 2:
+            self._call("fmi2EnterInitializationMode", fmu.enterInitializationMode)
+        else:
+            self._call("fmi3EnterInitializationMode",
+                       lambda: fmu.enterInitializationMode(tolerance=self.tolerance, startTime=t0, stopTime=stop_time))
+
+    #: The tolerance told to the FMU at its start (None: the FMU's own choice).
+    tolerance: float | None = None
 
     def initial_outputs(self, t0: float, u: np.ndarray) -> np.ndarray:
         self.set_inputs(u, t0)
@@ -320,12 +366,15 @@ class FmuParticipant:
 
     def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray:
         self.set_inputs(u, t0)
-        self._call("fmi2ExitInitializationMode", self.fmu.exitInitializationMode)
+        self._call(f"fmi{self.version}ExitInitializationMode", self.fmu.exitInitializationMode)
         return self.get_outputs(t0)
+
+    def _exchange(self, what: str, t: float) -> Callable[[str, Callable[[], Any]], Any]:
+        return lambda call, action: self._call(call, action, t)
 
     def set_inputs(self, values: np.ndarray, t: float) -> None:
         """Set all connected inputs (values in the order given to configure): one fmi2SetReal
-        for Real inputs, one call per other type present."""
+        for Real inputs of an FMI 2.0 FMU, else one call per type present."""
         if not self.inputs:
             return
         self.input_values[:] = values
@@ -333,22 +382,28 @@ class FmuParticipant:
             self._call("fmi2SetReal", lambda: self.fmu.fmi2SetReal(self.fmu.component, self._in_refs,
                                                                    len(self.inputs), self._in_pointer), t)
         else:
-            self._inputs.set(self, self.input_values, t)
+            self._inputs.set(self.fmu, self.input_values, self._exchange("set", t))
 
     def get_outputs(self, t: float) -> np.ndarray:
-        """All read variables (one fmi2GetReal for Real ones, one call per other type present);
-        the returned array is reused by the next call."""
+        """All read variables (one fmi2GetReal for Real ones of an FMI 2.0 FMU, else one call per
+        type present); the returned array is reused by the next call."""
         if self.outputs and self._reads.real_only:
             self._call("fmi2GetReal", lambda: self.fmu.fmi2GetReal(self.fmu.component, self._read_refs,
                                                                    len(self.outputs), self._read_pointer), t)
         elif self.outputs:
-            self._reads.get(self, self.read_values, t)
+            self._reads.get(self.fmu, self.read_values, self._exchange("get", t))
         return self.read_values
 
     def do_step(self, t: float, h: float, u: np.ndarray, slopes: np.ndarray | None = None) -> None:
         """Set the inputs at ``t`` (held over the step, or interpolated with ``slopes`` [1/s] where
-        the FMU can interpolate inputs), then fmi2DoStep from ``t`` to ``t + h``."""
+        the FMU can interpolate inputs), then fmi2DoStep (fmi3DoStep) from ``t`` to ``t + h``;
+        :class:`Terminated` where the FMU ends the simulation in the step."""
         self.set_inputs(u, t)
+        if self.version == 3:
+            ended, last = self._call("fmi3DoStep", lambda: self.fmu.doStep(t, h, True)[1::2], t)
+            if ended:
+                self.end(t, last)
+            return
         if slopes is not None and self.inputs and self._inputs.real_only:
             self.input_slopes[:] = slopes
             self._call("fmi2SetRealInputDerivatives",
@@ -357,29 +412,37 @@ class FmuParticipant:
         self._call("fmi2DoStep", lambda: self.fmu.fmi2DoStep(self.fmu.component, t, h, 1), t)
 
     def reset(self) -> None:
-        """fmi2Reset: back to the state after instantiation (a new run on the same instance)."""
-        self._call("fmi2Reset", self.fmu.reset)
+        """fmi2Reset (fmi3Reset): back to the state after instantiation (a new run on the same instance)."""
+        self._call(f"fmi{self.version}Reset", self.fmu.reset)
 
     def terminate(self) -> None:
-        """fmi2Terminate at the end of a run (the instance may then be reset)."""
-        self._call("fmi2Terminate", self.fmu.terminate)
+        """fmi2Terminate (fmi3Terminate) at the end of a run (the instance may then be reset)."""
+        self._call(f"fmi{self.version}Terminate", self.fmu.terminate)
 
     def get_state(self, t: float) -> Any:
-        """fmi2GetFMUstate: a copy of the whole instance (integrator memory included)."""
-        return self._call("fmi2GetFMUstate", self.fmu.getFMUstate, t)
+        """fmi2GetFMUstate (fmi3GetFMUState): a copy of the whole instance (integrator memory included)."""
+        if self.version == 2:
+            return self._call("fmi2GetFMUstate", self.fmu.getFMUstate, t)
+        return self._call("fmi3GetFMUState", self.fmu.getFMUState, t)
 
     def set_state(self, state: Any, t: float) -> None:
-        self._call("fmi2SetFMUstate", lambda: self.fmu.setFMUstate(state), t)
+        if self.version == 2:
+            self._call("fmi2SetFMUstate", lambda: self.fmu.setFMUstate(state), t)
+        else:
+            self._call("fmi3SetFMUState", lambda: self.fmu.setFMUState(state), t)
 
     def free_state(self, state: Any) -> None:
-        self._call("fmi2FreeFMUstate", lambda: self.fmu.freeFMUstate(state))
+        if self.version == 2:
+            self._call("fmi2FreeFMUstate", lambda: self.fmu.freeFMUstate(state))
+        else:
+            self._call("fmi3FreeFMUState", lambda: self.fmu.freeFMUState(state))
 
     def close(self) -> None:
-        for what, action in (("fmi2Terminate", self.fmu.terminate), ("fmi2FreeInstance", self.fmu.freeInstance)):
+        for what, action in (("terminate", self.fmu.terminate), ("freeInstance", self.fmu.freeInstance)):
             try:
                 action()
             except Exception:  # noqa: BLE001 - closing after a failure must not mask it
-                if what == "fmi2FreeInstance":
+                if what == "freeInstance":
                     break
         try:
             self.fmu.freeLibrary()
@@ -389,43 +452,3 @@ class FmuParticipant:
 
 #: fmi2Status fmi2Discard.
 DISCARD = 2
-
-
-class _Typed:
-    """Variables of an FMU grouped by FMI type for the fmi2Set/Get calls: value references and
-    positions (in the caller's order) per type. Integer and Enumeration share fmi2Get/SetInteger;
-    Booleans travel as fmi2Boolean (an int) and are held as 1.0 / 0.0."""
-
-    def __init__(self, names: list[str], types: dict[str, str], refs: dict[str, int]):
-        unknown = [n for n in names if types[n] not in ("Real", "Integer", "Enumeration", "Boolean")]
-        if unknown:
-            raise RunError(f"variables {unknown}: type {types[unknown[0]]} cannot be exchanged at every step")
-        # kind -> (value references, positions, a buffer of the kind's C type), made once
-        self.groups: dict[str, tuple[Any, np.ndarray, Any]] = {}
-        for kind in ("Real", "Integer", "Boolean"):
-            positions = [k for k, n in enumerate(names) if _call_type(types[n]) == kind]
-            if positions:
-                references = (ctypes.c_uint * len(positions))(*[refs[names[k]] for k in positions])
-                buffer = ((ctypes.c_double if kind == "Real" else ctypes.c_int) * len(positions))()
-                self.groups[kind] = (references, np.array(positions, dtype=int), buffer)
-        self.real_only = set(self.groups) <= {"Real"}
-
-    def set(self, participant: FmuParticipant, values: np.ndarray, t: float) -> None:
-        fmu = participant.fmu
-        for kind, (references, positions, buffer) in self.groups.items():
-            chosen = values[positions].tolist()
-            buffer[:] = chosen if kind == "Real" else [int(round(v)) for v in chosen]
-            participant._call(f"fmi2Set{kind}", partial(getattr(fmu, f"fmi2Set{kind}"), fmu.component, references,
-                                                         len(references), buffer), t)
-
-    def get(self, participant: FmuParticipant, out: np.ndarray, t: float) -> None:
-        fmu = participant.fmu
-        for kind, (references, positions, buffer) in self.groups.items():
-            participant._call(f"fmi2Get{kind}", partial(getattr(fmu, f"fmi2Get{kind}"), fmu.component, references,
-                                                         len(references), buffer), t)
-            out[positions] = buffer[:]
-
-
-def _call_type(variable_type: str) -> str:
-    """The type whose fmi2Get/Set functions a variable uses (Enumeration: Integer's)."""
-    return "Integer" if variable_type == "Enumeration" else variable_type

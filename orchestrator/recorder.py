@@ -8,7 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .model import Port
+from .fmi_access import StringTable
+from .model import INTEGER_RANGES, Port
 
 
 def communication_points(t0: float, stop_time: float, h: float) -> np.ndarray:
@@ -26,11 +27,14 @@ class Recorder:
     """One row per communication point ``times``; :meth:`sample` copies the recorded slots of the
     value vector into row ``k``; :meth:`frame` gives time [s] and one column per port (the rows
     sampled so far, when a run stops early), typed as the variables (``types``: their FMI types;
-    Integer and Enumeration columns as whole numbers, Boolean ones as true/false; default Real)."""
+    whole-number and Enumeration columns as integers, Boolean ones as true/false, String ones as
+    text from the run's ``strings``; default Real)."""
 
-    def __init__(self, ports: list[Port], slots: np.ndarray, times: np.ndarray, types: list[str] | None = None):
+    def __init__(self, ports: list[Port], slots: np.ndarray, times: np.ndarray, types: list[str] | None = None,
+                 strings: StringTable | None = None):
         self.columns = [str(port) for port in ports]
         self.types = types or ["Real"] * len(ports)
+        self.strings = strings
         self.slots = slots
         self.times = times
         self.rows = np.empty((len(times), slots.size))
@@ -43,10 +47,15 @@ class Recorder:
     def frame(self) -> pd.DataFrame:
         data = pd.DataFrame(self.rows[:self.filled], columns=self.columns)
         for column, kind in zip(self.columns, self.types):
-            if kind in ("Integer", "Enumeration"):
-                data[column] = data[column].astype("int64")
+            if kind in INTEGER_RANGES:
+                data[column] = data[column].astype("uint64" if kind == "UInt64" else "int64")
             elif kind == "Boolean":
                 data[column] = data[column] != 0.0
+            elif kind == "String":
+                strings = self.strings or StringTable()
+                data[column] = [strings.text(v) for v in data[column]]
+            elif kind == "Float32":
+                data[column] = data[column].astype("float32")
         data.insert(0, "time", self.times[:self.filled])
         return data
 

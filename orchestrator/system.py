@@ -12,10 +12,12 @@ algorithm = "gauss-seidel" # or "jacobi"
 # order = ["torque", "body", "wheel1"]   # Gauss-Seidel order (default: sources, FMUs, other blocks)
 # threads = 2              # FMUs stepped at the same time (default: the cores)
 # native = true            # FMUs stepped from C (orchestrator.native; default true)
+# relative_tolerance = 1e-6 # of the integrator of Model Exchange FMUs (CVode)
 
 [[fmu]]
 name = "body"
 path = "RoverBody.fmu"     # relative to this file (or to --fmu-dir)
+# interface = "model-exchange"   # run its ME interface (the engine integrates it); default CS where offered
 parameters = { "rover.M" = 1570.0 }
 start = { }                # start values of inputs (and of states with an exact start)
 
@@ -50,6 +52,7 @@ from .blocks import make_block
 from .builder import SIMULATION_DEFAULTS, SystemBuilder, dependency_graph, optional_inputs
 from .model import (
     ALGORITHMS,
+    INTERFACES,
     BlockEntry,
     Connection,
     FmuEntry,
@@ -62,8 +65,8 @@ from .model import (
 #: The keys each section of a system file may have.
 SECTION_KEYS = {
     "simulation": {"stop_time", "step", "start_time", "algorithm", "order", "tolerance", "max_iterations",
-                   "relaxation", "allow_algebraic_loops", "threads", "native"},
-    "fmu": {"name", "path", "parameters", "start"},
+                   "relaxation", "allow_algebraic_loops", "threads", "native", "relative_tolerance"},
+    "fmu": {"name", "path", "parameters", "start", "interface"},
     "connection": {"from", "to"},
     "record": {"variables"},
 }
@@ -146,7 +149,10 @@ def _read_fmu_entry(builder: SystemBuilder, entry: dict[str, Any], number: int) 
     if not isinstance(entry["path"], str):
         raise builder.error(where, f"path = {entry['path']!r}: expected a file name")
     values = {key: _table(entry.get(key), f"{builder.name}: {where} {key}") for key in ("parameters", "start")}
-    builder.add_fmu(instance, entry["path"], where=where, **values)
+    interface = entry.get("interface")
+    if interface is not None and interface not in INTERFACES:
+        raise builder.error(f"{where} interface", f"{interface!r}: expected one of {', '.join(INTERFACES)}")
+    builder.add_fmu(instance, entry["path"], where=where, interface=interface, **values)
 
 
 def _read_block_entry(builder: SystemBuilder, entry: dict[str, Any], number: int, folder: Path | None) -> None:
@@ -171,7 +177,7 @@ def system_to_dict(system: System, folder: Path | None = None) -> dict[str, Any]
     simulation: dict[str, Any] = {"stop_time": system.stop_time, "step": system.step}
     settings = {"start_time": system.start_time, "algorithm": system.algorithm, "order": list(system.order),
                 "allow_algebraic_loops": system.allow_algebraic_loops, "threads": system.threads_setting,
-                "native": system.native}
+                "native": system.native, "relative_tolerance": system.relative_tolerance}
     simulation.update({k: v for k, v in settings.items() if v is not None and v != SIMULATION_DEFAULTS.get(k)})
     if system.algorithm == "iterative":
         simulation.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,
@@ -180,6 +186,8 @@ def system_to_dict(system: System, folder: Path | None = None) -> dict[str, Any]
     data["fmu"] = []
     for f in system.fmus:
         entry: dict[str, Any] = {"name": f.name, "path": _relative(f.path, folder)}
+        if f.interface != "co-simulation":
+            entry["interface"] = f.interface
         entry.update({key: dict(values) for key, values in (("parameters", f.parameters), ("start", f.start))
                       if values})
         data["fmu"].append(entry)

@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .model import FmuEntry, Port, System, declared_start, numeric
+from .fmi_access import StringTable
+from .model import FmuEntry, Port, System, Value, declared_start, numeric
 
 
 @dataclass
@@ -30,15 +31,19 @@ class ParticipantWiring:
 class Wiring:
     participants: dict[str, ParticipantWiring]  # by instance name
     record_slots: np.ndarray                     # slots of system.record, in its order
-    constants: dict[int, float]                  # slot -> value of unconnected FMU inputs
+    constants: dict[int, Value]                  # slot -> value of unconnected FMU inputs
     size: int                                    # length of the value vector
     extra_slots: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))  # of wire()'s extra ports
 
-    def initial_values(self) -> np.ndarray:
-        """The value vector before initialization: zeros and the constant inputs."""
+    def initial_values(self, strings: StringTable | None = None) -> np.ndarray:
+        """The value vector before initialization: zeros and the constant inputs (a String as its
+        number in the run's ``strings``)."""
         values = np.zeros(self.size)
         for slot, value in self.constants.items():
-            values[slot] = value
+            if isinstance(value, str):
+                values[slot] = strings.number(value) if strings is not None else 0.0
+            else:
+                values[slot] = numeric(value)
         return values
 
 
@@ -60,7 +65,7 @@ class _Builder:
         self.entries = system.participants()
         self.slots = _Slots()
         self.reads: dict[str, list[str]] = {name: [] for name in self.entries}
-        self.constants: dict[int, float] = {}
+        self.constants: dict[int, Value] = {}
 
     def slot_of(self, port: Port) -> int:
         """The slot holding the value of ``port`` (a connected input resolves to its source)."""
@@ -72,7 +77,7 @@ class _Builder:
             if variable.causality == "input":  # not connected: its start value, constant in time
                 slot = self.slots(port)
                 start = entry.start.get(port.variable, declared_start(variable))
-                self.constants[slot] = numeric(start) if start is not None else 0.0
+                self.constants[slot] = start if start is not None else 0.0
                 return slot
             if port.variable not in self.reads[port.instance]:
                 self.reads[port.instance].append(port.variable)

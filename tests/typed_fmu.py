@@ -5,15 +5,11 @@ against the FMI 2.0 headers FMPy ships; None (and why) where no compiler works."
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
-import zipfile
 from pathlib import Path
 
 import fmpy
+from c_fmu import compile_fmu
 
-SOURCE = Path(__file__).with_name("fmus") / "typed.c"
 GUID = "{7c1e5c4e-typed-fmu-rover-cosim-tests}"
 
 #: (name, type, value reference, causality, variability, start, dependencies of an output)
@@ -31,6 +27,8 @@ VARIABLES = [
     ("b", "Boolean", 1, "input", "discrete", "false", None),
     ("notb", "Boolean", 2, "output", "discrete", None, "b"),
     ("label", "String", 0, "parameter", "fixed", "none", None),
+    ("s", "String", 1, "input", "discrete", "", None),
+    ("sout", "String", 2, "output", "discrete", None, "s"),
 ]
 
 
@@ -66,22 +64,8 @@ def model_description(states: bool = False, fixed_step: bool = False) -> str:
 
 
 def build_typed_fmu(folder: Path, name: str = "Typed", states: bool = False, fixed_step: bool = False,
-                    platform: str = "linux64") -> Path | str:
+                    platform: str | None = None) -> Path | str:
     """``folder``/``name``.fmu, or why it could not be built. ``states``: it says it can get and
     set its state; ``fixed_step``: that it takes one fixed step; ``platform``: where its binary goes."""
-    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if not compiler:
-        return "no C compiler ($CC, cc or gcc) on PATH"
-    headers = Path(fmpy.__file__).parent / "c-code"
-    work = folder / f"{name}-build"
-    (work / "binaries" / "linux64").mkdir(parents=True, exist_ok=True)
-    library = work / "binaries" / "linux64" / "Typed.so"
-    done = subprocess.run([compiler, "-shared", "-fPIC", "-O1", f"-I{headers}", str(SOURCE), "-o", str(library)],
-                          capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        return f"{compiler} failed: {done.stderr.strip()[:300]}"
-    fmu = folder / f"{name}.fmu"
-    with zipfile.ZipFile(fmu, "w") as archive:
-        archive.writestr("modelDescription.xml", model_description(states, fixed_step))
-        archive.write(library, f"binaries/{platform}/Typed.so")
-    return fmu
+    return compile_fmu("typed.c", "Typed", folder, name, model_description(states, fixed_step),
+                       platform or fmpy.platform)

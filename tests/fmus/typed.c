@@ -17,6 +17,8 @@
  *          1 b        input     discrete
  *          2 notb     output    not b (direct feedthrough)
  * String   0 label    parameter (kept, returned by fmi2GetString)
+ *          1 s        input
+ *          2 sout     output    label + ":" + s (direct feedthrough)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,7 +30,7 @@ typedef struct {
     double x, u, gain;
     int counter, k, stop_after;
     int b;
-    char label[128];
+    char label[128], s[128], sout[260];
     int terminated;
     fmi2CallbackFunctions callbacks;
     char name[64];
@@ -51,6 +53,7 @@ static void defaults(Instance *c) {
     c->x = 0.0; c->u = 0.0; c->gain = 2.0;
     c->counter = 0; c->k = 0; c->stop_after = 0; c->b = fmi2False; c->terminated = 0;
     strcpy(c->label, "none");
+    strcpy(c->s, "");
 }
 
 fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String location,
@@ -123,8 +126,12 @@ fmi2Status fmi2GetBoolean(fmi2Component component, const fmi2ValueReference vr[]
 fmi2Status fmi2GetString(fmi2Component component, const fmi2ValueReference vr[], size_t n, fmi2String value[]) {
     Instance *c = component;
     for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 0) return refuse(c, "fmi2GetString: no such String");
-        value[i] = c->label;
+        if (vr[i] == 0) value[i] = c->label;
+        else if (vr[i] == 1) value[i] = c->s;
+        else if (vr[i] == 2) {
+            snprintf(c->sout, sizeof c->sout, "%s:%s", c->label, c->s);
+            value[i] = c->sout;
+        } else return refuse(c, "fmi2GetString: no such String");
     }
     return fmi2OK;
 }
@@ -164,8 +171,10 @@ fmi2Status fmi2SetString(fmi2Component component, const fmi2ValueReference vr[],
                          const fmi2String value[]) {
     Instance *c = component;
     for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 0 || !value[i]) return refuse(c, "fmi2SetString: not the String parameter");
-        snprintf(c->label, sizeof c->label, "%s", value[i]);
+        if (!value[i]) return refuse(c, "fmi2SetString: no text given");
+        if (vr[i] == 0) snprintf(c->label, sizeof c->label, "%s", value[i]);
+        else if (vr[i] == 1) snprintf(c->s, sizeof c->s, "%s", value[i]);
+        else return refuse(c, "fmi2SetString: not the String parameter or input");
     }
     return fmi2OK;
 }

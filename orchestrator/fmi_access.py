@@ -1,0 +1,137 @@
+"""Values in and out of an FMU, per FMI version: which C function sets and gets a variable of
+each type, its C type, and :class:`Exchange`, the variables a participant sets or reads at every
+step grouped by those functions (value references resolved per type, buffers made once).
+
+The value vector of a run holds every exchanged value as a float: numbers as they are (whole
+numbers exactly up to 2^53), Booleans as 1.0 / 0.0, Strings as their number in the run's
+:class:`StringTable`.
+
+FMI 2.0: fmi2Set/GetReal, Integer (also Enumeration), Boolean (an int), String. FMI 3.0:
+fmi3Set/GetFloat64, Float32, Int8 ... UInt64, Boolean (a bool), String; an Enumeration travels
+as Int64. Value references are unique per type in FMI 2.0 and across all variables in FMI 3.0;
+grouping by type serves both.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from collections.abc import Callable
+from functools import partial
+from typing import Any
+
+import numpy as np
+
+#: FMI 3.0 types -> their C type (an Enumeration is an Int64).
+FMI3_C_TYPES = {"Float64": ctypes.c_double, "Float32": ctypes.c_float, "Int8": ctypes.c_int8,
+                "UInt8": ctypes.c_uint8, "Int16": ctypes.c_int16, "UInt16": ctypes.c_uint16,
+                "Int32": ctypes.c_int32, "UInt32": ctypes.c_uint32, "Int64": ctypes.c_int64,
+                "UInt64": ctypes.c_uint64, "Boolean": ctypes.c_bool, "String": ctypes.c_char_p}
+#: FMI 2.0 function families -> their C type.
+FMI2_C_TYPES = {"Real": ctypes.c_double, "Integer": ctypes.c_int, "Boolean": ctypes.c_int, "String": ctypes.c_char_p}
+
+
+def call_kind(version: int, variable_type: str) -> str:
+    """The type name in the fmiNSet/Get function of a variable (FMI 2.0 Enumeration: Integer's;
+    FMI 3.0 Enumeration: Int64's)."""
+    if variable_type == "Enumeration":
+        return "Integer" if version == 2 else "Int64"
+    return variable_type
+
+
+def c_type(version: int, kind: str) -> Any:
+    """The ctypes type of one value of the function family ``kind``."""
+    table = FMI2_C_TYPES if version == 2 else FMI3_C_TYPES
+    if kind not in table:
+        raise ValueError(f"FMI {version}.0 variables of type {kind} cannot be exchanged (expected one of "
+                         f"{', '.join(table)})")
+    return table[kind]
+
+
+def raw_call(fmu: Any, version: int, action: str, kind: str) -> Callable[[Any, int, Any], Any]:
+    """``call(references, n, buffer)`` of fmi2<action><kind> or fmi3<action><kind> (``action``:
+    Set or Get) on the instance of the FMPy object ``fmu``."""
+    function = getattr(fmu, f"fmi{version}{action}{kind}")
+    component = fmu.component
+    if version == 2:
+        return lambda references, n, buffer: function(component, references, n, buffer)
+    return lambda references, n, buffer: function(component, references, n, buffer, n)
+
+
+class StringTable:
+    """The Strings of a run, each held in the value vector as its number here (the same text:
+    the same number, so connections copy it and the iterative master sees it settle)."""
+
+    def __init__(self) -> None:
+        self.texts: list[str] = []
+        self.numbers: dict[str, int] = {}
+
+    def number(self, text: str) -> float:
+        """The number of ``text`` (given one on first sight)."""
+        found = self.numbers.get(text)
+        if found is None:
+            found = self.numbers[text] = len(self.texts)
+            self.texts.append(text)
+        return float(found)
+
+    def text(self, number: float) -> str:
+        """The text of ``number`` (0.0 before any String was seen: the empty text)."""
+        k = int(number)
+        return self.texts[k] if 0 <= k < len(self.texts) else ""
+
+
+class Exchange:
+    """The variables ``names`` of an FMU (of FMI ``version``) grouped by the function that sets
+    or gets them; :meth:`set` and :meth:`get` move them between the FMU and a float array in the
+    order of ``names``. ``real_only``: a single FMI 2.0 fmi2Set/GetReal group (the native stepper's
+    and the fast path's case)."""
+
+    def __init__(self, version: int, names: list[str], types: dict[str, str], refs: dict[str, int],
+                 strings: StringTable):
+        self.version, self.strings = version, strings
+        #: kind -> (value references, positions in ``names``, a buffer of the kind's C type), made once
+        self.groups: dict[str, tuple[Any, np.ndarray, Any]] = {}
+        for name in names:
+            c_type(version, call_kind(version, types[name]))  # refuse a type that cannot travel, by name
+        kinds = dict.fromkeys(call_kind(version, types[n]) for n in names)
+        for kind in kinds:
+            positions = [k for k, n in enumerate(names) if call_kind(version, types[n]) == kind]
+            references = (ctypes.c_uint * len(positions))(*[refs[names[k]] for k in positions])
+            buffer = (c_type(version, kind) * len(positions))()
+            self.groups[kind] = (references, np.array(positions, dtype=int), buffer)
+        self.real_only = version == 2 and set(self.groups) <= {"Real"}
+
+    def set(self, fmu: Any, values: np.ndarray, call: Callable[[str, Callable[[], Any]], Any]) -> None:
+        """Set every variable from ``values``; ``call(what, action)`` makes each FMI call (and
+        turns its failure into the participant's error)."""
+        for kind, (references, positions, buffer) in self.groups.items():
+            chosen = values[positions].tolist()
+            if kind == "String":
+                buffer[:] = [self.strings.text(v).encode() for v in chosen]
+            elif kind in ("Real", "Float64", "Float32"):
+                buffer[:] = chosen
+            elif kind == "Boolean":
+                buffer[:] = [(v != 0.0) if self.version == 3 else int(v != 0.0) for v in chosen]
+            else:
+                buffer[:] = [int(round(v)) for v in chosen]
+            call(f"fmi{self.version}Set{kind}", partial(raw_call(fmu, self.version, "Set", kind), references,
+                                                         len(references), buffer))
+
+    def get(self, fmu: Any, out: np.ndarray, call: Callable[[str, Callable[[], Any]], Any]) -> None:
+        """Read every variable into ``out`` (in the order of ``names``)."""
+        for kind, (references, positions, buffer) in self.groups.items():
+            call(f"fmi{self.version}Get{kind}", partial(raw_call(fmu, self.version, "Get", kind), references,
+                                                         len(references), buffer))
+            if kind == "String":
+                out[positions] = [self.strings.number((b or b"").decode(errors="replace")) for b in buffer]
+            else:
+                out[positions] = [float(v) for v in buffer]
+
+
+def set_by_name(fmu: Any, version: int, values: dict[str, Any], types: dict[str, str], refs: dict[str, int],
+                call: Callable[[str, Callable[[], Any]], Any]) -> None:
+    """Set typed values (parameters, start values) by variable name: one call per function family."""
+    strings = StringTable()
+    names = list(values)
+    exchange = Exchange(version, names, types, refs, strings)
+    vector = np.array([strings.number(v) if types[n] == "String" else float(v) for n, v in values.items()])
+    exchange.set(fmu, vector, call)
