@@ -136,12 +136,74 @@ class Table(Source):
         return float(np.interp(t, self.times, self.data))
 
 
+class CsvInput:
+    """Signals read from a CSV file, FMPy's convention: the first column is time [s], increasing
+    (a repeated time is a step: from that time on the later row holds), every other column an
+    output of that name, interpolated linearly, or held from row to row for the columns in
+    ``hold`` (discrete signals: integers, Booleans as true/false or 1/0); before the first time
+    the first row holds, after the last the last. ``types``: the FMI type of each output where
+    it is not Real (e.g. {"k" = "Integer"}), so it may drive an input of that type."""
+
+    inputs: tuple[str, ...] = ()
+
+    def __init__(self, name: str, file: str | Path, hold: Sequence[str] = (), types: Mapping[str, str] | None = None):
+        import pandas as pd
+
+        self.name = name
+        self.file = Path(file)
+        try:
+            table = pd.read_csv(self.file, skipinitialspace=True)
+        except (OSError, ValueError) as error:
+            raise ValueError(f"block {name!r}: file {self.file}: cannot be read as CSV ({error})") from None
+        if table.shape[1] < 2 or len(table) < 1:
+            raise ValueError(f"block {name!r}: file {self.file}: expected a time column and at least one signal "
+                             f"column with at least one row (got {table.shape[1]} columns, {len(table)} rows)")
+        table = table.replace({"true": 1.0, "false": 0.0, "True": 1.0, "False": 0.0})
+        try:
+            data = table.to_numpy(dtype=float)
+        except ValueError as error:
+            raise ValueError(f"block {name!r}: file {self.file}: every value must be a number, true or false "
+                             f"({error})") from None
+        self.times, self.values = data[:, 0], data[:, 1:]
+        if not np.all(np.isfinite(data)):
+            raise ValueError(f"block {name!r}: file {self.file}: empty or non-finite values")
+        if np.any(np.diff(self.times) < 0):
+            row = int(np.argmax(np.diff(self.times) < 0)) + 2
+            raise ValueError(f"block {name!r}: file {self.file}: time decreases at data row {row}")
+        self.outputs = tuple(str(c).strip() for c in table.columns[1:])
+        unknown = sorted(set(hold) - set(self.outputs)) + sorted(set(types or {}) - set(self.outputs))
+        if unknown:
+            raise ValueError(f"block {name!r}: hold/types name columns {unknown} that {self.file.name} does not "
+                             f"have (its columns: {', '.join(self.outputs)})")
+        self.held = np.array([c in set(hold) for c in self.outputs], dtype=bool)
+        self.types = dict(types or {})
+        self.units: dict[str, str] = {}
+
+    def values_at(self, t: float) -> np.ndarray:
+        """Every output at ``t`` [s]."""
+        k = int(np.searchsorted(self.times, t, side="right")) - 1  # the last row at or before t
+        if k < 0:
+            return self.values[0].copy()
+        if k >= len(self.times) - 1:
+            return self.values[-1].copy()
+        weight = (t - self.times[k]) / (self.times[k + 1] - self.times[k])
+        interpolated = self.values[k] + weight * (self.values[k + 1] - self.values[k])
+        return np.where(self.held, self.values[k], interpolated)
+
+    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+        return self.values_at(t0)
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        return self.values_at(t + h)
+
+
 BLOCK_TYPES: dict[str, type] = {
     "constant": Constant,
     "step": Step,
     "ramp": Ramp,
     "tanh_step": TanhStep,
     "table": Table,
+    "csv": CsvInput,
 }
 
 
@@ -153,6 +215,9 @@ def make_block(name: str, kind: str, params: Mapping[str, Any], folder: Path | N
     if kind not in BLOCK_TYPES:
         raise ValueError(f"block {name!r}: type {kind!r}: expected one of {', '.join([*BLOCK_TYPES, 'python'])}")
     _check_keys(name, f"type {kind!r}", BLOCK_TYPES[kind], params)
+    if kind == "csv" and folder is not None and isinstance(params.get("file"), str) \
+            and not Path(params["file"]).is_absolute():
+        params = {**params, "file": folder / params["file"]}
     try:
         return BLOCK_TYPES[kind](name=name, **params)
     except TypeError as error:
@@ -247,4 +312,7 @@ KEY_MEANINGS = {
     "values": "output values at the table's times [unit of y] (linear between them, held beyond)",
     "table.time": "the table's times [s], increasing",
     "unit": "unit of the output y, checked against what it drives (e.g. \"N.m\")",
+    "file": "the CSV file (relative: to the system file's folder); first column time [s], one output per other column",
+    "hold": "columns held from row to row (discrete signals) instead of interpolated",
+    "types": "FMI type of an output that is not Real, e.g. { k = \"Integer\" }",
 }

@@ -39,6 +39,7 @@ from .blocks import BLOCK_TYPES, Block
 from .loops import describe, find_loop
 from .model import (
     ALGORITHMS,
+    VARIABLE_TYPES,
     BlockEntry,
     Connection,
     FmuEntry,
@@ -134,6 +135,11 @@ def optional_inputs(fmu_path: Path, description: Any = None) -> set[str]:
         return {v.name for v in variables if v.causality == "input" and v.start is not None}
     except (OSError, ValueError, zipfile.BadZipFile):
         return set()
+
+
+def block_port_type(block: Block, variable: str) -> str:
+    """The FMI type of a block's port: Real, unless the block's optional ``types`` name another."""
+    return str(getattr(block, "types", {}).get(variable, "Real"))
 
 
 def dependency_graph(fmus: list[FmuEntry], blocks: list[BlockEntry],
@@ -373,6 +379,10 @@ class SystemBuilder:
         return {v.name for v in self._fmus_entry(instance, None).description.modelVariables
                 if v.causality == "parameter"}
 
+    def fmu_entry(self, instance: str) -> FmuEntry:
+        """The FMU component ``instance`` as built so far."""
+        return self._fmus_entry(instance, None)
+
     def fmu_names(self) -> list[str]:
         return list(self._fmus)
 
@@ -387,6 +397,10 @@ class SystemBuilder:
                 raise self.error(where, f"{block!r} is not a block: it has no {attribute!r}")
         if not hasattr(block, "units"):
             setattr(block, "units", {})  # noqa: B010 - the protocol reads it as a property
+        for variable, kind_of in getattr(block, "types", {}).items():
+            if kind_of not in VARIABLE_TYPES or kind_of == "String":
+                raise self.error(where, f"types {variable} = {kind_of!r}: expected a number or Boolean type "
+                                 f"({', '.join(k for k in VARIABLE_TYPES if k != 'String')})")
         if kind is None:
             kind = next((k for k, cls in BLOCK_TYPES.items() if type(block) is cls), "python")
         self._blocks[name] = BlockEntry(name, kind, block, keys)
@@ -416,10 +430,10 @@ class SystemBuilder:
                          f"(inputs {list(block.inputs)}, outputs {list(block.outputs)})")
 
     def _type(self, port: Port) -> str:
-        """The FMI type of ``port`` (a block's ports are Real)."""
+        """The FMI type of ``port`` (a block's ports are Real unless its ``types`` say otherwise)."""
         if port.instance in self._fmus:
             return self._fmus[port.instance].variable_type(port.variable)
-        return "Real"
+        return block_port_type(self._blocks[port.instance].block, port.variable)
 
     def connect(self, source: str | Port, target: str | Port, *, where: str | None = None,
                 label: str | None = None) -> SystemBuilder:

@@ -15,6 +15,7 @@ from contextlib import ExitStack, contextmanager
 
 import numpy as np
 
+from .builder import block_port_type
 from .execution import Execution, make_execution
 from .fmi_access import StringTable
 from .model import FmuEntry, Port, System
@@ -117,10 +118,10 @@ def _observed_ports(system: System, observers: Sequence[Observer]) -> list[Port]
 
 
 def _types(system: System, ports: Sequence[Port]) -> list[str]:
-    """The FMI type of each port (a block's ports are Real)."""
+    """The FMI type of each port (a block's ports are Real unless it says otherwise)."""
     entries = system.participants()
-    return [entry.variable_type(port.variable) if isinstance(entry := entries[port.instance], FmuEntry) else "Real"
-            for port in ports]
+    return [entry.variable_type(port.variable) if isinstance(entry := entries[port.instance], FmuEntry)
+            else block_port_type(entry.block, port.variable) for port in ports]
 
 
 def run(system: System, *, progress: Callable[[float], None] | None = None,

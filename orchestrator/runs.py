@@ -1,5 +1,7 @@
-"""A co-simulation run written to disk: the CSV of recorded trajectories and a JSON sidecar (the
-system file, SHA-256 of each FMU, package versions, wall time), both or neither."""
+"""A co-simulation run written to disk: the recorded trajectories (CSV, or Parquet for long runs)
+and a JSON sidecar (the system file, SHA-256 of each FMU, package versions, wall time), both or
+neither. CSV values are written at full precision (each reads back equal to the bit); Strings
+are quoted where they need it; Parquet keeps every column's type."""
 
 from __future__ import annotations
 
@@ -35,18 +37,35 @@ def sidecar(system: System, result: RunResult, command: str) -> dict[str, object
     }
 
 
+#: The file types a run's trajectories are written as.
+FORMATS = (".csv", ".parquet")
+
+
 def sidecar_path(csv_path: Path) -> Path:
-    """The JSON sidecar of ``csv_path``; ValueError when the two would be one file."""
+    """The JSON sidecar of ``csv_path`` (a .csv or .parquet file); ValueError for another suffix."""
     csv_path = Path(csv_path)
-    if csv_path.suffix.lower() != ".csv":
-        raise ValueError(f"output {csv_path}: expected a .csv file (its sidecar is the same name with .json)")
+    if csv_path.suffix.lower() not in FORMATS:
+        raise ValueError(f"output {csv_path}: expected a .csv or .parquet file (its sidecar is the same name "
+                         "with .json)")
     return csv_path.with_suffix(".json")
+
+
+def table_bytes(data: Any, path: Path) -> bytes:
+    """``data`` (a DataFrame) as the bytes of ``path``'s format: CSV at full precision (Python's
+    shortest repr of each float: it reads back equal), or Parquet (pyarrow)."""
+    if Path(path).suffix.lower() == ".parquet":
+        import io
+
+        buffer = io.BytesIO()
+        data.to_parquet(buffer, engine="pyarrow", index=False)
+        return buffer.getvalue()
+    return data.to_csv(index=False).encode()
 
 
 def partial_path(csv_path: Path) -> Path:
     """Where a failed run's rows go: ``NAME.partial.csv`` beside ``NAME.csv``."""
     csv_path = Path(csv_path)
-    return csv_path.with_name(f"{csv_path.stem}.partial.csv")
+    return csv_path.with_name(f"{csv_path.stem}.partial{csv_path.suffix}")
 
 
 def write_partial(system: System, data: Any, csv_path: Path, failure: str,
@@ -59,7 +78,7 @@ def write_partial(system: System, data: Any, csv_path: Path, failure: str,
                    "last_time_s": float(data["time"].iloc[-1]) if len(data) else None,
                    "system_file": str(system.path) if system.path else None})
     json_path = sidecar_path(target)
-    write_all({target: data.to_csv(index=False, float_format="%.10g").encode(), json_path: json_bytes(record)})
+    write_all({target: table_bytes(data, target), json_path: json_bytes(record)})
     return [target, json_path]
 
 
@@ -67,8 +86,7 @@ def write_run(system: System, result: RunResult, csv_path: Path, command: str = 
     """Write ``csv_path`` and ``csv_path`` with suffix ``.json`` atomically; returns both paths."""
     csv_path = Path(csv_path)
     json_path = sidecar_path(csv_path)
-    csv_bytes = result.data.to_csv(index=False, float_format="%.10g").encode()
-    write_all({csv_path: csv_bytes, json_path: json_bytes(sidecar(system, result, command))})
+    write_all({csv_path: table_bytes(result.data, csv_path), json_path: json_bytes(sidecar(system, result, command))})
     return [csv_path, json_path]
 
 

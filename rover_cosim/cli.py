@@ -90,7 +90,8 @@ def build_parser() -> argparse.ArgumentParser:
                      "DefaultExperiment unless --stop-time/--step say otherwise), or the name of a shipped example: "
                      + ", ".join(EXAMPLES))
     run.add_argument("-o", "--output", type=Path, default=None,
-                     help="CSV to write (default: results/<system name>.csv); a .json sidecar goes beside it")
+                     help="CSV (full precision) or .parquet to write (default: results/<system name>.csv); a .json "
+                     "sidecar goes beside it")
     run.add_argument("--fmu-dir", type=Path, default=None,
                      help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
     run.add_argument("--algorithm", choices=("jacobi", "gauss-seidel", "iterative"), default=None,
@@ -100,6 +101,15 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--threads", type=int, default=None,
                      help="FMUs stepped at the same time (Jacobi; Gauss-Seidel where inputs are ready); "
                      "default: the system file's, else the number of cores")
+    run.add_argument("--interface", choices=("co-simulation", "model-exchange"), default=None,
+                     help="one FMU run alone: the interface to run (default: Co-Simulation where it has it; "
+                     "Model Exchange is integrated by CVode)")
+    run.add_argument("--start", type=_assignment, action="append", metavar="NAME=VALUE",
+                     help="one FMU run alone: a parameter or start value (repeatable; TOML values: 2.5, 3, true, "
+                     "\"text\")")
+    run.add_argument("--input", type=Path, default=None, metavar="CSV",
+                     help="one FMU run alone: input signals, first column time [s], one column per input "
+                     "(continuous Real inputs interpolated, the others held; a repeated time is a step)")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     _add_soil_options(run)
 
@@ -196,7 +206,12 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
         except SspError as error:
             raise SystemFileError(str(error)) from None
     elif path.suffix.lower() == ".fmu":
-        return _one_fmu(path, overrides), path  # the overrides are its settings
+        return _one_fmu(path, overrides, args), path  # the overrides are its settings
+    given = [flag for flag, value in (("--interface", args.interface), ("--start", args.start),
+                                      ("--input", args.input)) if value]
+    if given:
+        raise SystemFileError(f"{path}: {', '.join(given)} apply to one FMU run alone (rover-cosim run model.fmu); "
+                              "a system file gives its FMUs' interface, start values and inputs itself")
     else:
         system = load_system(path, fmu_dir=fmu_dir)
     if overrides:
@@ -204,15 +219,30 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
     return system, path
 
 
-def _one_fmu(path: Path, settings: dict[str, Any]):  # noqa: ANN202 - System, imported lazily
+def _one_fmu(path: Path, settings: dict[str, Any], args: argparse.Namespace):  # noqa: ANN202 - System
     """A system of the one FMU ``path`` (instance ``model``), every output recorded, the stop time
-    and step from ``settings`` or the FMU's DefaultExperiment."""
-    from rover_cosim.orchestrator.builder import SystemBuilder
+    and step from ``settings`` or the FMU's DefaultExperiment, the values of --start and the
+    input file of --input."""
+    from rover_cosim.orchestrator.single import single_fmu_system
 
-    builder = SystemBuilder(str(path))
-    if settings:
-        builder.simulation(**settings)
-    return builder.add_fmu("model", path.resolve(), where=f"FMU {path.name}").build()
+    system, notes = single_fmu_system(path, settings, interface=args.interface, values=dict(args.start or []),
+                                      input_file=args.input)
+    for note in notes:
+        print(f"rover-cosim run: {note}", file=sys.stderr)
+    return system
+
+
+def _assignment(text: str) -> tuple[str, Any]:
+    """``NAME=VALUE`` of --start: the value as TOML writes it (1.5, 3, true, "text"), else as text."""
+    import tomllib
+
+    name, equals, value = text.partition("=")
+    if not equals or not name.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected NAME=VALUE (e.g. h=2.5, on=true, label=\"moon\")")
+    try:
+        return name.strip(), tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        return name.strip(), value.strip()
 
 
 def _export_ssp(args: argparse.Namespace) -> int:

@@ -68,7 +68,7 @@ def test_stop_time_between_steps_ends_with_one_shorter_step(fmu_dir, fmus):
 def test_output_that_would_be_its_own_sidecar_is_refused(fmu_dir, fmus, tmp_path, capsys):
     target = tmp_path / "x.json"
     code = main(["run", "single_wheel_step", "--fmu-dir", str(fmu_dir), "-o", str(target), "--quiet"])
-    assert code == 2 and "expected a .csv file" in capsys.readouterr().err
+    assert code == 2 and "expected a .csv or .parquet file" in capsys.readouterr().err
     assert not list(tmp_path.iterdir())
 
 

@@ -1,0 +1,67 @@
+"""One FMU run alone, as ``fmpy simulate`` runs it: the system of ``rover-cosim run model.fmu``.
+
+The FMU is instance ``model``; its DefaultExperiment gives the stop time and step unless the
+settings do; values given by name go to its parameters or start values (by the variable's
+causality); an input file (a CSV, ``blocks.CsvInput``) drives the inputs its columns name
+(continuous Real inputs interpolated, the others held); every output of the FMU is recorded.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from .blocks import CsvInput
+from .builder import SystemBuilder
+from .model import System, SystemFileError
+
+#: The instance name of the one FMU.
+INSTANCE = "model"
+
+
+def single_fmu_system(path: Path, settings: Mapping[str, Any] | None = None, *, interface: str | None = None,
+                      values: Mapping[str, Any] | None = None,
+                      input_file: Path | None = None) -> tuple[System, list[str]]:
+    """The system of the FMU ``path`` alone, and notes for the user (input columns that name no
+    input of the FMU, left out). SystemFileError for anything that does not fit the FMU."""
+    builder = SystemBuilder(str(path))
+    if settings:
+        builder.simulation(**settings)
+    builder.add_fmu(INSTANCE, Path(path).resolve(), interface=interface, where=f"FMU {Path(path).name}")
+    variables = builder.fmu_entry(INSTANCE).variables()
+    parameters = {k: v for k, v in (values or {}).items() if k in variables and variables[k].causality == "parameter"}
+    builder.set_parameters(INSTANCE, parameters, where="--start")
+    builder.set_start(INSTANCE, {k: v for k, v in (values or {}).items() if k not in parameters}, where="--start")
+    notes: list[str] = []
+    if input_file is not None:
+        notes = _connect_input(builder, variables, Path(input_file))
+    outputs = [f"{INSTANCE}.{v.name}" for v in variables.values()
+               if v.causality == "output" and v.type not in ("Binary", "Clock") and not v.dimensions]
+    builder.record(*outputs, where="outputs", replace=True)
+    return builder.build(), notes
+
+
+def _connect_input(builder: SystemBuilder, variables: dict[str, Any], input_file: Path) -> list[str]:
+    """The input file as a block driving the FMU inputs its columns name."""
+    try:
+        probe = CsvInput("input", input_file)
+    except ValueError as error:
+        raise SystemFileError(f"{builder.name}: --input: {error}") from None
+    inputs = {name for name, v in variables.items() if v.causality == "input"}
+    used = [c for c in probe.outputs if c in inputs]
+    unused = [c for c in probe.outputs if c not in inputs]
+    if not used:
+        raise SystemFileError(f"{builder.name}: --input {input_file}: no column names an input of the FMU (columns: "
+                              f"{', '.join(probe.outputs)}; inputs: {', '.join(sorted(inputs)) or 'none'})")
+    continuous = {"Real", "Float64", "Float32"}
+    hold = [c for c in used if str(variables[c].type) not in continuous or variables[c].variability == "discrete"]
+    types = {c: str(variables[c].type) for c in used if str(variables[c].type) not in ("Real",)}
+    try:
+        block = CsvInput("input", input_file, hold=hold, types=types)
+    except ValueError as error:
+        raise SystemFileError(f"{builder.name}: --input: {error}") from None
+    builder.add_block("input", block, kind="csv", keys={"file": str(input_file), "hold": hold, "types": types})
+    for column in used:
+        builder.connect(f"input.{column}", f"{INSTANCE}.{column}", where=f"--input column {column!r}")
+    return [f"input columns {', '.join(unused)}: not inputs of the FMU, left out"] if unused else []
