@@ -207,6 +207,18 @@ BLOCK_TYPES: dict[str, type] = {
 }
 
 
+#: Python block factories ("module:callable") an SSP archive's annotation may name; an archive
+#: naming another is refused (it would run code chosen by whoever wrote the archive).
+REGISTERED_FACTORIES: set[str] = set()
+
+
+def register_factory(factory: str) -> None:
+    """Allow SSP archives to name the Python block factory ``factory`` ("module:callable")."""
+    if not isinstance(factory, str) or ":" not in factory:
+        raise ValueError(f"{factory!r}: expected \"module:callable\"")
+    REGISTERED_FACTORIES.add(factory)
+
+
 def make_block(name: str, kind: str, params: Mapping[str, Any], folder: Path | None = None) -> Block:
     """A block from its system-file entry; ValueError naming the block for bad entries. A
     ``type = "python"`` block's module is looked up in ``folder`` (the system file's) first."""

@@ -19,6 +19,7 @@ recorded variables) go in the same annotation.
 from __future__ import annotations
 
 import json
+import os
 import tempfile
 import zipfile
 from dataclasses import dataclass
@@ -29,7 +30,7 @@ from lxml import etree
 
 from rover_cosim.common.units import base_units
 
-from .blocks import make_block
+from .blocks import BLOCK_TYPES, REGISTERED_FACTORIES, make_block
 from .builder import SystemBuilder
 from .model import BlockEntry, Connection, System, Value
 
@@ -56,14 +57,17 @@ def _q(namespace: str, tag: str) -> str:
     return f"{{{namespace}}}{tag}"
 
 
-#: The SSP element of each FMI type (an Enumeration travels as its number, an Integer).
-SSP_TYPES = {"Real": "Real", "Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean", "String": "String"}
+#: The SSP element of each FMI type (an Enumeration travels as its number, an Integer; SSP 1.0
+#: has one Real and one Integer for FMI 3.0's several float and integer types).
+SSP_TYPES = {"Real": "Real", "Float64": "Real", "Float32": "Real", "Integer": "Integer", "Enumeration": "Integer",
+             "Int8": "Integer", "UInt8": "Integer", "Int16": "Integer", "UInt16": "Integer", "Int32": "Integer",
+             "UInt32": "Integer", "Int64": "Integer", "UInt64": "Integer", "Boolean": "Boolean", "String": "String"}
 
 
 def _connector(parent: etree._Element, name: str, kind: str, unit: str | None, variable_type: str = "Real") -> None:
     connector = etree.SubElement(parent, _q(SSD, "Connector"), name=name, kind=kind)
     typed = etree.SubElement(connector, _q(SSC, SSP_TYPES[variable_type]))
-    if unit and variable_type == "Real":
+    if unit and SSP_TYPES[variable_type] == "Real":
         typed.set("unit", unit)
 
 
@@ -115,6 +119,7 @@ class _SsdWriter:
         self.external = external
         self.outside = {e.name for e in external}
         self.units: set[str] = set()
+        self.block_files: dict[str, bytes] = {}  # files of blocks (a csv block's), by their name in the archive
         self.parameters: dict[str, list[tuple[str, Value, str | None]]] = {name: [] for name in self.fmus}
         self.root = etree.Element(_q(SSD, "SystemStructureDescription"), nsmap={"ssd": SSD, "ssc": SSC},
                                   version="1.0", name=system.path.stem if system.path else "system")
@@ -146,6 +151,7 @@ class _SsdWriter:
                 files[source] = _parameter_set(values, name)
         files["SystemStructure.ssd"] = etree.tostring(self.root, xml_declaration=True, encoding="UTF-8",
                                                       pretty_print=True)
+        files.update(self.block_files)
         return files
 
     def _used(self, name: str) -> set[str]:
@@ -203,9 +209,19 @@ class _SsdWriter:
                               "max_iterations": system.iteration.max_iterations,
                               "relaxation": system.iteration.relaxation},
                 "allow_algebraic_loops": system.algebraic_loop is not None,
-                "blocks": [{"name": e.name, "type": e.kind, **_keys(e)} for e in self.external],
+                "blocks": [self._block(e) for e in self.external],
                 "block_connections": [{"from": str(c.source), "to": str(c.target)} for c in system.connections
                                       if c.source.instance in self.outside or c.target.instance in self.outside]}
+
+
+    def _block(self, entry: BlockEntry) -> dict[str, Any]:
+        """A block as the annotation keeps it; a csv block's file goes into the archive."""
+        keys = dict(_keys(entry))
+        if entry.kind == "csv":
+            inner = f"resources/{entry.name}.csv"
+            self.block_files[inner] = Path(entry.block.file).read_bytes()  # type: ignore[attr-defined]
+            keys["file"] = inner
+        return {"name": entry.name, "type": entry.kind, **keys}
 
 
 def _keys(entry: BlockEntry) -> dict[str, Any]:
@@ -266,66 +282,191 @@ def validate_ssd(archive: Path) -> None:
         raise SspError(f"{archive}: {error}") from None
 
 
-def load_ssp(archive: Path, folder: Path) -> System:
-    """The System of an SSP archive written by export_ssp (or another tool: one flat system of
-    FMU components), its files unpacked into ``folder`` (which must outlive the run)."""
-    archive = Path(archive)
+#: The largest archive load_ssp unpacks [bytes, uncompressed, all entries together]; the
+#: environment variable ROVER_COSIM_SSP_MAX_BYTES sets another.
+SIZE_LIMIT = 4 * 2**30
+
+
+def size_limit() -> int:
+    """The size limit of SSP archives [bytes]: ROVER_COSIM_SSP_MAX_BYTES, else :data:`SIZE_LIMIT`."""
+    text = os.environ.get("ROVER_COSIM_SSP_MAX_BYTES")
+    if text is None:
+        return SIZE_LIMIT
+    try:
+        limit = int(text)
+    except ValueError:
+        raise SspError(f"ROVER_COSIM_SSP_MAX_BYTES = {text!r}: expected a whole number of bytes") from None
+    if limit <= 0:
+        raise SspError(f"ROVER_COSIM_SSP_MAX_BYTES = {text!r}: expected a number of bytes > 0")
+    return limit
+
+
+def _unpack(archive: Path, folder: Path, limit: int) -> None:
+    """Every entry of ``archive`` into ``folder``: none may lie outside it, none be a link, and
+    together they may not exceed ``limit`` bytes (read as they are unpacked, not as declared)."""
     try:
         with zipfile.ZipFile(archive) as zf:
-            zf.extractall(folder)
+            entries = zf.infolist()
+            declared = sum(e.file_size for e in entries)
+            if declared > limit:
+                raise SspError(f"{archive}: {declared} bytes unpacked: above the limit of {limit} bytes "
+                               "(ROVER_COSIM_SSP_MAX_BYTES sets another)")
+            folder.mkdir(parents=True, exist_ok=True)
+            root = folder.resolve()
+            total = 0
+            for entry in entries:
+                target = (root / entry.filename).resolve()
+                if not target.is_relative_to(root) or entry.filename.startswith("/"):
+                    raise SspError(f"{archive}: entry {entry.filename!r} lies outside the archive's folder")
+                if (entry.external_attr >> 16) & 0o170000 == 0o120000:
+                    raise SspError(f"{archive}: entry {entry.filename!r} is a symbolic link (not allowed)")
+                if entry.is_dir():
+                    target.mkdir(parents=True, exist_ok=True)
+                    continue
+                target.parent.mkdir(parents=True, exist_ok=True)
+                with zf.open(entry) as source, open(target, "wb") as sink:
+                    while chunk := source.read(1 << 20):
+                        total += len(chunk)
+                        if total > limit:
+                            raise SspError(f"{archive}: more than {limit} bytes unpacked: above the limit "
+                                           "(ROVER_COSIM_SSP_MAX_BYTES sets another)")
+                        sink.write(chunk)
     except (OSError, zipfile.BadZipFile) as error:
         raise SspError(f"{archive}: not a readable SSP archive ({error})") from None
+
+
+def inside(folder: Path, source: str | None, what: str) -> Path:
+    """The file ``source`` (a relative path in the archive) under ``folder``; SspError for a path
+    that leaves the archive, a URI or a file that is not there."""
+    if not source:
+        raise SspError(f"{what}: no source given")
+    if "://" in source or source.startswith(("/", "\\")) or ":" in source.split("/")[0]:
+        raise SspError(f"{what}: source {source!r}: expected a relative path inside the archive")
+    root = folder.resolve()
+    path = (root / source).resolve()
+    if not path.is_relative_to(root):
+        raise SspError(f"{what}: source {source!r} lies outside the archive")
+    if not path.is_file():
+        raise SspError(f"{what}: source {source!r} is not in the archive")
+    return path
+
+
+def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None) -> System:
+    """The System of an SSP 1.0 archive, written by export_ssp or by another tool (one flat system
+    of FMU components; what is not supported is named), its files unpacked into ``folder`` (which
+    must outlive the run). ``settings``: simulation settings that override the archive's (as the
+    command line's --step, --stop-time); a step neither gives comes from the FMUs' DefaultExperiment."""
+    archive = Path(archive)
+    _unpack(archive, folder, size_limit())
+    if not (folder / "SystemStructure.ssd").is_file():
+        raise SspError(f"{archive}: no SystemStructure.ssd at the top of the archive")
     validate_ssd(archive)
-    ssd_root = etree.parse(str(folder / "SystemStructure.ssd")).getroot()  # noqa: S320 - validated above
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    ssd_root = etree.parse(str(folder / "SystemStructure.ssd"), parser).getroot()  # noqa: S320 - validated
     ns = {"ssd": SSD, "ssc": SSC, "ssv": SSV}
     top = ssd_root.find("ssd:System", ns)
-    settings = _settings(ssd_root, ns)
+    _refuse_unsupported(top, ns)
+    annotation = _annotation(ssd_root, ns)
     builder = SystemBuilder(str(archive), base=folder)
-    builder.simulation(where="[simulation]", **_simulation(settings))
+    builder.simulation(where="[simulation]", **_simulation(annotation, ssd_root, ns))
+    if settings:
+        builder.simulation(where="command line", **settings)
     for entry in _fmu_entries(top, folder, ns):
         builder.add_fmu(entry["name"], entry["path"], parameters=entry["parameters"], start=entry["start"],
-                        where=f"[[fmu]] {entry['name']!r}")
-    for entry in settings.get("blocks", []):
-        keys = {k: v for k, v in entry.items() if k not in ("name", "type")}
-        where = f"[[block]] {entry['name']!r}"
-        try:
-            block = make_block(entry["name"], entry["type"], keys, None)
-        except ValueError as failure:
-            raise builder.error(where, str(failure)) from None
-        builder.add_block(entry["name"], block, kind=entry["type"], keys=keys, where=where)
+                        where=f"component {entry['name']!r}")
+    for entry in annotation.get("blocks", []):
+        _annotation_block(builder, entry, folder)
     elements = [c for c in top.findall("ssd:Connections/ssd:Connection", ns)
                 if c.get("startElement") and c.get("endElement")]  # system connectors: the blocks' side
     connections = [(f"{c.get('startElement')}.{c.get('startConnector')}",
                     f"{c.get('endElement')}.{c.get('endConnector')}") for c in elements]
-    connections += [(c["from"], c["to"]) for c in settings.get("block_connections", [])]
+    connections += [(c["from"], c["to"]) for c in annotation.get("block_connections", [])]
     for i, (source, target) in enumerate(connections, 1):
         builder.connect(source, target, where=f"connection {i} ({source} -> {target})")
-    if settings.get("record"):
-        builder.record(*settings["record"], where="recorded variables")
+    if annotation.get("record"):
+        builder.record(*annotation["record"], where="recorded variables")
     return builder.build()
 
 
-def _simulation(settings: dict[str, Any]) -> dict[str, Any]:
-    """[simulation] of the archive's experiment and master annotation."""
-    simulation = {"stop_time": float(settings.get("stop_time", 1.0)), "step": float(settings["step"]),
-                  "start_time": float(settings.get("start_time", 0.0)),
-                  "algorithm": settings.get("algorithm", "gauss-seidel")}
-    if settings.get("allow_algebraic_loops") and simulation["algorithm"] != "iterative":
+def _refuse_unsupported(top: etree._Element | None, ns: dict[str, str]) -> None:
+    """SspError naming what the archive uses that the engine does not run."""
+    if top is None:
+        raise SspError("the archive's SystemStructure.ssd has no system")
+    nested = top.findall("ssd:Elements/ssd:System", ns)
+    if nested:
+        raise SspError(f"nested systems ({', '.join(str(n.get('name')) for n in nested)}) are not supported: "
+                       "flatten them into one system of FMU components")
+    for component in top.findall("ssd:Elements/ssd:Component", ns):
+        kind = component.get("type", "application/x-fmu-sharedlibrary")
+        if kind != "application/x-fmu-sharedlibrary":
+            raise SspError(f"component {component.get('name')!r}: type {kind!r} is not supported (expected an FMU, "
+                           "application/x-fmu-sharedlibrary)")
+    if top.findall("ssd:Elements/ssd:SignalDictionaryReference", ns) or top.find("ssd:SignalDictionaries", ns) \
+            is not None:
+        raise SspError("signal dictionaries are not supported: connect the components directly")
+
+
+def _annotation_block(builder: SystemBuilder, entry: dict[str, Any], folder: Path) -> None:
+    """One block of our annotation: a built-in type, or a Python factory registered with the engine."""
+    name, kind = entry.get("name"), entry.get("type")
+    keys = {k: v for k, v in entry.items() if k not in ("name", "type")}
+    where = f"annotation block {name!r}"
+    if kind == "python" and keys.get("factory") not in REGISTERED_FACTORIES:
+        raise builder.error(where, f"the archive names the Python block factory {keys.get('factory')!r}, which is "
+                            "not registered with the engine (an archive may name the built-in block types, "
+                            f"{', '.join(BLOCK_TYPES)}, and factories registered with "
+                            "rover_cosim.orchestrator.blocks.register_factory: it would run code chosen by the "
+                            "archive's author otherwise)")
+    if kind != "python" and kind not in BLOCK_TYPES:
+        raise builder.error(where, f"type {kind!r}: expected one of {', '.join(BLOCK_TYPES)}")
+    if kind == "csv":
+        keys["file"] = str(inside(folder, keys.get("file"), where))
+    try:
+        block = make_block(str(name), str(kind), keys, None)
+    except ValueError as failure:
+        raise builder.error(where, str(failure)) from None
+    builder.add_block(str(name), block, kind=str(kind), keys=keys, where=where)
+
+
+def _simulation(annotation: dict[str, Any], root: etree._Element, ns: dict[str, str]) -> dict[str, Any]:
+    """The simulation settings of the archive: its DefaultExperiment and our master annotation
+    (a foreign archive has none: its step and any missing stop time come from the FMUs)."""
+    simulation: dict[str, Any] = {}
+    experiment = root.find("ssd:DefaultExperiment", ns)
+    if experiment is not None:
+        for key, attribute in (("start_time", "startTime"), ("stop_time", "stopTime")):
+            if experiment.get(attribute) is not None:
+                simulation[key] = _float(experiment.get(attribute), f"DefaultExperiment {attribute}")
+    if "step" in annotation:
+        simulation["step"] = annotation["step"]
+    simulation["algorithm"] = annotation.get("algorithm", "gauss-seidel")
+    if annotation.get("allow_algebraic_loops") and simulation["algorithm"] != "iterative":
         simulation["allow_algebraic_loops"] = True
-    if simulation["algorithm"] == "iterative" and settings.get("iteration"):
-        simulation.update(settings["iteration"])
-    if settings.get("order"):
-        simulation["order"] = settings["order"]
+    if simulation["algorithm"] == "iterative" and annotation.get("iteration"):
+        simulation.update(annotation["iteration"])
+    if annotation.get("order"):
+        simulation["order"] = annotation["order"]
     return simulation
+
+
+def _float(text: str | None, what: str) -> float:
+    try:
+        return float(text)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise SspError(f"{what} = {text!r}: expected a number") from None
 
 
 def _fmu_entries(top: etree._Element, folder: Path, ns: dict[str, str]) -> list[dict[str, Any]]:
     """[[fmu]] entries of the components, their bound values split into parameters and start
-    values by the variable's causality (values bound to the system are named instance.variable)."""
+    values by the variable's causality (values bound to the system are named instance.variable;
+    an enumeration value by its item name)."""
     import fmpy
 
-    entries = [{"name": c.get("name"), "path": str(folder / c.get("source")), "values": _bound_values(c, folder, ns)}
-               for c in top.findall("ssd:Elements/ssd:Component", ns)]
+    entries = []
+    for c in top.findall("ssd:Elements/ssd:Component", ns):
+        name = c.get("name")
+        path = inside(folder, c.get("source"), f"component {name!r}")
+        entries.append({"name": name, "path": str(path), "values": _bound_values(c, folder, ns)})
     by_name = {entry["name"]: entry for entry in entries}
     for name, value in _bound_values(top, folder, ns).items():
         instance, _, variable = name.partition(".")
@@ -333,49 +474,74 @@ def _fmu_entries(top: etree._Element, folder: Path, ns: dict[str, str]) -> list[
             by_name[instance]["values"][variable] = value
     for entry in entries:
         given = entry.pop("values")
-        causality = {v.name: v.causality for v in fmpy.read_model_description(entry["path"]).modelVariables}
-        entry["parameters"] = {k: v for k, v in given.items() if causality.get(k) == "parameter"}
-        entry["start"] = {k: v for k, v in given.items() if causality.get(k) != "parameter"}
+        try:
+            variables = {v.name: v for v in fmpy.read_model_description(entry["path"]).modelVariables}
+        except Exception as error:  # noqa: BLE001 - fmpy raises many kinds
+            raise SspError(f"component {entry['name']!r}: {Path(entry['path']).name} is not a readable FMU: "
+                           f"{error}") from None
+        given = {k: _enumeration_value(variables.get(k), v, entry["name"]) for k, v in given.items()}
+        entry["parameters"] = {k: v for k, v in given.items()
+                               if k in variables and variables[k].causality == "parameter"}
+        entry["start"] = {k: v for k, v in given.items() if k not in entry["parameters"]}
     return entries
 
 
-def _settings(root: etree._Element, ns: dict[str, str]) -> dict[str, Any]:
-    settings: dict[str, Any] = {}
+def _enumeration_value(variable: Any, value: Value, instance: str) -> Value:
+    """An SSV enumeration value (its item name) as the item's number; other values as they are."""
+    if variable is None or variable.type != "Enumeration" or not isinstance(value, str):
+        return value
+    items = {item.name: int(item.value) for item in getattr(variable.declaredType, "items", [])}
+    if value not in items:
+        raise SspError(f"component {instance!r}: {variable.name} = {value!r}: expected one of its items "
+                       f"({', '.join(items)})")
+    return items[value]
+
+
+def _annotation(root: etree._Element, ns: dict[str, str]) -> dict[str, Any]:
+    """Our master annotation (settings, blocks), {} where the archive has none (a foreign one)."""
     for annotation in root.findall("ssd:Annotations/ssc:Annotation", ns):
         if annotation.get("type") == ANNOTATION_TYPE and len(annotation):
-            settings = json.loads(annotation[0].text or "{}")
-    experiment = root.find("ssd:DefaultExperiment", ns)
-    if experiment is not None:
-        settings["start_time"] = float(experiment.get("startTime", 0.0))
-        if experiment.get("stopTime") is not None:
-            settings["stop_time"] = float(experiment.get("stopTime"))
-    if "step" not in settings:
-        raise SspError("the archive gives no communication step (no org.rover-cosim annotation); "
-                       "run it with --step")
-    return settings
+            try:
+                settings = json.loads(annotation[0].text or "{}")
+            except ValueError as error:
+                raise SspError(f"the {ANNOTATION_TYPE} annotation is not valid JSON ({error})") from None
+            if not isinstance(settings, dict):
+                raise SspError(f"the {ANNOTATION_TYPE} annotation: expected a JSON object")
+            return settings
+    return {}
 
 
 def _bound_values(element: etree._Element, folder: Path, ns: dict[str, str]) -> dict[str, Value]:
-    """name -> value of the parameter sets (files in the archive) bound to ``element`` (Real,
-    Integer, Boolean and String values; the others are not read)."""
+    """name -> value of the parameter sets bound to ``element``: files in the archive or inline
+    ``ssd:ParameterValues`` (Real, Integer, Boolean, String and Enumeration values)."""
     values: dict[str, Value] = {}
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
     for binding in element.findall("ssd:ParameterBindings/ssd:ParameterBinding", ns):
         source = binding.get("source")
         prefix = binding.get("prefix", "")
-        if not source:
+        inline = binding.find("ssd:ParameterValues/ssv:ParameterSet", ns)
+        if source:
+            path = inside(folder, source, f"parameter binding of {element.get('name')!r}")
+            parameter_set = etree.parse(str(path), parser).getroot()  # noqa: S320 - no entities, no network
+        elif inline is not None:
+            parameter_set = inline
+        else:
             continue
-        parameter_set = etree.parse(str(folder / source)).getroot()  # noqa: S320 - our own archive, validated
         for parameter in parameter_set.findall("ssv:Parameters/ssv:Parameter", ns):
             for kind, read in SSV_READERS.items():
                 found = parameter.find(f"ssv:{kind}", ns)
                 if found is not None:
-                    values[prefix + parameter.get("name")] = read(found.get("value"))
+                    try:
+                        values[prefix + str(parameter.get("name"))] = read(found.get("value"))
+                    except (TypeError, ValueError):
+                        raise SspError(f"parameter {parameter.get('name')!r}: {found.get('value')!r} is not a "
+                                       f"{kind} value") from None
     return values
 
 
 #: How a value of each SSV element is read.
 SSV_READERS: dict[str, Any] = {"Real": float, "Integer": int, "Boolean": lambda text: text.strip() in ("true", "1"),
-                               "String": str}
+                               "String": str, "Enumeration": str}
 
 
 def fmpy_parameter_set(archive: Path) -> Any:

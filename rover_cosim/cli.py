@@ -200,20 +200,19 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
     overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
                                                ("stop_time", args.stop_time), ("threads", args.threads))
                  if value is not None}
-    if path.suffix.lower() == ".ssp":
-        try:
-            system = load_ssp(path, unpack)
-        except SspError as error:
-            raise SystemFileError(str(error)) from None
-    elif path.suffix.lower() == ".fmu":
+    if path.suffix.lower() == ".fmu":
         return _one_fmu(path, overrides, args), path  # the overrides are its settings
     given = [flag for flag, value in (("--interface", args.interface), ("--start", args.start),
                                       ("--input", args.input)) if value]
     if given:
         raise SystemFileError(f"{path}: {', '.join(given)} apply to one FMU run alone (rover-cosim run model.fmu); "
                               "a system file gives its FMUs' interface, start values and inputs itself")
-    else:
-        system = load_system(path, fmu_dir=fmu_dir)
+    if path.suffix.lower() == ".ssp":
+        try:  # the overrides are settings of the archive's system, checked as its own
+            return load_ssp(path, unpack, overrides), path
+        except SspError as error:
+            raise SystemFileError(f"{path}: {error}") from None
+    system = load_system(path, fmu_dir=fmu_dir)
     if overrides:
         system = replace_settings(system, name=f"{path} (with command-line overrides)", **overrides)
     return system, path

@@ -14,7 +14,9 @@ import pandas as pd
 import pytest
 
 from rover_cosim.cli import EXAMPLES, main
+from rover_cosim.orchestrator.blocks import register_factory
 from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.model import SystemFileError
 from rover_cosim.orchestrator.ssp import SspError, export_ssp, fmpy_parameter_set, load_ssp, validate_ssd
 from rover_cosim.orchestrator.system import system_from_dict
 
@@ -133,6 +135,9 @@ def test_a_python_block_travels_as_connectors_and_an_annotation(fmu_dir, fmus, t
     data["fmu"][0]["start"] = {"omega": 5.0}
     system = system_from_dict(data, name="brake.toml", base=fmu_dir)
     exported = export_ssp(system, tmp_path / "brake.ssp")
+    with pytest.raises(SystemFileError, match="Python block factory 'test_orchestrator:Gain', which is not registered"):
+        load_ssp(exported.path, tmp_path / "refused")
+    register_factory("test_orchestrator:Gain")
     with zipfile.ZipFile(exported.path) as archive:
         ssd = archive.read("SystemStructure.ssd").decode()
     assert 'name="brake_y" kind="input"' in ssd and 'name="brake_u" kind="output"' in ssd
