@@ -57,7 +57,7 @@ IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 #: The simulation settings and their defaults (stop_time and step have none).
 SIMULATION_DEFAULTS: dict[str, Any] = {"start_time": 0.0, "algorithm": "gauss-seidel", "order": None,
                                        "allow_algebraic_loops": False, "threads": None, "native": True,
-                                       "relative_tolerance": 1e-6}
+                                       "relative_tolerance": 1e-6, "output_interval": None}
 ITERATION_KEYS = ("tolerance", "max_iterations", "relaxation")
 
 
@@ -207,7 +207,8 @@ class SystemBuilder:
         names, Gauss-Seidel order; default: sources, FMUs, other blocks); ``tolerance``,
         ``max_iterations``, ``relaxation`` (iterative only); ``allow_algebraic_loops``;
         ``threads`` (FMUs stepped at the same time; None: the cores); ``native`` (FMUs stepped from C);
-        ``relative_tolerance`` (of the integrator of Model Exchange FMUs, and told to every FMU)."""
+        ``relative_tolerance`` (of the integrator of Model Exchange FMUs, and told to every FMU);
+        ``output_interval`` [s] (rows recorded every so often, a whole number of steps; default: every step)."""
         if where is not None:
             self._settings.where = where
         accepted = {"stop_time", "step", *SIMULATION_DEFAULTS, *ITERATION_KEYS}
@@ -233,6 +234,13 @@ class SystemBuilder:
             raise self.error(f"{where} stop_time", f"{stop_time!r}: expected a stop time > start time {start_time} s")
         if step > stop_time - start_time:
             raise self.error(f"{where} step", f"{step!r} s is longer than the run ({stop_time - start_time!r} s)")
+        interval = values.get("output_interval")
+        if interval is not None:
+            interval = self._number(interval, f"{where} output_interval")
+            multiple = interval / step
+            if not interval > 0 or abs(multiple - round(multiple)) > 1e-9 * max(1.0, multiple) or round(multiple) < 1:
+                raise self.error(f"{where} output_interval", f"{interval!r}: expected a whole number of communication "
+                                 f"steps ({step!r} s) > 0")
 
     def _check_switches(self) -> None:
         values, where = self._settings.values, self._settings.where
@@ -574,7 +582,8 @@ class SystemBuilder:
                       list(self._connections), float(values["step"]), float(values["stop_time"]),
                       float(values["start_time"]), values["algorithm"], order, list(record), iteration, loop,
                       values["threads"], values["native"], values["allow_algebraic_loops"], self.name,
-                      dict(self._settings_from), float(values["relative_tolerance"]))
+                      dict(self._settings_from), float(values["relative_tolerance"]),
+                      None if values["output_interval"] is None else float(values["output_interval"]))
 
     @classmethod
     def from_system(cls, system: System, name: str | None = None) -> SystemBuilder:
@@ -584,7 +593,8 @@ class SystemBuilder:
         settings: dict[str, Any] = {"stop_time": system.stop_time, "step": system.step, "start_time": system.start_time,
                     "algorithm": system.algorithm, "order": list(system.order),
                     "allow_algebraic_loops": system.allow_algebraic_loops, "threads": system.threads_setting,
-                    "native": system.native, "relative_tolerance": system.relative_tolerance}
+                    "native": system.native, "relative_tolerance": system.relative_tolerance,
+                    "output_interval": system.output_interval}
         if system.algorithm == "iterative":
             settings.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,
                             relaxation=system.iteration.relaxation)

@@ -140,7 +140,8 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
         initialize(participants, wiring, values, system.start_time, system.stop_time)
         execution = make_execution(system, participants, wiring)
         stack.callback(execution.close)
-        recorder = Recorder(system.record, wiring.record_slots, times, _types(system, system.record), strings)
+        recorder = Recorder(system.record, wiring.record_slots, times, _types(system, system.record), strings,
+                            system.record_every)
         watchers: list[Watcher] = [FiniteCheck(execution, execution.checked_in_python), Recording(recorder)]
         offset = 0
         for observer in observers:

@@ -213,6 +213,13 @@ class System:
     settings_from: dict[str, str] = field(default_factory=dict)
     #: Relative tolerance of the integrator of Model Exchange FMUs (CVode).
     relative_tolerance: float = 1e-6
+    #: s, rows recorded every so often (a whole number of steps; the last row always); None: every step.
+    output_interval: float | None = None
+
+    @property
+    def record_every(self) -> int:
+        """Communication steps between two recorded rows."""
+        return 1 if self.output_interval is None else max(1, round(self.output_interval / self.step))
 
     @property
     def threads(self) -> int:

@@ -31,10 +31,11 @@ class Recorder:
     text from the run's ``strings``; default Real)."""
 
     def __init__(self, ports: list[Port], slots: np.ndarray, times: np.ndarray, types: list[str] | None = None,
-                 strings: StringTable | None = None):
+                 strings: StringTable | None = None, every: int = 1):
         self.columns = [str(port) for port in ports]
         self.types = types or ["Real"] * len(ports)
         self.strings = strings
+        self.every = every  # rows kept in the frame: every ``every``-th communication point, and the last
         self.slots = slots
         self.times = times
         self.rows = np.empty((len(times), slots.size))
@@ -45,7 +46,10 @@ class Recorder:
         self.filled = k + 1
 
     def frame(self) -> pd.DataFrame:
-        data = pd.DataFrame(self.rows[:self.filled], columns=self.columns)
+        kept = np.arange(self.filled)
+        if self.every > 1 and self.filled:
+            kept = np.union1d(kept[::self.every], [self.filled - 1])
+        data = pd.DataFrame(self.rows[kept], columns=self.columns)
         for column, kind in zip(self.columns, self.types):
             if kind in INTEGER_RANGES:
                 data[column] = data[column].astype("uint64" if kind == "UInt64" else "int64")
@@ -56,7 +60,7 @@ class Recorder:
                 data[column] = [strings.text(v) for v in data[column]]
             elif kind == "Float32":
                 data[column] = data[column].astype("float32")
-        data.insert(0, "time", self.times[:self.filled])
+        data.insert(0, "time", self.times[kept])
         return data
 
 

@@ -13,6 +13,7 @@ algorithm = "gauss-seidel" # or "jacobi"
 # threads = 2              # FMUs stepped at the same time (default: the cores)
 # native = true            # FMUs stepped from C (orchestrator.native; default true)
 # relative_tolerance = 1e-6 # of the integrator of Model Exchange FMUs (CVode)
+# output_interval = 0.01   # s, rows recorded every so often (a whole number of steps; default every step)
 
 [[fmu]]
 name = "body"
@@ -65,7 +66,8 @@ from .model import (
 #: The keys each section of a system file may have.
 SECTION_KEYS = {
     "simulation": {"stop_time", "step", "start_time", "algorithm", "order", "tolerance", "max_iterations",
-                   "relaxation", "allow_algebraic_loops", "threads", "native", "relative_tolerance"},
+                   "relaxation", "allow_algebraic_loops", "threads", "native", "relative_tolerance",
+                   "output_interval"},
     "fmu": {"name", "path", "parameters", "start", "interface"},
     "connection": {"from", "to"},
     "record": {"variables"},
@@ -177,7 +179,8 @@ def system_to_dict(system: System, folder: Path | None = None) -> dict[str, Any]
     simulation: dict[str, Any] = {"stop_time": system.stop_time, "step": system.step}
     settings = {"start_time": system.start_time, "algorithm": system.algorithm, "order": list(system.order),
                 "allow_algebraic_loops": system.allow_algebraic_loops, "threads": system.threads_setting,
-                "native": system.native, "relative_tolerance": system.relative_tolerance}
+                "native": system.native, "relative_tolerance": system.relative_tolerance,
+                "output_interval": system.output_interval}
     simulation.update({k: v for k, v in settings.items() if v is not None and v != SIMULATION_DEFAULTS.get(k)})
     if system.algorithm == "iterative":
         simulation.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,

@@ -98,6 +98,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="override the system file's master algorithm")
     run.add_argument("--step", type=float, default=None, help="override the communication step [s]")
     run.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
+    run.add_argument("--output-interval", type=float, default=None,
+                     help="record a row every so often [s] (a whole number of steps; the last row always)")
     run.add_argument("--threads", type=int, default=None,
                      help="FMUs stepped at the same time (Jacobi; Gauss-Seidel where inputs are ready); "
                      "default: the system file's, else the number of cores")
@@ -198,7 +200,8 @@ def _load_run_system(args: argparse.Namespace, unpack: Path):  # noqa: ANN202 - 
 
     path, fmu_dir = _system_path(args)
     overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
-                                               ("stop_time", args.stop_time), ("threads", args.threads))
+                                               ("stop_time", args.stop_time), ("threads", args.threads),
+                                               ("output_interval", args.output_interval))
                  if value is not None}
     if path.suffix.lower() == ".fmu":
         return _one_fmu(path, overrides, args), path  # the overrides are its settings
