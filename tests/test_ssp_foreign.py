@@ -10,6 +10,7 @@ from __future__ import annotations
 import zipfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typed_fmu import build_typed_fmu
 
@@ -180,3 +181,53 @@ def test_what_the_engine_does_not_run_is_named(typed, tmp_path):
     archive = _foreign(typed, tmp_path, elements=_component("a", "resources/Typed.fmu") + nested)
     with pytest.raises(SspError, match=r"nested systems \(inner\) are not supported"):
         load_ssp(archive, tmp_path / "unpacked")
+
+
+def _mixed_archive(typed: Path, folder: Path) -> tuple[object, Path]:
+    """a -> b across Real, Integer and Boolean (what FMPy's and libcosim's SSP readers exchange),
+    Jacobi; a's k and b given start values, exported as an SSP archive."""
+    system = (SystemBuilder("mixed").simulation(stop_time=0.5, step=0.1, algorithm="jacobi")
+              .add_fmu("a", typed, parameters={"gain": 3.0}, start={"u": 0.5, "k": 4, "b": True})
+              .add_fmu("b", typed).connect("a.y", "b.u").connect("a.k2", "b.k").connect("a.notb", "b.b")
+              .record("b.y", "b.k2", "b.notb").build())
+    return system, export_ssp(system, folder / "mixed.ssp").path
+
+
+def test_fmpy_runs_our_mixed_type_archive_to_our_values(typed, tmp_path):
+    from fmpy.ssp.simulation import simulate_ssp
+
+    from rover_cosim.orchestrator.ssp import fmpy_parameter_set
+
+    system, archive = _mixed_archive(typed, tmp_path)
+    ours = run(system).data  # type: ignore[arg-type]
+    theirs = simulate_ssp(str(archive), stop_time=0.5, step_size=0.1, parameter_set=fmpy_parameter_set(archive))
+    # FMPy's simulate_ssp labels each row with the time at the start of the step it has just taken,
+    # and starts the connections at 0 in its first step (no initial exchange): its row k is our row
+    # k + 1, compared from its second row on
+    for column in ("b.y", "b.k2", "b.notb"):
+        got = theirs[[n for n in theirs.dtype.names if n.endswith(column)][0]]
+        np.testing.assert_array_equal(np.asarray(got[1:], dtype=float), ours[column].to_numpy(float)[2:],
+                                      err_msg=column)
+
+
+def test_libcosim_runs_our_mixed_type_archive_to_our_values(typed, tmp_path):
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+
+    log_output_level(CosimLogLevel.ERROR)
+    system, archive = _mixed_archive(typed, tmp_path)
+    ours = run(system).data  # type: ignore[arg-type]
+    execution = CosimExecution.from_ssp_file(str(archive), step_size=round(0.1 * 1e9))
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    index = {(i.name.decode() if isinstance(i.name, bytes) else i.name): i.index for i in execution.slave_infos()}
+    got = []
+    for _ in range(5):
+        execution.step(1)
+        got.append((observer.last_real_values(index["b"], [2])[0], observer.last_integer_values(index["b"], [2])[0],
+                    observer.last_boolean_values(index["b"], [2])[0]))
+    theirs = np.array(got, dtype=float)
+    np.testing.assert_array_equal(theirs[:, 0], ours["b.y"].to_numpy()[1:])
+    np.testing.assert_array_equal(theirs[:, 1], ours["b.k2"].to_numpy(float)[1:])
+    np.testing.assert_array_equal(theirs[:, 2], ours["b.notb"].to_numpy(float)[1:])
