@@ -192,6 +192,7 @@ class SystemBuilder:
         self._driven: dict[Port, str] = {}     # input -> the label of the connection driving it
         self._record: list[Port] | None = None
         self._settings_from: dict[str, str] = {}
+        self._given: set[str] = set()  # the settings given (not defaults)
 
     # --- messages -------------------------------------------------------------------------------
     def error(self, where: str, message: str) -> SystemFileError:
@@ -217,6 +218,7 @@ class SystemBuilder:
             raise self.error(self._settings.where, f"unknown setting(s) {sorted(unknown)}; expected {sorted(accepted)}")
         for key, value in settings.items():
             (self._settings.iteration if key in ITERATION_KEYS else self._settings.values)[key] = value
+            self._given.add(key)
         self._check_times()
         self._check_switches()
         return self
@@ -387,6 +389,11 @@ class SystemBuilder:
         return {v.name for v in self._fmus_entry(instance, None).description.modelVariables
                 if v.causality == "parameter"}
 
+    def setting_from(self, key: str, origin: str) -> SystemBuilder:
+        """Say where the setting ``key`` came from (the run record's ``settings_from``)."""
+        self._settings_from[key] = origin
+        return self
+
     def fmu_entry(self, instance: str) -> FmuEntry:
         """The FMU component ``instance`` as built so far."""
         return self._fmus_entry(instance, None)
@@ -501,17 +508,21 @@ class SystemBuilder:
                     raise self.error(self._where[entry.name], f"input {entry.name}.{variable} is not connected")
 
     def _default_experiment(self) -> None:
-        """A stop time or step the settings leave out, from the FMUs' DefaultExperiment: the
-        largest stop time and the smallest step (``settings_from`` says where each came from)."""
+        """A start time, stop time or step the settings leave out, from the FMUs' DefaultExperiment:
+        the latest start, the largest stop time and the smallest step (``settings_from`` says where
+        each came from)."""
         values = self._settings.values
-        for key, attribute, pick in (("stop_time", "stopTime", max), ("step", "stepSize", min)):
-            if key in values:
+        for key, attribute, pick in (("start_time", "startTime", max), ("stop_time", "stopTime", max),
+                                     ("step", "stepSize", min)):
+            if key in values and (key != "start_time" or key in self._given):
                 continue
             given = [(float(getattr(f.description.defaultExperiment, attribute)), f.name) for f in self._fmus.values()
                      if f.description.defaultExperiment is not None
                      and getattr(f.description.defaultExperiment, attribute) is not None]
             if given:
                 value, name = pick(given)
+                if key == "start_time" and value == values.get("start_time", 0.0):
+                    continue  # the default start time: nothing taken from elsewhere
                 values[key] = value
                 self._settings_from[key] = f"DefaultExperiment {attribute} of {name} ({self._fmus[name].path.name})"
         self._check_times()

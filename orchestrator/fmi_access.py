@@ -3,8 +3,9 @@ each type, its C type, and :class:`Exchange`, the variables a participant sets o
 step grouped by those functions (value references resolved per type, buffers made once).
 
 The value vector of a run holds every exchanged value as a float: numbers as they are (whole
-numbers exactly up to 2^53), Booleans as 1.0 / 0.0, Strings as their number in the run's
-:class:`StringTable`.
+numbers exactly up to 2^53: a connected or recorded Int64/UInt64 beyond that is rounded to the
+nearest float; parameters and start values are set exactly), Booleans as 1.0 / 0.0, Strings as
+their number in the run's :class:`StringTable`.
 
 FMI 2.0: fmi2Set/GetReal, Integer (also Enumeration), Boolean (an int), String. FMI 3.0:
 fmi3Set/GetFloat64, Float32, Int8 ... UInt64, Boolean (a bool), String; an Enumeration travels
@@ -129,9 +130,20 @@ class Exchange:
 
 def set_by_name(fmu: Any, version: int, values: dict[str, Any], types: dict[str, str], refs: dict[str, int],
                 call: Callable[[str, Callable[[], Any]], Any]) -> None:
-    """Set typed values (parameters, start values) by variable name: one call per function family."""
-    strings = StringTable()
-    names = list(values)
-    exchange = Exchange(version, names, types, refs, strings)
-    vector = np.array([strings.number(v) if types[n] == "String" else float(v) for n, v in values.items()])
-    exchange.set(fmu, vector, call)
+    """Set typed values (parameters, start values) by variable name: one call per function
+    family, each value converted to its C type directly (64-bit integers stay exact)."""
+    groups: dict[str, list[tuple[int, Any]]] = {}
+    for name, value in values.items():
+        groups.setdefault(call_kind(version, types[name]), []).append((refs[name], value))
+    for kind, pairs in groups.items():
+        references = (ctypes.c_uint * len(pairs))(*[r for r, _ in pairs])
+        if kind == "String":
+            converted: list[Any] = [str(v).encode() for _, v in pairs]
+        elif kind in ("Real", "Float64", "Float32"):
+            converted = [float(v) for _, v in pairs]
+        elif kind == "Boolean":
+            converted = [bool(v) if version == 3 else int(bool(v)) for _, v in pairs]
+        else:
+            converted = [int(v) for _, v in pairs]
+        buffer = (c_type(version, kind) * len(pairs))(*converted)
+        call(f"fmi{version}Set{kind}", partial(raw_call(fmu, version, "Set", kind), references, len(pairs), buffer))

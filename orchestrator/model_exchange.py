@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from fmpy.sundials import CVodeSolver
 
-from .fmi_access import StringTable
+from .fmi_access import Exchange, StringTable
 from .model import FmuEntry
 from .participants import FmuParticipant, RunError
 
@@ -87,10 +87,15 @@ class ModelExchangeParticipant(FmuParticipant):
         self._started = False
         #: Whether CVode may go on from where it stopped (nothing changed since: no restart needed).
         self._fresh = False
+        self._step_start = 0.0  # s, where the step under way began (an end inside it is reported from there)
 
     def configure(self, inputs: list[str], reads: list[str]) -> None:
         super().configure(inputs, reads)
         self._discrete = self.discrete_inputs
+        # the continuous inputs alone: what may be set in Continuous-Time Mode
+        self._continuous_positions = np.flatnonzero(~self._discrete)
+        self._continuous = Exchange(self.version, [self.inputs[k] for k in self._continuous_positions], self.types,
+                                    self.refs, self.strings)
 
     # --- FMI calls that differ between the versions ----------------------------------------------
     def _mode(self, what: str, t: float) -> None:
@@ -107,8 +112,8 @@ class ModelExchangeParticipant(FmuParticipant):
         name = "fmi2NewDiscreteStates" if self.version == 2 else "fmi3UpdateDiscreteStates"
         for _ in range(MAX_EVENT_ITERATIONS):
             needed, terminate, _nominals, _values, defined, next_time = self._call(name, update, t)
-            if terminate:
-                self.end(t, t)
+            if terminate:  # the run ends in the step from its start, having got to t
+                self.end(min(self._step_start, t), t)
             if not needed:
                 self.next_event = float(next_time) if defined else math.inf
                 return
@@ -132,6 +137,7 @@ class ModelExchangeParticipant(FmuParticipant):
     # --- the participant ------------------------------------------------------------------------
     def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray:
         """Exit Initialization Mode, the initial event iteration, Continuous-Time Mode, the integrator."""
+        self._step_start = t0
         self.set_inputs(u, t0)
         self._call(f"fmi{self.version}ExitInitializationMode", self.fmu.exitInitializationMode, t0)
         self._event_iteration(t0)
@@ -144,6 +150,7 @@ class ModelExchangeParticipant(FmuParticipant):
     def do_step(self, t: float, h: float, u: np.ndarray, slopes: np.ndarray | None = None) -> None:
         """Integrate from ``t`` to ``t + h`` with the inputs ``u`` held (``slopes`` are not used:
         a held input is what an ME FMU is given between events)."""
+        self._step_start = t
         self._take_inputs(np.asarray(u, dtype=float), t)
         if not self._fresh:  # the inputs, or the state (an event, a restored state), changed: restart at t
             self._restart(t)
@@ -169,8 +176,10 @@ class ModelExchangeParticipant(FmuParticipant):
             self.set_inputs(u, t)
             self._event_iteration(t)
             self._mode("continuous", t)
-        else:
-            self.set_inputs(u, t)
+        else:  # continuous inputs only, in Continuous-Time Mode
+            chosen = self._continuous_positions
+            self.input_values[chosen] = u[chosen]
+            self._continuous.set(self.fmu, self.input_values[chosen], self._exchange("set", t))
         self._fresh = False
 
     def _advance(self, t: float, now: float, end: float) -> float:
@@ -219,6 +228,7 @@ class ModelExchangeParticipant(FmuParticipant):
         fmu_state, self.next_event = state
         super().set_state(fmu_state, t)
         self._fresh = False
+        self.input_values[:] = np.nan  # the restored FMU holds the inputs of its time: set them all anew
 
     def free_state(self, state: Any) -> None:
         super().free_state(state[0])

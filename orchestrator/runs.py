@@ -16,24 +16,30 @@ from .participants import RunError
 from .recorder import RunResult
 
 
-def sidecar(system: System, result: RunResult, command: str) -> dict[str, object]:
+def sidecar(system: System, result: RunResult, command: str,
+            extra: dict[str, Any] | None = None) -> dict[str, object]:
     record = run_record(command, {"algorithm": system.algorithm, "step_s": system.step,
                                   "start_time_s": system.start_time, "stop_time_s": system.stop_time,
-                                  "order": system.order})
+                                  "order": system.order, "relative_tolerance": system.relative_tolerance,
+                                  "output_interval_s": system.output_interval})
     return {
         **record,
         "system_file": str(system.path) if system.path else None,
         "system_sha256": file_sha256(system.path) if system.path else None,
         "settings_from": system.settings_from,
         "stopped": result.stopped,
-        "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid}
+        "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid,
+                            "fmi_version": str(fmu.description.fmiVersion), "interface": fmu.interface,
+                            "parameters": dict(fmu.parameters), "start": dict(fmu.start)}
                  for fmu in system.fmus},
+        "blocks_keys": {block.name: block.keys for block in system.blocks if block.keys is not None},
         "blocks": {block.name: block.kind for block in system.blocks},
         "steps": result.steps,
         "wall_seconds": result.wall_seconds,
         "participant_seconds": result.step_seconds,
         "master_overhead_seconds": result.master_overhead_seconds,
         "columns": list(result.data.columns),
+        **(extra or {}),
     }
 
 
@@ -82,11 +88,14 @@ def write_partial(system: System, data: Any, csv_path: Path, failure: str,
     return [target, json_path]
 
 
-def write_run(system: System, result: RunResult, csv_path: Path, command: str = "rover-cosim run") -> list[Path]:
-    """Write ``csv_path`` and ``csv_path`` with suffix ``.json`` atomically; returns both paths."""
+def write_run(system: System, result: RunResult, csv_path: Path, command: str = "rover-cosim run",
+              extra: dict[str, Any] | None = None) -> list[Path]:
+    """Write ``csv_path`` and ``csv_path`` with suffix ``.json`` atomically; returns both paths.
+    ``extra``: more for the record (e.g. the soil and wheel the run was given)."""
     csv_path = Path(csv_path)
     json_path = sidecar_path(csv_path)
-    write_all({csv_path: table_bytes(result.data, csv_path), json_path: json_bytes(sidecar(system, result, command))})
+    record = sidecar(system, result, command, extra)
+    write_all({csv_path: table_bytes(result.data, csv_path), json_path: json_bytes(record)})
     return [csv_path, json_path]
 
 

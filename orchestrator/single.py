@@ -29,17 +29,44 @@ def single_fmu_system(path: Path, settings: Mapping[str, Any] | None = None, *, 
     if settings:
         builder.simulation(**settings)
     builder.add_fmu(INSTANCE, Path(path).resolve(), interface=interface, where=f"FMU {Path(path).name}")
-    variables = builder.fmu_entry(INSTANCE).variables()
+    entry = builder.fmu_entry(INSTANCE)
+    variables = entry.variables()
+    notes = _fill_experiment(builder, entry.description, dict(settings or {}))
     parameters = {k: v for k, v in (values or {}).items() if k in variables and variables[k].causality == "parameter"}
     builder.set_parameters(INSTANCE, parameters, where="--start")
     builder.set_start(INSTANCE, {k: v for k, v in (values or {}).items() if k not in parameters}, where="--start")
-    notes: list[str] = []
     if input_file is not None:
-        notes = _connect_input(builder, variables, Path(input_file))
-    outputs = [f"{INSTANCE}.{v.name}" for v in variables.values()
-               if v.causality == "output" and v.type not in ("Binary", "Clock") and not v.dimensions]
-    builder.record(*outputs, where="outputs", replace=True)
+        notes += _connect_input(builder, variables, Path(input_file))
+    outputs = [v for v in variables.values() if v.causality == "output"]
+    left = [f"{v.name} ({'an array' if v.dimensions else v.type})" for v in outputs
+            if v.type in ("Binary", "Clock") or v.dimensions]
+    if left:
+        notes.append(f"outputs {', '.join(left)}: not recorded (FMI 3.0 arrays, Binary and Clock variables are "
+                     "not supported)")
+    builder.record(*[f"{INSTANCE}.{v.name}" for v in outputs if v.type not in ("Binary", "Clock")
+                     and not v.dimensions], where="outputs", replace=True)
     return builder.build(), notes
+
+
+def _fill_experiment(builder: SystemBuilder, description: Any, settings: dict[str, Any]) -> list[str]:
+    """As FMPy: a stop time neither the settings nor the DefaultExperiment give is 1 s; a step
+    neither gives divides the run into 500 to 1000 steps (FMPy's auto_interval). Says so."""
+    from fmpy.util import auto_interval
+
+    experiment = description.defaultExperiment
+    start = float(settings.get("start_time", getattr(experiment, "startTime", None) or 0.0))
+    chosen: dict[str, float] = {}
+    if "stop_time" not in settings and getattr(experiment, "stopTime", None) is None:
+        chosen["stop_time"] = start + 1.0
+    stop = float(settings.get("stop_time", chosen.get("stop_time", getattr(experiment, "stopTime", None) or 1.0)))
+    if "step" not in settings and getattr(experiment, "stepSize", None) is None:
+        chosen["step"] = float(auto_interval(stop - start))
+    if chosen:
+        builder.simulation(where="defaults", **chosen)
+        for key in chosen:
+            builder.setting_from(key, "chosen as fmpy simulate does (the FMU's DefaultExperiment gives none)")
+    return [f"{key} = {value:g} s: the FMU's DefaultExperiment gives none (as fmpy simulate chooses it)"
+            for key, value in chosen.items()]
 
 
 def _connect_input(builder: SystemBuilder, variables: dict[str, Any], input_file: Path) -> list[str]:

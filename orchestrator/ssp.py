@@ -210,6 +210,7 @@ class _SsdWriter:
                               "relaxation": system.iteration.relaxation},
                 "allow_algebraic_loops": system.algebraic_loop is not None,
                 "blocks": [self._block(e) for e in self.external],
+                "interfaces": {f.name: f.interface for f in system.fmus if f.interface != "co-simulation"},
                 "block_connections": [{"from": str(c.source), "to": str(c.target)} for c in system.connections
                                       if c.source.instance in self.outside or c.target.instance in self.outside]}
 
@@ -371,9 +372,10 @@ def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None
     builder.simulation(where="[simulation]", **_simulation(annotation, ssd_root, ns))
     if settings:
         builder.simulation(where="command line", **settings)
+    interfaces = annotation.get("interfaces", {})
     for entry in _fmu_entries(top, folder, ns):
         builder.add_fmu(entry["name"], entry["path"], parameters=entry["parameters"], start=entry["start"],
-                        where=f"component {entry['name']!r}")
+                        interface=interfaces.get(entry["name"]), where=f"component {entry['name']!r}")
     for entry in annotation.get("blocks", []):
         _annotation_block(builder, entry, folder)
     elements = [c for c in top.findall("ssd:Connections/ssd:Connection", ns)

@@ -270,7 +270,7 @@ def _export_ssp(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from rover_cosim.orchestrator.builder import with_parameters
     from rover_cosim.orchestrator.system import SystemFileError
-    from rover_cosim.terramechanics.library import fmu_parameters
+    from rover_cosim.terramechanics.library import describe, fmu_parameters
 
     choice = None
     if args.soil or args.wheel or args.assignments:
@@ -283,12 +283,15 @@ def _run(args: argparse.Namespace) -> int:
         except SystemFileError as error:
             print(f"rover-cosim run: {error}", file=sys.stderr)
             return 2
+        extra = None
         if choice is not None:  # the chosen soil and wheel go to every FMU that has them
             system = with_parameters(system, fmu_parameters(choice.soil, choice.wheel))
-        return _run_system(args, system, path)
+            extra = describe(choice)
+        return _run_system(args, system, path, extra)
 
 
-def _run_system(args: argparse.Namespace, system, path: Path) -> int:  # noqa: ANN001 - System, imported lazily
+def _run_system(args: argparse.Namespace, system, path: Path,  # noqa: ANN001 - System, imported lazily
+                extra: dict[str, Any] | None = None) -> int:
     from rover_cosim.orchestrator.master import RunError, run
     from rover_cosim.orchestrator.runs import PartialWriter, sidecar_path, write_run
     from rover_cosim.progress import ProgressBar
@@ -311,7 +314,7 @@ def _run_system(args: argparse.Namespace, system, path: Path) -> int:  # noqa: A
         print(f"rover-cosim run: {error} ({output} not written{kept})", file=sys.stderr)
         return 1
     bar.close()
-    for written in write_run(system, result, output):
+    for written in write_run(system, result, output, extra=extra):
         print(f"wrote {written}")
     if result.stopped:
         print(f"stopped: {result.stopped}")

@@ -26,6 +26,7 @@ BALL2 = [
     ("count", "Integer", 0, "output", "discrete", "exact", "0", ""),
     ("maxBounces", "Integer", 1, "parameter", "fixed", "exact", "0", ""),
     ("late", "Boolean", 0, "output", "discrete", "exact", "false", ""),
+    ("frozen", "Boolean", 1, "input", "discrete", None, "false", ""),
 ]
 
 #: FMI 3.0: (name, type, value reference, causality, variability, initial, start, extra attributes)
@@ -67,8 +68,8 @@ def _ball2_description() -> str:
     lines += ["  </ModelVariables>", "  <ModelStructure>", "    <Outputs>"]
     lines += [f'      <Unknown index="{index[n]}" dependencies=""/>' for n in ("h", "v", "count", "late")]
     lines += ["    </Outputs>", "    <Derivatives>"]
-    lines += [f'      <Unknown index="{index["der(h)"]}" dependencies="{index["v"]}"/>',
-              f'      <Unknown index="{index["der(v)"]}" dependencies="{index["a"]}"/>']
+    lines += [f'      <Unknown index="{index["der(h)"]}" dependencies="{index["v"]} {index["frozen"]}"/>',
+              f'      <Unknown index="{index["der(v)"]}" dependencies="{index["a"]} {index["frozen"]}"/>']
     lines += ["    </Derivatives>", "    <InitialUnknowns>"]
     lines += [f'      <Unknown index="{index[n]}"/>' for n in ("der(h)", "der(v)")]
     lines += ["    </InitialUnknowns>", "  </ModelStructure>", "</fmiModelDescription>", ""]

@@ -7,17 +7,18 @@ exact solution (ball_fmus.exact_height) to compare with."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
-from ball_fmus import G, build_ball2, build_ball3, exact_height
+from ball_fmus import E, G, build_ball2, build_ball3, exact_height
 from typed_fmu import build_typed_fmu
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, run
-from rover_cosim.orchestrator.blocks import Constant
+from rover_cosim.orchestrator.blocks import Constant, CsvInput
 from rover_cosim.orchestrator.model import SystemFileError
 from rover_cosim.orchestrator.system import load_system, system_from_dict, system_to_toml
 
@@ -90,11 +91,38 @@ def test_a_held_continuous_input_drives_the_integrated_fmu(ball2):
 
 
 def test_an_fmu_ending_the_simulation_in_an_event_ends_the_run_cleanly(ball2):
+    """maxBounces = 3: the FMU ends the simulation in the event of the third bounce, at
+    t1 + 2 e v1 / g + 2 e^2 v1 / g with t1 = sqrt(2 h0 / g), v1 = g t1; a one-FMU run keeps a last
+    row there, as FMPy does."""
     system = (SystemBuilder("three").simulation(stop_time=3.0, step=0.01)
-              .add_fmu("ball", ball2, parameters={"maxBounces": 3}).record("ball.count").build())
+              .add_fmu("ball", ball2, parameters={"maxBounces": 3}).record("ball.count", "ball.h").build())
     result = run(system)
+    t1 = math.sqrt(2 * 1.0 / G)
+    third = t1 + 2 * E * G * t1 / G + 2 * E * E * G * t1 / G
     assert "ended the simulation" in (result.stopped or "")
-    assert result.data["ball.count"].iloc[-1] in (2, 3) and result.data["time"].iloc[-1] < 1.6
+    assert result.data["ball.count"].iloc[-1] == 3 and result.data["ball.count"].iloc[-2] == 2
+    assert abs(result.data["time"].iloc[-1] - third) < 1e-4 and result.data["ball.h"].iloc[-1] == 0.0
+
+
+@pytest.mark.parametrize("algorithm", ["jacobi", "gauss-seidel", "iterative"])
+def test_discrete_inputs_of_a_model_exchange_fmu_are_set_in_event_mode(ball2, tmp_path, algorithm):
+    """The ball is frozen (a discrete Boolean input, which the FMU accepts only in Event Mode) from
+    0.2 s to 0.3 s while a continuous input is also connected: its height stands still for 0.1 s
+    and then falls as the exact ball delayed by 0.1 s. Jacobi gives the FMU the input at the start
+    of each step; Gauss-Seidel (the source first) and the iterative master (discrete inputs at the
+    end of the step) the one at its end: the freeze begins a step earlier."""
+    signals = tmp_path / "frozen.csv"
+    signals.write_text("time,a,frozen\n0,0,false\n0.2,0,false\n0.2,0,true\n0.3,0,true\n0.3,0,false\n1,0,false\n")
+    system = (SystemBuilder("frozen").simulation(stop_time=0.5, step=0.01, algorithm=algorithm)
+              .add_fmu("ball", ball2)
+              .add_block("in", CsvInput("in", signals, hold=["frozen"], types={"frozen": "Boolean"}))
+              .connect("in.a", "ball.a").connect("in.frozen", "ball.frozen").record("ball.h").build())
+    data = run(system).data
+    times = data["time"].to_numpy()
+    begin = 0.2 if algorithm == "jacobi" else 0.19
+    expected = _exact(np.where(times <= begin, times, np.maximum(times - 0.1, begin)))[0]
+    bound = 2e-5 if algorithm != "iterative" else 2e-3
+    assert np.abs(data["ball.h"].to_numpy() - expected).max() < bound
 
 
 def test_fmi3_co_simulation_steps_exactly_and_records_every_scalar_type(ball3):
@@ -165,4 +193,4 @@ def test_rover_cosim_run_takes_a_model_exchange_only_fmu(ball2, tmp_path, capsys
     out = tmp_path / "ball.csv"
     assert main(["run", str(ball2), "--stop-time", "1.0", "-o", str(out)]) == 0
     text = out.read_text().splitlines()
-    assert text[0] == "time,model.h,model.v,model.count,model.late" and len(text) == 102
+    assert text[0] == "time,model.h,model.v,model.count,model.late" and len(text) == 102  # frozen: an input

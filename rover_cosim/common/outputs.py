@@ -74,9 +74,11 @@ def json_bytes(value: object) -> bytes:
 
 
 def run_record(command: str, parameters: Mapping[str, object]) -> dict[str, object]:
-    """What a run did: command, parameters, versions, git commit, machine, time."""
+    """What a run did: command (and the process's whole command line), parameters, versions, git
+    commit, machine, time."""
     return {
         "command": command,
+        "command_line": list(sys.argv),
         "parameters": parameters,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "git_commit": _git_commit(),

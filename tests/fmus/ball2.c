@@ -5,7 +5,8 @@
  *
  * Real     0 h  1 der(h)  2 v  3 der(v)  4 g  5 e  6 a (input)  7 tSwitch
  * Integer  0 count (output)  1 maxBounces (parameter)
- * Boolean  0 late (output)
+ * Boolean  0 late (output)  1 frozen (discrete input: set only in Initialization or Event Mode,
+ *          as FMI 2.0 requires of a discrete input of a Model Exchange FMU)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,8 +15,14 @@
 #include "fmi2Functions.h"
 #include "ball_model.h"
 
+/* The states of an instance, and the ones each value-setting call is allowed in. */
+enum { INSTANTIATED = 1, INITIALIZATION = 2, EVENT = 4, CONTINUOUS = 8 };
+#define SET_CONTINUOUS (INSTANTIATED | INITIALIZATION | EVENT | CONTINUOUS)
+#define SET_DISCRETE (INSTANTIATED | INITIALIZATION | EVENT)
+
 typedef struct {
     Ball ball;
+    int mode;
     fmi2CallbackFunctions callbacks;
     char name[64];
 } Instance;
@@ -46,6 +53,7 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
     c->callbacks = *functions;
     snprintf(c->name, sizeof c->name, "%s", name ? name : "ball");
     ball_defaults(&c->ball);
+    c->mode = INSTANTIATED;
     return c;
 }
 
@@ -57,10 +65,19 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol, fmi2Real t, fmi
     ((Instance *)c)->ball.time = start;
     return fmi2OK;
 }
-fmi2Status fmi2EnterInitializationMode(fmi2Component c) { CHECK(c); return fmi2OK; }
-fmi2Status fmi2ExitInitializationMode(fmi2Component c) { CHECK(c); return fmi2OK; }
+static fmi2Status enter(fmi2Component c, int mode) {
+    CHECK(c);
+    ((Instance *)c)->mode = mode;
+    return fmi2OK;
+}
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) { return enter(c, INITIALIZATION); }
+fmi2Status fmi2ExitInitializationMode(fmi2Component c) { return enter(c, EVENT); }
 fmi2Status fmi2Terminate(fmi2Component c) { CHECK(c); return fmi2OK; }
-fmi2Status fmi2Reset(fmi2Component c) { CHECK(c); ball_defaults(&((Instance *)c)->ball); return fmi2OK; }
+fmi2Status fmi2Reset(fmi2Component c) {
+    CHECK(c);
+    ball_defaults(&((Instance *)c)->ball);
+    return enter(c, INSTANTIATED);
+}
 
 fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], size_t n, fmi2Real value[]) {
     Instance *c = component;
@@ -69,7 +86,7 @@ fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], s
     for (size_t i = 0; i < n; i++) {
         switch (vr[i]) {
         case 0: value[i] = b->h; break;
-        case 1: value[i] = b->resting ? 0.0 : b->v; break;
+        case 1: value[i] = ball_height_rate(b); break;
         case 2: value[i] = b->v; break;
         case 3: value[i] = ball_acceleration(b); break;
         case 4: value[i] = b->g; break;
@@ -126,15 +143,24 @@ fmi2Status fmi2GetBoolean(fmi2Component component, const fmi2ValueReference vr[]
     Instance *c = component;
     CHECK(c);
     for (size_t i = 0; i < n; i++) {
-        if (vr[i] != 0) return refuse(c, "fmi2GetBoolean: no such Boolean");
-        value[i] = c->ball.late ? fmi2True : fmi2False;
+        if (vr[i] == 0) value[i] = c->ball.late ? fmi2True : fmi2False;
+        else if (vr[i] == 1) value[i] = c->ball.frozen ? fmi2True : fmi2False;
+        else return refuse(c, "fmi2GetBoolean: no such Boolean");
     }
     return fmi2OK;
 }
 
-fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean value[]) {
-    (void)vr; (void)n; (void)value;
-    return refuse(c, "fmi2SetBoolean: no settable Boolean");
+fmi2Status fmi2SetBoolean(fmi2Component component, const fmi2ValueReference vr[], size_t n,
+                          const fmi2Boolean value[]) {
+    Instance *c = component;
+    CHECK(c);
+    if (!(c->mode & SET_DISCRETE))
+        return refuse(c, "fmi2SetBoolean: the discrete input frozen cannot be set in Continuous-Time Mode");
+    for (size_t i = 0; i < n; i++) {
+        if (vr[i] != 1) return refuse(c, "fmi2SetBoolean: not the Boolean input");
+        c->ball.frozen = value[i] != fmi2False;
+    }
+    return fmi2OK;
 }
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String value[]) {
     (void)vr; (void)n; (void)value;
@@ -185,7 +211,7 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 }
 
 /* --- Model Exchange ------------------------------------------------------------------------- */
-fmi2Status fmi2EnterEventMode(fmi2Component c) { CHECK(c); return fmi2OK; }
+fmi2Status fmi2EnterEventMode(fmi2Component c) { return enter(c, EVENT); }
 fmi2Status fmi2NewDiscreteStates(fmi2Component component, fmi2EventInfo *info) {
     Instance *c = component;
     CHECK(c && info);
@@ -199,7 +225,7 @@ fmi2Status fmi2NewDiscreteStates(fmi2Component component, fmi2EventInfo *info) {
     info->nextEventTime = isfinite(next) ? next : 0.0;
     return fmi2OK;
 }
-fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { CHECK(c); return fmi2OK; }
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { return enter(c, CONTINUOUS); }
 fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean no_prior, fmi2Boolean *event,
                                        fmi2Boolean *terminate) {
     (void)no_prior;
@@ -223,7 +249,7 @@ fmi2Status fmi2SetContinuousStates(fmi2Component component, const fmi2Real x[], 
 fmi2Status fmi2GetDerivatives(fmi2Component component, fmi2Real dx[], size_t n) {
     Instance *c = component;
     CHECK(c && n == 2);
-    dx[0] = c->ball.resting ? 0.0 : c->ball.v;
+    dx[0] = ball_height_rate(&c->ball);
     dx[1] = ball_acceleration(&c->ball);
     return fmi2OK;
 }

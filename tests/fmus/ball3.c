@@ -121,7 +121,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], 
         switch (vr[i]) {
         case 0: values[i] = b->time; break;
         case 1: values[i] = b->h; break;
-        case 2: values[i] = b->resting ? 0.0 : b->v; break;
+        case 2: values[i] = ball_height_rate(b); break;
         case 3: values[i] = b->v; break;
         case 4: values[i] = ball_acceleration(b); break;
         case 5: values[i] = b->g; break;
@@ -368,7 +368,7 @@ fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 x[],
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 dx[], size_t n) {
     Instance *c = instance;
     CHECK(c && n == 2);
-    dx[0] = c->ball.resting ? 0.0 : c->ball.v;
+    dx[0] = ball_height_rate(&c->ball);
     dx[1] = ball_acceleration(&c->ball);
     return fmi3OK;
 }

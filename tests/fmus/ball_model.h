@@ -2,6 +2,7 @@
  * Co-Simulation and Model Exchange): the equations once, each interface's calls around them.
  *
  *   der(h) = v,  der(v) = a - g           (h: height [m], v: velocity [m/s], a: input [m/s2])
+ *   frozen (a discrete input, ball2 only): the ball is held where it is (both derivatives 0)
  *   state event  h = 0 falling: v := -e v (count += 1); below V_REST the ball rests on the floor
  *   time event   t = tSwitch: late := true
  *   maxBounces > 0: the simulation ends at that bounce.
@@ -20,19 +21,23 @@ typedef struct {
     double g, e;        /* m/s2 gravity, 1 coefficient of restitution */
     double a;           /* m/s2: input, an upward acceleration */
     double t_switch;    /* s: the time event */
-    int count, max_bounces, late, resting, terminated;
+    int count, max_bounces, late, resting, terminated, frozen;
 } Ball;
 
 static inline void ball_defaults(Ball *b) {
     b->time = 0.0; b->h = 1.0; b->v = 0.0; b->g = 9.81; b->e = 0.7; b->a = 0.0; b->t_switch = 0.5;
-    b->count = 0; b->max_bounces = 0; b->late = 0; b->resting = 0; b->terminated = 0;
+    b->count = 0; b->max_bounces = 0; b->late = 0; b->resting = 0; b->terminated = 0; b->frozen = 0;
 }
 
 /* m/s2: the acceleration (none while resting, unless the input lifts the ball). */
 static inline double ball_acceleration(const Ball *b) {
     double acceleration = b->a - b->g;
+    if (b->frozen) return 0.0;
     return b->resting && acceleration <= 0.0 ? 0.0 : acceleration;
 }
+
+/* m/s: the rate of the height (none while resting or frozen). */
+static inline double ball_height_rate(const Ball *b) { return b->resting || b->frozen ? 0.0 : b->v; }
 
 /* The event indicator: the height (positive in flight; a resting ball has none to cross). */
 static inline double ball_indicator(const Ball *b) { return b->resting ? 1.0 : b->h; }
