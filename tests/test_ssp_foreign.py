@@ -16,7 +16,7 @@ from typed_fmu import build_typed_fmu
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, run
-from rover_cosim.orchestrator.model import SystemFileError
+from rover_cosim.orchestrator.model import System, SystemFileError
 from rover_cosim.orchestrator.ssp import SspError, export_ssp, load_ssp, validate_ssd
 
 SSD_HEAD = ('<?xml version="1.0" encoding="UTF-8"?>\n<ssd:SystemStructureDescription '
@@ -183,7 +183,7 @@ def test_what_the_engine_does_not_run_is_named(typed, tmp_path):
         load_ssp(archive, tmp_path / "unpacked")
 
 
-def _mixed_archive(typed: Path, folder: Path) -> tuple[object, Path]:
+def _mixed_archive(typed: Path, folder: Path) -> tuple[System, Path]:
     """a -> b across Real, Integer and Boolean (what FMPy's and libcosim's SSP readers exchange),
     Jacobi; a's k and b given start values, exported as an SSP archive."""
     system = (SystemBuilder("mixed").simulation(stop_time=0.5, step=0.1, algorithm="jacobi")
@@ -199,7 +199,7 @@ def test_fmpy_runs_our_mixed_type_archive_to_our_values(typed, tmp_path):
     from rover_cosim.orchestrator.ssp import fmpy_parameter_set
 
     system, archive = _mixed_archive(typed, tmp_path)
-    ours = run(system).data  # type: ignore[arg-type]
+    ours = run(system).data
     theirs = simulate_ssp(str(archive), stop_time=0.5, step_size=0.1, parameter_set=fmpy_parameter_set(archive))
     # FMPy's simulate_ssp labels each row with the time at the start of the step it has just taken,
     # and starts the connections at 0 in its first step (no initial exchange): its row k is our row
@@ -217,7 +217,7 @@ def test_libcosim_runs_our_mixed_type_archive_to_our_values(typed, tmp_path):
 
     log_output_level(CosimLogLevel.ERROR)
     system, archive = _mixed_archive(typed, tmp_path)
-    ours = run(system).data  # type: ignore[arg-type]
+    ours = run(system).data
     execution = CosimExecution.from_ssp_file(str(archive), step_size=round(0.1 * 1e9))
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer)
