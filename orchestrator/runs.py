@@ -57,15 +57,29 @@ def sidecar_path(csv_path: Path) -> Path:
 
 
 def table_bytes(data: Any, path: Path) -> bytes:
-    """``data`` (a DataFrame) as the bytes of ``path``'s format: CSV at full precision (Python's
-    shortest repr of each float: it reads back equal), or Parquet (pyarrow)."""
-    if Path(path).suffix.lower() == ".parquet":
-        import io
+    """``data`` (a DataFrame) as the bytes of ``path``'s format: CSV at full precision (the
+    shortest text of each float that reads back equal; Arrow's writer, ~10x pandas' speed; Booleans
+    as true/false, Strings quoted), or Parquet (pyarrow; every column keeps its type)."""
+    import io
 
-        buffer = io.BytesIO()
-        data.to_parquet(buffer, engine="pyarrow", index=False)
+    import pyarrow as pa
+
+    table = pa.Table.from_pandas(data, preserve_index=False)
+    buffer = io.BytesIO()
+    if Path(path).suffix.lower() == ".parquet":
+        import pyarrow.parquet as pq
+
+        pq.write_table(table, buffer)
         return buffer.getvalue()
-    return data.to_csv(index=False).encode()
+    import csv
+
+    import pyarrow.csv as pc
+
+    header = io.StringIO()
+    csv.writer(header, lineterminator="\n").writerow([str(c) for c in data.columns])
+    buffer.write(header.getvalue().encode())
+    pc.write_csv(table, buffer, pc.WriteOptions(include_header=False, quoting_style="needed"))
+    return buffer.getvalue()
 
 
 def partial_path(csv_path: Path) -> Path:
