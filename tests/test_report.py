@@ -43,7 +43,62 @@ def test_every_table_scrolls_inside_its_box(page):
 
 def test_outside_the_papers_scope_is_described_with_numbers(page):
     section = page[page.index("Behaviour outside the paper"):]
-    assert re.search(r"At zero slip Fx is the rolling resistance: -?\d+\.\d N", section)
+    # the paper's soil: a resistance at the lightest load, a pull at the heaviest
+    assert re.search(r"At zero slip Fx is a resistance of \d+\.\d N at 100 N and a pull of \d+\.\d N at 800 N",
+                     section)
+    assert "pulls at zero slip at" in section
+
+
+def _fig3_only(folder, values):
+    """A results folder with only a Fig. 3 table: Fx at zero slip per load as given."""
+    folder.mkdir()
+    rows = ["load_N,slip,Fx_N"] + [f"{load},0.0,{fx}" for load, fx in values] + [f"{load},0.1,50" for load, _ in values]
+    (folder / "fig3_fx_vs_slip.csv").write_text("\n".join(rows) + "\n")
+    return build_report(folder)
+
+
+def test_the_zero_slip_sentence_follows_the_sign_of_the_force(tmp_path):
+    resisting = _fig3_only(tmp_path / "r", [(100, -0.8), (800, -3.5)])
+    assert "a resistance of 0.8 N at 100 N and a resistance of 3.5 N at 800 N" in resisting
+    assert "a rolling wheel needs some slip to pull" in resisting
+    pulling = _fig3_only(tmp_path / "p", [(100, 2.0), (800, 40.9)])
+    assert "a pull of 2.0 N at 100 N and a pull of 40.9 N at 800 N" in pulling
+    assert "the wheel pulls already when it rolls without slip" in pulling
+    assert "needs some slip to pull" not in pulling
+
+
+def _links(page: str) -> list[str]:
+    """Every src and href attribute of the page's tags."""
+    from html.parser import HTMLParser
+
+    found: list[str] = []
+
+    class Links(HTMLParser):
+        def handle_starttag(self, tag, attrs):  # noqa: ANN001, ANN202 - HTMLParser's hook
+            found.extend(value or "" for name, value in attrs if name in ("src", "href"))
+
+    Links().feed(page)
+    return found
+
+
+INJECTIONS = ("<script>alert(1)</script>", "<img src=x onerror=alert(1)>", "<iframe src=https://example.org>")
+
+
+def test_what_the_user_wrote_is_escaped_and_the_page_loads_nothing_remote(tmp_path):
+    from rover_cosim.terramechanics.library import choose
+
+    soil_file = tmp_path / "evil.toml"
+    soil_file.write_text(f"title = {INJECTIONS[1]!r}\nsource = {INJECTIONS[2]!r}\nc = 500.0\nphi_deg = 30.0\n")
+    named = tmp_path / "<script>alert(1)<_script>.toml"
+    named.write_text(soil_file.read_text())
+    results = tmp_path / "results"
+    write_fig3(results, choice=choose(soil=str(named)))
+    page = build_report(results)
+    for text in ("<script", "<img src=x", "<iframe"):  # as tags: nowhere (as text, escaped, they may be)
+        assert text not in page, text
+    assert "&lt;script&gt;alert(1)&lt;_script&gt;" in page and "&lt;iframe src=https://example.org&gt;" in page
+    assert not [value for value in _links(page) if not value.startswith(("data:", "#"))]  # nothing remote
+    assert "reproduction of Yoshikawa" not in page and "paper Fit" not in page
 
 
 @pytest.mark.skipif(shutil.which("chromium") is None, reason="chromium not on PATH (Debian package `chromium`)")

@@ -4,6 +4,7 @@ of every run. ``page``: HTML building blocks; ``sections``: one function per par
 
 from __future__ import annotations
 
+import html
 from pathlib import Path
 
 from . import sections
@@ -13,20 +14,27 @@ from .page import document
 def build_report(results: Path) -> str:
     results = Path(results)
     identification, simulation = results / "identification", results / "simulation"
-    parts = ["<h1>rover-cosim: reproduction of Yoshikawa et al.</h1>",
-             ("<p>Every number below is read from the files under <code>results/</code> written by "
-              "<code>make run</code>; the paper's values are quoted beside ours.</p>")]
+    paper_soil = sections.on_paper_soil(results)
+    label = html.escape(sections.soil_label(results))
+    if paper_soil:
+        parts = ["<h1>rover-cosim: reproduction of Yoshikawa et al. (paper's soil and wheel)</h1>",
+                 ("<p>Every number below is read from the files under <code>results/</code> written by "
+                  "<code>make run</code>; the paper's values are quoted beside ours.</p>")]
+    else:
+        parts = [f"<h1>rover-cosim: the paper's pipeline on {label}</h1>",
+                 ("<p>Every number below is read from the files under <code>results/</code>. The soil or wheel "
+                  "is not the paper's, so the paper's numbers are not set beside these.</p>")]
     parts += sections.soil_section(results)
     parts += sections.fig3_section(results)
-    parts += sections.identification_section(identification)
+    parts += sections.identification_section(identification, paper_soil)
     parts += sections.lateral_section(identification)
-    parts += sections.closed_loop_section(simulation)
+    parts += sections.closed_loop_section(simulation, paper_soil)
     parts += sections.path_section(simulation)
     parts += sections.coupling_section(results)
     parts += sections.montecarlo_section(results / "montecarlo")
     parts += sections.scope_section(results)
     parts += sections.provenance_section(results)
-    return document("rover-cosim report", parts)
+    return document(f"rover-cosim report: {sections.soil_label(results)}", parts)
 
 
 __all__ = ["build_report"]

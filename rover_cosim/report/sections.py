@@ -44,10 +44,31 @@ def _record(*paths: Path) -> dict[str, Any]:
     return {}
 
 
+def soil_record(results: Path) -> dict[str, Any]:
+    """The soil and wheel the results were made with (from the jobs' records; {} if none say)."""
+    return _record(results / "identification" / "identification.json", results / "simulation" / "simulation.json",
+                   results / "fig3_fx_vs_slip.json")
+
+
+def on_paper_soil(results: Path) -> bool:
+    """Whether the results are on the paper's soil and wheel (Table 2, unchanged): only then are
+    the paper's numbers set beside ours."""
+    record = soil_record(results)
+    soil, wheel = record.get("soil", {}), record.get("wheel", {})
+    paper_soil = soil.get("values", asdict(Soil())) == asdict(Soil())
+    return paper_soil and wheel.get("values", asdict(Wheel())) == asdict(Wheel()) and not record.get("set")
+
+
+def soil_label(results: Path) -> str:
+    """"soil NAME, wheel NAME" of the results (not escaped)."""
+    record = soil_record(results)
+    return (f"soil {record.get('soil', {}).get('name', 'paper')}, "
+            f"wheel {record.get('wheel', {}).get('name', 'paper')}")
+
+
 def soil_section(results: Path) -> list[str]:
     """Table 2: the soil and wheel in use beside the paper's."""
-    record = _record(results / "identification" / "identification.json", results / "simulation" / "simulation.json",
-                     results / "fig3_fx_vs_slip.json")
+    record = soil_record(results)
     soil, wheel = record.get("soil", {}), record.get("wheel", {})
     used = {**soil.get("values", asdict(Soil())), **wheel.get("values", asdict(Wheel()))}
     paper = {**asdict(Soil()), **asdict(Wheel())}
@@ -56,29 +77,37 @@ def soil_section(results: Path) -> list[str]:
         convert = math.degrees if key in ANGLES else float
         rows.append({"parameter": label, "unit": unit, "paper (Table 2, Ishigami 2007)": convert(paper[key]),
                      "in use": convert(used.get(key, paper[key]))})
-    name = f"{soil.get('name', 'paper')}: {soil.get('title') or 'the paper’s soil'}"
-    wheel_name = f"{wheel.get('name', 'paper')}: {wheel.get('title') or 'the paper’s wheel'}"
+    name = html.escape(f"{soil.get('name', 'paper')}: {soil.get('title') or 'the paper’s soil'}")
+    wheel_name = html.escape(f"{wheel.get('name', 'paper')}: {wheel.get('title') or 'the paper’s wheel'}")
+    changed = html.escape(", ".join(map(str, record.get("set") or [])))
+    source = html.escape(str(soil.get("source") or "paper Table 2"))
     return ["<h2>Soil and wheel in use (Table 2)</h2>",
-            f"<p>Soil <b>{name}</b>; wheel <b>{wheel_name}</b>"
-            + (f"; changed with {', '.join(record['set'])}" if record.get("set") else "") + ". Source: "
-            + f"{soil.get('source') or 'paper Table 2'}.</p>",
+            f"<p>Soil <b>{name}</b>; wheel <b>{wheel_name}</b>" + (f"; changed with {changed}" if changed else "")
+            + f". Source: {source}.</p>",
             table(pd.DataFrame(rows), default="{:.4g}")]
 
 
 def fig3_section(results: Path) -> list[str]:
     return ["<h2>Fig. 3: Fx against slip (numpy reference wheel)</h2>",
-            image(results / "fig3_fx_vs_slip.png", "Fx(slip) for loads 100-800 N, the soil in use")]
+            image(results / "fig3_fx_vs_slip.png", f"Fx(slip) for loads 100-800 N, {soil_label(results)}")]
 
 
-def identification_section(identification: Path) -> list[str]:
+def identification_section(identification: Path, paper_soil: bool = True) -> list[str]:
+    """Table 1 and the identified model; the paper's Fit beside ours only on the paper's soil."""
     sections = ["<h2>Identification (Sec. 3): Table 1</h2>"]
     models = identification / "fit_models.csv"
     if not models.exists():
         return [*sections, missing(models)]
     fits = pd.read_csv(models)
-    shown = pd.DataFrame({"load [N]": fits["load_N"], "paper Fit [%]": fits["paper_fit_percent"],
-                          "ours, linear Eq. (14) [%]": fits["fit_percent_linear"],
-                          "ours, quadratic (recommended) [%]": fits["fit_percent_quadratic"]})
+    columns = {"load [N]": fits["load_N"]}
+    if paper_soil:
+        columns["paper Fit [%]"] = fits["paper_fit_percent"]
+    columns.update({"ours, linear Eq. (14) [%]": fits["fit_percent_linear"],
+                    "ours, quadratic (recommended) [%]": fits["fit_percent_quadratic"]})
+    shown = pd.DataFrame(columns)
+    if not paper_soil:
+        sections.append("<p>Fit (Eq. 15) of the models identified on this soil; the paper's Table 1 is for its "
+                        "own soil and is not set beside them.</p>")
     sections.append(table(shown, {"load [N]": "{:.0f}"}, default="{:.1f}"))
     model_file = identification / "model.json"
     if model_file.exists():
@@ -139,17 +168,22 @@ CHECKS = {"time_to_98_percent_s": ("time to reach 0.98 m/s [s]", "{:.2f}"),
           "Fz_at_start_N": ("load at the start [N]", "{:.1f}")}
 
 
-def closed_loop_section(simulation: Path) -> list[str]:
+def closed_loop_section(simulation: Path, paper_soil: bool = True) -> list[str]:
+    """Table 3 and Fig. 10; the paper's RMS beside ours only on the paper's soil."""
     sections = ["<h2>Closed loop (Sec. 4): Table 3 and Fig. 10</h2>"]
     rms_path, cosim_path = simulation / "rms.csv", simulation / "rms_cosim.csv"
     if not (rms_path.exists() and cosim_path.exists()):
         return [*sections, missing(rms_path)]
     ours, cosim = pd.read_csv(rms_path), pd.read_csv(cosim_path)
-    paper = [f"{PAPER_RMS[i]:.1f}" if i in PAPER_RMS else f"— (mirror of limb {i - 3})" for i in ours["limb"]]
-    sections.append(table(pd.DataFrame({"limb": [str(i) for i in ours["limb"]], "paper RMS [N]": paper,
-                                        "ours, Rover.fmu [N]": ours["rms_N"],
-                                        "ours, RoverBody + 6 Wheel [N]": cosim["rms_N"]}), default="{:.2f}"))
-    sections.append("<p>RMS(Fx - Fx_des) per limb; limbs 4-6 mirror 1-3 (the paper reports 1-3).</p>")
+    columns: dict[str, Any] = {"limb": [str(i) for i in ours["limb"]]}
+    if paper_soil:
+        columns["paper RMS [N]"] = [f"{PAPER_RMS[i]:.1f}" if i in PAPER_RMS else f"— (mirror of limb {i - 3})"
+                                    for i in ours["limb"]]
+    columns.update({"ours, Rover.fmu [N]": ours["rms_N"], "ours, RoverBody + 6 Wheel [N]": cosim["rms_N"]})
+    sections.append(table(pd.DataFrame(columns), default="{:.2f}"))
+    sections.append("<p>RMS(Fx - Fx_des) per limb; limbs 4-6 mirror 1-3"
+                    + (" (the paper reports 1-3)." if paper_soil else "; the paper's Table 3 is for its own soil.")
+                    + "</p>")
     ablation = simulation / "ablation_fixed_load.csv"
     if ablation.exists():
         shown = pd.read_csv(ablation).rename(columns={"rms_lut_N": "RMS, per-load look-up tables [N]",
@@ -281,10 +315,20 @@ def scope_section(results: Path) -> list[str]:
         data = pd.read_csv(fig3)
         zero = data[data["slip"].abs() < 1e-12].sort_values("load_N")
         if len(zero):
-            lightest, heaviest = zero.iloc[0], zero.iloc[-1]
-            lines.append(f"<li>At zero slip Fx is the rolling resistance: {lightest['Fx_N']:.1f} N at "
-                         f"{lightest['load_N']:.0f} N and {heaviest['Fx_N']:.1f} N at {heaviest['load_N']:.0f} N "
-                         "(Fig. 3): a rolling wheel needs some slip to pull.</li>")
+            parts = [f"{'a pull' if fx > 0 else 'a resistance' if fx < 0 else 'no force'} of {abs(fx):.1f} N at "
+                     f"{load:.0f} N" for load, fx in ((float(r["load_N"]), float(r["Fx_N"])) for _, r in
+                                                       zero.iloc[[0, -1]].drop_duplicates().iterrows())]
+            pulling = [f"{load:.0f}" for load, fx in zip(zero["load_N"], zero["Fx_N"]) if fx > 0]
+            if not pulling:
+                meaning = "a rolling wheel needs some slip to pull"
+            elif len(pulling) == len(zero):
+                meaning = ("the wheel pulls already when it rolls without slip (its sinkage gives shear ahead of "
+                           "the contact's bottom)")
+            else:
+                meaning = (f"it pulls at zero slip at {', '.join(pulling)} N and needs some slip to pull at the "
+                           "other loads")
+            lines.append(f"<li>At zero slip Fx is {' and '.join(parts)} (Fig. 3, {html.escape(soil_label(results))}): "
+                         f"{meaning}.</li>")
     lines += ["<li>Standstill: below 1 mm/s the forces blend into a static regime (a wheel at rest with no torque "
               "stays at rest; on a slope a holding torque holds it), where the identified model, made from "
               "rolling runs, does not apply.</li>",
