@@ -122,8 +122,8 @@ def build(kind: str, name: str, table: dict[str, Any]) -> Soil | Wheel:
         base_wheel = Wheel(**_values("wheel", DEFAULT, _shipped(WHEELS)[DEFAULT]))
         return replace(base_wheel, **values)
     base = _values("soil", DEFAULT, _shipped(SOILS)[DEFAULT])
-    if "phi" in values and "xc" not in values:
-        base["xc"] = math.radians(45.0) - values["phi"] / 2
+    if "xc" not in values:
+        base.pop("xc", None)  # Soil derives it from the soil's own phi: 45 deg - phi/2
     try:
         return Soil(**{**base, **values})
     except ValueError as error:

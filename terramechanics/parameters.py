@@ -57,6 +57,16 @@ class Wheel:
         _check("J", self.J, self.J > 0, "J > 0 kg·m²")
 
 
+#: The value of ``Soil.xc`` that stands for "from φ": 45° - φ/2 (a NaN, replaced on construction).
+XC_FROM_PHI = float("nan")
+
+
+def xc_from_phi(phi: float) -> float:
+    """Hegedus's destructive angle X_c = 45° - φ/2 [rad] of a soil of friction angle ``phi`` [rad]
+    (as Ishigami et al. 2007 use it): the one definition, for the library, the jobs and the records."""
+    return math.radians(45.0) - float(phi) / 2
+
+
 @dataclass(frozen=True)
 class Soil:
     """Soil parameters of the Bekker/Wong-Reece/Ishigami wheel-soil model (Eqs. 3-10).
@@ -78,7 +88,10 @@ class Soil:
         ky_beta: growth of ky with the slip angle [m/rad] (0.020: ky = 0.020 |β| + 0.013 m).
         rho: dry density of the soil [kg/m³] (Ishigami et al. 2007: 1.6e3), for the sidewall.
         gravity: gravity acting on the soil [m/s²] (lunar, 1.62); rho·gravity is its weight density.
-        xc: destructive angle of the soil piled against the wheel's side [rad] (45° - φ/2 = 26.4°).
+        xc: destructive angle of the soil piled against the wheel's side [rad]; left out (or
+            :data:`XC_FROM_PHI`), Hegedus's 45° - φ/2, from the soil's own φ (26.4° for Table 2's
+            37.2°). ``dataclasses.replace(soil, phi=...)`` keeps the xc it had; ``library.vary``
+            and a soil table without xc derive it anew.
 
     The accepted ranges keep the contact patch well defined for every slip in [-1, 1]:
     0 < a0 - a1 and a0 + a1 < 1 put the maximum-stress angle strictly between the exit and
@@ -99,9 +112,11 @@ class Soil:
     ky_beta: float = 0.020
     rho: float = 1.6e3
     gravity: float = 1.62
-    xc: float = math.radians(26.4)
+    xc: float = float("nan")  # XC_FROM_PHI: 45 deg - phi/2, set in __post_init__
 
     def __post_init__(self) -> None:
+        if isinstance(self.xc, float) and math.isnan(self.xc) and isinstance(self.phi, (int, float)):
+            object.__setattr__(self, "xc", xc_from_phi(self.phi))
         _check_finite(self)
         _check("c", self.c, self.c >= 0, "c >= 0 Pa")
         _check("phi", self.phi, 0 < self.phi < math.pi / 2, "0 < phi < pi/2 rad")

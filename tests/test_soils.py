@@ -117,3 +117,21 @@ def test_run_gives_the_soil_to_every_fmu_that_has_it(fmu_dir, fmus, tmp_path):
                  "-o", str(default)]) == 0
     sand, paper = np.loadtxt(out, delimiter=",", skiprows=1), np.loadtxt(default, delimiter=",", skiprows=1)
     assert not np.allclose(sand[-1], paper[-1])
+
+
+def test_the_destructive_angle_follows_phi_however_phi_is_entered(tmp_path):
+    """X_c = 45 deg - phi/2 unless given: from a TOML file, --set, Soil.from_degrees, Soil(phi=...)
+    and library.vary the same soil has the same X_c (and so the same records and cache keys)."""
+    from rover_cosim.terramechanics.library import choose, fmu_parameters, vary
+    from rover_cosim.terramechanics.parameters import xc_from_phi
+
+    (tmp_path / "mine.toml").write_text("phi_deg = 35.0\n")
+    ways = [choose(soil=str(tmp_path / "mine.toml")).soil, choose(assignments=["soil.phi_deg=35"]).soil,
+            Soil.from_degrees(35.0), Soil(phi=math.radians(35.0)), vary(choose(), soil={"phi_deg": 35.0}).soil]
+    assert {soil.xc for soil in ways} == {xc_from_phi(math.radians(35.0))}
+    assert math.degrees(ways[0].xc) == pytest.approx(27.5, abs=1e-12)
+    assert len({tuple(sorted(fmu_parameters(soil, choose().wheel).items())) for soil in ways}) == 1
+    assert Soil().xc == math.radians(26.4)                       # the paper's Table 2 value, derived
+    (tmp_path / "given.toml").write_text("phi_deg = 35.0\nxc_deg = 20.0\n")
+    assert math.degrees(choose(soil=str(tmp_path / "given.toml")).soil.xc) == pytest.approx(20.0)
+    assert math.degrees(Soil.from_degrees(35.0, xc=math.radians(20.0)).xc) == pytest.approx(20.0)
