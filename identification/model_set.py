@@ -26,6 +26,10 @@ class ModelFileError(ValueError):
     """A model.json that cannot be read; the message names the file."""
 
 
+class ModelMismatch(ValueError):
+    """A model used on another soil or wheel than it was identified on; the message names both."""
+
+
 @dataclass
 class ModelSet:
     """The identified models of model.json (see the module docstring)."""
@@ -49,6 +53,28 @@ class ModelSet:
         if label not in self.longitudinal:
             raise ModelFileError(f"{self.source}: model {label!r} not in it (has {sorted(self.longitudinal)})")
         return self.longitudinal[label]
+
+    def mismatch(self, soil: dict[str, float], wheel: dict[str, float], soil_name: str = "?",
+                 wheel_name: str = "?") -> str | None:
+        """Why the models do not belong to the soil and wheel given (their values, SI, as
+        ``dataclasses.asdict`` gives them), or None: they were identified on them (or the file
+        does not say what they were identified on)."""
+        known_soil = self.details.get("soil", {}).get("values")
+        known_wheel = self.details.get("wheel", {}).get("values")
+        problems = []
+        for kind, known, given, name in (("soil", known_soil, soil, soil_name), ("wheel", known_wheel, wheel,
+                                                                                  wheel_name)):
+            if known is None:
+                continue
+            differ = sorted(k for k in set(known) | set(given) if known.get(k) != given.get(k))
+            if differ:
+                identified = self.details.get(kind, {}).get("name", "?")
+                problems.append(f"{kind} {identified!r} (identified on) is not {kind} {name!r} (in use): "
+                                f"{', '.join(differ)} differ")
+        if not problems:
+            return None
+        return (f"{self.source} was identified on another soil or wheel: {'; '.join(problems)}. Identify on this soil "
+                "(rover-cosim identify --soil ...), or pass --allow-model-mismatch to use it anyway")
 
     def to_dict(self) -> dict[str, Any]:
         details = dict(self.details)

@@ -146,6 +146,8 @@ def build_parser() -> argparse.ArgumentParser:
                           help="identified model (from `rover-cosim identify`)")
     simulate.add_argument("--only", choices=("straight", "path"), default=None,
                           help="only the paper's straight run, or only the path following (default: both)")
+    simulate.add_argument("--allow-model-mismatch", action="store_true",
+                          help="use a model identified on another soil or wheel (refused otherwise; recorded)")
     _add_soil_options(simulate)
 
     monte = commands.add_parser("montecarlo", help="Monte Carlo over soil uncertainty: the paper's closed loop with "
@@ -163,6 +165,9 @@ def build_parser() -> argparse.ArgumentParser:
     monte.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
     monte.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
     monte.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    monte.add_argument("--allow-model-mismatch", action="store_true",
+                       help="use a model identified on another soil or wheel than the study's nominal ones "
+                       "(refused otherwise; recorded)")
     monte.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
     commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources")
@@ -385,10 +390,12 @@ def _simulate(args: argparse.Namespace) -> int:
     if choice is None:
         return 2
     try:
+        allow = args.allow_model_mismatch
         if args.only != "path":
-            _print_straight(run_simulation(args.fmu_dir, args.model, args.out, choice))
+            _print_straight(run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow))
         if args.only != "straight":
-            _print_path(run_path_following(args.fmu_dir, args.model, args.out, choice=choice))
+            _print_path(run_path_following(args.fmu_dir, args.model, args.out, choice=choice,
+                                           allow_model_mismatch=allow))
     except (SystemFileError, RunError, ValueError) as error:
         print(f"rover-cosim simulate: {error} (nothing written)", file=sys.stderr)
         return 1
@@ -415,7 +422,8 @@ def _montecarlo(args: argparse.Namespace) -> int:
     bar = ProgressBar("montecarlo", enabled=not args.quiet)
     try:
         outcome = run_montecarlo(study, args.fmu_dir, args.model, args.out, workers=args.workers,
-                                 scheduler=args.scheduler, cache_dir=args.cache, progress=bar)
+                                 scheduler=args.scheduler, cache_dir=args.cache, progress=bar,
+                                 allow_model_mismatch=args.allow_model_mismatch)
     except (OSError, RuntimeError, ValueError) as error:
         bar.close()
         print(f"rover-cosim montecarlo: {error} (nothing written)", file=sys.stderr)

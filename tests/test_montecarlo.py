@@ -364,3 +364,31 @@ def test_the_report_shows_the_study_when_it_was_run(study_run, tmp_path):
     assert montecarlo_section(tmp_path / "none") == []   # no study run: no section
     page = build_report(folder.parent)
     assert "Monte Carlo over soil uncertainty" in page and "rover-cosim montecarlo" in page   # provenance too
+
+
+# --- a model on another soil -----------------------------------------------------------------------------
+
+def test_a_model_identified_on_another_soil_is_refused_naming_both(fmu_dir, model, tmp_path, capsys):
+    """simulate, the path following and the Monte Carlo refuse the session's model (identified on
+    the paper's soil) on lete_sand, naming both soils, before running anything; the flag lets it
+    through and says why in what it returns (and so in the records)."""
+    from rover_cosim.cli import main
+    from rover_cosim.identification.model_set import ModelMismatch
+    from rover_cosim.jobs.path_following import run_path_following
+    from rover_cosim.jobs.simulate import checked_models, run_simulation
+
+    other = choose(soil="lete_sand")
+    for job in (lambda: run_simulation(fmu_dir, model, tmp_path / "s", other),
+                lambda: run_path_following(fmu_dir, model, tmp_path / "p", choice=other)):
+        with pytest.raises(ModelMismatch, match="soil 'paper' \\(identified on\\) is not soil 'lete_sand' \\(in use\\)"):
+            job()
+    assert not (tmp_path / "s").exists() and not (tmp_path / "p").exists()
+    _, why = checked_models(model, other, allow_mismatch=True)
+    assert why is not None and "--allow-model-mismatch" in why
+    assert checked_models(model, choose(), allow_mismatch=False)[1] is None
+    with pytest.raises(ModelMismatch, match="study's nominal soil and wheel: lete_sand"):
+        run_montecarlo(_study(soil="lete_sand"), fmu_dir, model, tmp_path / "m", workers=1)
+    assert main(["simulate", "--model", str(model), "--fmu-dir", str(fmu_dir), "--soil", "lete_sand",
+                 "--out", str(tmp_path / "cli")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "was identified on another soil or wheel" in err and "Warning" not in err

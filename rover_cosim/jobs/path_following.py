@@ -44,7 +44,7 @@ from rover_cosim.terramechanics import Wheel
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover
-from .simulate import models_of
+from .simulate import checked_models, models_of
 
 STEP = 1e-3  # s
 WHEELS = range(1, 7)
@@ -163,14 +163,15 @@ def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str
 
 
 def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SCENARIOS),
-                       choice: Choice | None = None) -> PathResult:
+                       choice: Choice | None = None, *, allow_model_mismatch: bool = False) -> PathResult:
     """Every scenario on both plants and with kinematic steering, on the soil and wheel of
-    ``choice`` (default: the paper's); writes every file (all or none)."""
+    ``choice`` (default: the paper's); writes every file (all or none). A model identified on
+    another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``."""
     started = time.perf_counter()
     fmu_dir = Path(fmu_dir).resolve()
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     walls: dict[str, float] = {}
-    models = ModelSet.read(model)
+    models, mismatch = checked_models(model, choice, allow_model_mismatch)
     builds = {"inverse": lambda s: monolithic_system(fmu_dir, models, s, choice=choice),
               "cosim": lambda s: cosim_system(fmu_dir, models, s, choice),
               "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice)}
@@ -190,6 +191,7 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
                          "algorithm": "gauss-seidel"})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
+                   "model_mismatch": mismatch,
                    "wall_seconds": time.perf_counter() - started,
                    "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
     out = Path(out_dir)

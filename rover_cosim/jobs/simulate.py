@@ -13,7 +13,7 @@ results/simulation/
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +24,7 @@ from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, writ
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
-from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.identification.model_set import ModelMismatch, ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
@@ -123,15 +123,28 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
             "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
 
 
-def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None) -> SimulationResult:
+def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> tuple[ModelSet, str | None]:
+    """The models of ``model`` and why they do not belong to the soil and wheel of ``choice``
+    (None: they do); ModelMismatch naming both unless ``allow_mismatch``."""
+    models = ModelSet.read(model)
+    choice = choice or choose()
+    why = models.mismatch(asdict(choice.soil), asdict(choice.wheel), choice.soil_name, choice.wheel_name)
+    if why is not None and not allow_mismatch:
+        raise ModelMismatch(why)
+    return models, why
+
+
+def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None, *,
+                   allow_model_mismatch: bool = False) -> SimulationResult:
     """The closed loop on both plants and the ablation; writes every file (all or none). The
-    FMUs run on the soil and wheel of ``choice`` (default: the paper's)."""
+    FMUs run on the soil and wheel of ``choice`` (default: the paper's); a model identified on
+    another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``."""
     started = time.perf_counter()
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
     walls: dict[str, float] = {}
     fmu_dir = Path(fmu_dir).resolve()
-    models = ModelSet.read(model)
+    models, mismatch = checked_models(model, choice, allow_model_mismatch)
     for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
         outcome = run(build(fmu_dir, models, choice))
         tables[plant] = trajectories(outcome.data, plant)
@@ -146,7 +159,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
                                                   "algorithm": "gauss-seidel", "fixed_load_ablation_N": STATIC_LOAD})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in ("Rover", "RoverBody", "Wheel")},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls,
-                   **describe(choice or choose()),
+                   **describe(choice or choose()), "model_mismatch": mismatch,
                    "wall_seconds": time.perf_counter() - started, "checks": results,
                    "rms_N": {"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
                              "fixed_load_ablation": ablation["rms_N"].tolist()}})

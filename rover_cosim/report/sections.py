@@ -192,6 +192,9 @@ def closed_loop_section(simulation: Path, paper_soil: bool = True) -> list[str]:
         sections += ["<p>Ablation: the same controller with one model at a fixed 424 N instead of the per-load "
                      "look-up tables:</p>", table(shown, default="{:.2f}")]
     record_path = simulation / "simulation.json"
+    if record_path.exists() and json.loads(record_path.read_text()).get("model_mismatch"):
+        why = html.escape(str(json.loads(record_path.read_text())["model_mismatch"]))
+        sections.insert(1, f"<p class='note'>Run with --allow-model-mismatch: {why}</p>")
     if record_path.exists():
         checks = json.loads(record_path.read_text()).get("checks", {})
         rows = [{"plant": {"monolithic": "Rover.fmu", "cosim": "RoverBody + 6 Wheel"}.get(p, p),

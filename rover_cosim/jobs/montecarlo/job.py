@@ -22,7 +22,7 @@ import os
 import time
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +32,7 @@ import pandas as pd
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 from rover_cosim.common.parallel import parallel_map
 from rover_cosim.identification.cache import discard, remove_partial_files
-from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.identification.model_set import ModelMismatch, ModelSet
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
 from .. import path_following
@@ -198,25 +198,21 @@ def simulate_check(simulation: Path, nominal: dict[str, Any] | None, study: Stud
             "largest_difference_N": max(abs(a - b) for a, b in zip(ours, theirs))}
 
 
-def identified_on(model: Path, nominal: dict[str, Any]) -> dict[str, Any]:
-    """The soil and wheel the model was identified on (identification.json beside model.json), and
-    whether they are the study's nominal ones; a warning when they are not."""
-    record_path = model.parent / "identification.json"
-    if not record_path.exists():
-        return {"known": False, "why": f"{record_path} not found"}
-    record = json.loads(record_path.read_text())
-    soil, wheel = record.get("soil", {}), record.get("wheel", {})
-    same = soil.get("values") == nominal["soil"] and wheel.get("values") == nominal["wheel"]
-    if not same:
-        warnings.warn(f"{model} was identified on soil {soil.get('name')!r} and wheel {wheel.get('name')!r}, not on "
-                      "the study's nominal soil and wheel: sample 0 is then not the identification soil", stacklevel=3)
-    return {"known": True, "soil": soil.get("name"), "wheel": wheel.get("name"), "same_as_nominal": same}
+def identified_on(models: ModelSet, nominal: Choice) -> dict[str, Any]:
+    """The soil and wheel the models were identified on (model.json's record), and whether they
+    are the study's nominal ones (and if not, why)."""
+    soil, wheel = models.details.get("soil", {}), models.details.get("wheel", {})
+    if not soil.get("values"):
+        return {"known": False, "why": f"{models.source} does not record its soil"}
+    why = models.mismatch(asdict(nominal.soil), asdict(nominal.wheel), nominal.soil_name, nominal.wheel_name)
+    return {"known": True, "soil": soil.get("name"), "wheel": wheel.get("name"), "same_as_nominal": why is None,
+            "mismatch": why}
 
 
 def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, workers: int | None = None,
                    scheduler: str | None = None, cache_dir: Path | None = None,
                    progress: Callable[[float], None] | None = None, samples: pd.DataFrame | None = None,
-                   simulation: Path | None = None) -> MonteCarloResult:
+                   simulation: Path | None = None, allow_model_mismatch: bool = False) -> MonteCarloResult:
     """Run (or take from the cache) every sample of ``study`` and write every file (all or none).
     ``samples`` replaces the study's drawn samples (a table like sampling.sample_table's);
     ``simulation``: make simulate's folder, for the nominal check (default: beside ``out_dir``)."""
@@ -228,6 +224,11 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
         if not (fmu_dir / FMUS[scenario]).is_file():
             raise FileNotFoundError(f"FMU {fmu_dir / FMUS[scenario]} not found (run `make fmus`)")
     nominal_choice = choose(study.soil, study.wheel)
+    models = ModelSet.read(model)
+    identified = identified_on(models, nominal_choice)
+    if identified.get("mismatch") and not allow_model_mismatch:  # sample 0 would not be the model's soil
+        raise ModelMismatch(f"{identified['mismatch']} (the study's nominal soil and wheel: {study.soil}, "
+                            f"{study.wheel})")
     if samples is None:
         samples = sample_table(study, nominal_values(study, nominal_choice, fmu_dir))
     hashes = fingerprint({name: file_sha256(fmu_dir / name) for name in sorted(set(FMUS.values()))
@@ -235,7 +236,7 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     cache = Path(cache_dir) if cache_dir is not None else out / "cache"
     cache.mkdir(parents=True, exist_ok=True)
     remove_partial_files(cache)
-    specs = _specs(study, samples, fmu_dir, ModelSet.read(model), nominal_choice, cache, hashes)
+    specs = _specs(study, samples, fmu_dir, models, nominal_choice, cache, hashes)
     results, rejected = _cached(specs)
     missing = [s for s in specs if (s.sample, s.scenario) not in results]
     compute_started = time.perf_counter()
@@ -254,7 +255,7 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
         "fmus": hashes["fmus"], "model": str(model), "model_sha256": hashes["model"], **describe(nominal_choice),
         "nominal": f"sample 0: the soil and wheel the model was identified on ({study.soil}, {study.wheel}), "
                    "no parameter changed",
-        "model_identified_on": identified_on(model, hashes), "scenarios": numbers,
+        "model_identified_on": identified, "allow_model_mismatch": allow_model_mismatch, "scenarios": numbers,
         "runs_computed": len(missing), "runs_cached": len(specs) - len(missing), "runs_failed": len(failures),
         **_cost(runs, len(missing), compute_seconds, workers, scheduler),
         "simulate_check": simulate_check(simulation or out.parent / "simulation",
