@@ -380,7 +380,7 @@ def test_a_model_identified_on_another_soil_is_refused_naming_both(fmu_dir, mode
     other = choose(soil="lete_sand")
     for job in (lambda: run_simulation(fmu_dir, model, tmp_path / "s", other),
                 lambda: run_path_following(fmu_dir, model, tmp_path / "p", choice=other)):
-        with pytest.raises(ModelMismatch, match="soil 'paper' \\(identified on\\) is not soil 'lete_sand' \\(in use\\)"):
+        with pytest.raises(ModelMismatch, match=r"soil 'paper' \(identified on\) is not soil 'lete_sand' \(in use\)"):
             job()
     assert not (tmp_path / "s").exists() and not (tmp_path / "p").exists()
     _, why = checked_models(model, other, allow_mismatch=True)
