@@ -123,7 +123,7 @@ class ModelSet:
         try:
             text = path.read_bytes()
         except FileNotFoundError:
-            raise ModelFileError(f"identified model {path} not found (run `make identify`)") from None
+            raise ModelFileError(f"identified model {path} not found (make it with `rover-cosim identify`)") from None
         except OSError as error:
             raise ModelFileError(f"identified model {path}: cannot be read ({error})") from None
         return ModelSet.from_json(text, str(path))

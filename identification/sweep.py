@@ -211,7 +211,7 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
     if fmu_path is not None:
         fmu_path = Path(fmu_path).resolve()
         if not fmu_path.is_file():
-            raise FileNotFoundError(f"FMU {fmu_path} not found (run `make fmus`)")
+            raise FileNotFoundError(f"FMU {fmu_path} not found (build them with `rover-cosim build-fmus`)")
     folder = Path(cache_dir) / _plant_key(fmu_path) / plan.digest()
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "plan.json").write_text(json.dumps({**asdict(plan), "plant": str(fmu_path or "numpy reference")},

@@ -82,7 +82,7 @@ def read_fmu(fmu_path: Path, where: str) -> Any:
     """The model description of an FMI 2.0 or 3.0 FMU file with a Co-Simulation or Model
     Exchange interface (``where``: the label of messages); SystemFileError for anything else."""
     if not fmu_path.is_file():
-        raise SystemFileError(f"{where}: FMU file {fmu_path} not found (run `make fmus`?)")
+        raise SystemFileError(f"{where}: FMU file {fmu_path} not found (build them with `rover-cosim build-fmus`)")
     try:
         description = fmpy.read_model_description(str(fmu_path))
     except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds

@@ -170,7 +170,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "(refused otherwise; recorded)")
     monte.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
-    commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources")
+    soils = commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources; "
+                                "`soils NAME` shows one with every value and its unit")
+    soils.add_argument("name", nargs="?", default=None, help="a soil or wheel (shipped name, TOML file or FILE:NAME)")
     commands.add_parser("blocks", help="the block types of system files, with their keys, units and defaults")
 
     report = commands.add_parser("report", help="results/report.html: figures and tables beside the paper's")
@@ -332,6 +334,8 @@ def _cosim_study(args: argparse.Namespace) -> int:
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
 
+    if not _output_folder(args.out, "cosim-study"):
+        return 2
     try:
         outcome = write_cosim_study(args.fmu_dir, args.out)
     except (SystemFileError, RunError) as error:
@@ -347,11 +351,13 @@ def _identify(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.identify import run_identification
     from rover_cosim.progress import ProgressBar
 
+    if not _output_folder(args.out, "identify"):
+        return 2
     if args.workers is not None and args.workers < 1:
         print(f"rover-cosim identify: --workers {args.workers}: expected >= 1", file=sys.stderr)
         return 2
     if not args.fmu.is_file():
-        print(f"rover-cosim identify: FMU {args.fmu} not found (run `make fmus`)", file=sys.stderr)
+        print(f"rover-cosim identify: FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)", file=sys.stderr)
         return 2
     choice = _choice(args, "identify")
     if choice is None:
@@ -383,8 +389,10 @@ def _simulate(args: argparse.Namespace) -> int:
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
 
+    if not _output_folder(args.out, "simulate"):
+        return 2
     if not args.model.is_file():
-        print(f"rover-cosim simulate: identified model {args.model} not found (run `make identify`)", file=sys.stderr)
+        print(f"rover-cosim simulate: identified model {args.model} not found (make it with `rover-cosim identify`)", file=sys.stderr)
         return 2
     choice = _choice(args, "simulate")
     if choice is None:
@@ -406,18 +414,20 @@ def _montecarlo(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
     from rover_cosim.progress import ProgressBar
 
+    if not _output_folder(args.out, "montecarlo"):
+        return 2
     for option, value, least in (("--workers", args.workers, 1), ("--runs", args.runs, 1), ("--seed", args.seed, 0)):
         if value is not None and value < least:
             print(f"rover-cosim montecarlo: {option} {value}: expected >= {least}", file=sys.stderr)
             return 2
-    if not args.model.is_file():
-        print(f"rover-cosim montecarlo: identified model {args.model} not found (run `make identify`)",
-              file=sys.stderr)
-        return 2
     try:
         study = load_study(args.study, runs=args.runs, seed=args.seed)
     except StudyError as error:
         print(f"rover-cosim montecarlo: {error}", file=sys.stderr)
+        return 2
+    if not args.model.is_file():
+        print(f"rover-cosim montecarlo: identified model {args.model} not found (make it with `rover-cosim identify`)",
+              file=sys.stderr)
         return 2
     bar = ProgressBar("montecarlo", enabled=not args.quiet)
     try:
@@ -532,16 +542,58 @@ def _blocks(args: argparse.Namespace) -> int:
     return 0
 
 
+def _output_folder(out: Path, command: str) -> bool:
+    """Whether ``out`` can be an output folder (absent or a folder); else says why (on stderr)."""
+    if out.exists() and not out.is_dir():
+        print(f"rover-cosim {command}: --out {out} is a file: expected a folder (absent or existing)", file=sys.stderr)
+        return False
+    return True
+
+
 def _soils(args: argparse.Namespace) -> int:
     from rover_cosim.terramechanics import library
 
+    if args.name is not None:
+        return _one_soil(args.name)
     for kind in ("soil", "wheel"):
         print(f"{kind}s (--{kind} NAME):")
         for name in library.names(kind):
             _, table = library.entry(kind, name)
             print(f"  {name:15s} {table.get('title', '')}")
             print(f"  {'':15s} source: {table.get('source', '')}")
-    print(f"files: {library.SOILS}, {library.WHEELS}")
+    print(f"files: {library.SOILS}, {library.WHEELS}; `rover-cosim soils NAME` shows one")
+    return 0
+
+
+def _one_soil(name: str) -> int:
+    """``rover-cosim soils NAME``: one soil or wheel, every value with its unit, and its source."""
+    import math
+    from dataclasses import asdict
+
+    from rover_cosim.terramechanics import library
+    from rover_cosim.terramechanics.parameters import UNITS
+
+    found = []
+    for kind in ("soil", "wheel"):
+        try:
+            entry_name, table = library.entry(kind, name)
+            found.append((kind, entry_name, table, library.build(kind, entry_name, table)))
+        except ValueError:
+            continue
+    if not found:
+        print(f"rover-cosim soils: {name!r}: no shipped soil or wheel of that name, and no such TOML file (soils: "
+              f"{', '.join(library.names('soil'))}; wheels: {', '.join(library.names('wheel'))})", file=sys.stderr)
+        return 2
+    for kind, entry_name, table, built in found:
+        print(f"{kind} {entry_name}: {table.get('title', '')}")
+        print(f"  source: {table.get('source', '')}")
+        for key, value in asdict(built).items():
+            shown = f"{value:.6g}" + (f" rad ({math.degrees(value):.4g} deg)" if key in ("phi", "xc") else "")
+            given = "" if key in table or f"{key}_deg" in table else "  (default" + (
+                ": 45 deg - phi/2)" if key == "xc" else ": the paper's)")
+            print(f"  {key:8s} {shown} {UNITS.get(key, '') if key not in ('phi', 'xc') else ''}{given}")
+        for key, note in table.get("notes", {}).items():
+            print(f"  note {key}: {note}")
     return 0
 
 
@@ -549,7 +601,7 @@ def _fig3(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.fig3 import PAPER_LOADS, slip_grid, write_fig3
 
     choice = _choice(args, "fig3")
-    if choice is None:
+    if choice is None or not _output_folder(args.out, "fig3"):
         return 2
     try:
         written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step), choice)

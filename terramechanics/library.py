@@ -80,6 +80,9 @@ def entry(kind: str, spec: str) -> tuple[str, dict[str, Any]]:
     if not Path(spec).is_file() and ":" in spec:
         path, name = spec.rsplit(":", 1)
     if not Path(path).is_file():
+        if Path(path).suffix.lower() == ".toml" or "/" in path:
+            raise ValueError(f"{kind} file {path} not found (a {kind} is a shipped name: {', '.join(library)}; "
+                             "a TOML file; or FILE:NAME)")
         raise ValueError(f"{kind} {spec!r}: expected one of {', '.join(library)}, a TOML file or FILE:NAME")
     tables = _tables(Path(path))
     if any(isinstance(v, (int, float)) for v in tables.values()):
@@ -109,6 +112,9 @@ def _values(kind: str, name: str, table: dict[str, Any]) -> dict[str, float]:
         if key in DEGREES:
             if DEGREES[key] in table:
                 raise ValueError(f"{kind} {name!r}: both {key} and {DEGREES[key]} given")
+            if not 0 < float(value) < 90:
+                raise ValueError(f"{kind} {name!r}: {key} = {float(value)!r} is not physical: expected 0 < {key} < 90 "
+                                 "deg")
             values[DEGREES[key]] = math.radians(float(value))
         else:
             values[key] = float(value)

@@ -57,6 +57,12 @@ class Wheel:
         _check("J", self.J, self.J > 0, "J > 0 kg·m²")
 
 
+#: The SI unit of every Soil and Wheel field (angles in rad; the library's files may give them in
+#: degrees under ``phi_deg``, ``xc_deg``).
+UNITS = {"c": "Pa", "phi": "rad", "kc": "N/m^(n+1)", "kphi": "N/m^(n+2)", "n": "1", "kx": "m", "a0": "1", "a1": "1",
+         "lam": "1", "kx_beta": "m/rad", "ky": "m", "ky_beta": "m/rad", "rho": "kg/m^3", "gravity": "m/s^2",
+         "xc": "rad", "r": "m", "b": "m", "J": "kg.m^2"}
+
 #: The value of ``Soil.xc`` that stands for "from φ": 45° - φ/2 (a NaN, replaced on construction).
 XC_FROM_PHI = float("nan")
 

@@ -74,3 +74,24 @@ def test_simulate_labels_what_it_prints(simulated, capsys):
     for label in ("time to reach 0.98 m/s [s]", "final velocity [m/s]", "Rover.fmu", "RoverBody + 6 Wheel",
                   "RMS(Fx - Fx_des), Rover.fmu [N]", "limb"):
         assert label in out, label
+
+
+def test_papercuts_are_messages_naming_the_value(tmp_path, capsys):
+    """An output folder that is a file, a soil file that is not there, an angle out of range in
+    degrees, one soil shown with its units and sources."""
+    existing = tmp_path / "a_file"
+    existing.write_text("x")
+    for command in (["fig3"], ["simulate"], ["identify"], ["cosim-study"]):
+        assert main([*command, "--out", str(existing)]) == 2
+        assert f"--out {existing} is a file: expected a folder" in capsys.readouterr().err
+    assert existing.read_text() == "x"
+    assert main(["fig3", "--soil", str(tmp_path / "nofile.toml"), "--out", str(tmp_path / "f")]) == 2
+    assert "nofile.toml not found" in capsys.readouterr().err
+    assert main(["fig3", "--set", "soil.phi_deg=95", "--out", str(tmp_path / "f")]) == 2
+    assert "phi_deg = 95.0 is not physical: expected 0 < phi_deg < 90 deg" in capsys.readouterr().err
+    assert main(["soils", "lete_sand"]) == 0
+    shown = capsys.readouterr().out
+    assert "soil lete_sand: LETE sand" in shown and "c        1300 Pa" in shown and "(31.1 deg)" in shown
+    assert "xc " in shown and "45 deg - phi/2" in shown
+    assert main(["soils", "nothing_of_that_name"]) == 2
+    assert "no shipped soil or wheel of that name" in capsys.readouterr().err

@@ -203,3 +203,17 @@ def test_installed_wheel_works_from_another_folder(wheel, tmp_path):
     with zipfile.ZipFile(elsewhere / "Y" / "SingleWheel.fmu") as archive:
         assert "modelDescription.xml" in archive.namelist()
     assert run([command, "--version"], cwd=elsewhere, env=env).startswith("rover-cosim ")
+
+
+def test_the_wheel_is_release_shaped(wheel):
+    """The wheel carries the license text, the typing marker and the metadata a package index shows;
+    the repository has a changelog and a citation file (of this software and the paper it reproduces)."""
+    with zipfile.ZipFile(wheel) as archive:
+        names = archive.namelist()
+        metadata = archive.read(next(n for n in names if n.endswith(".dist-info/METADATA"))).decode()
+    assert any(n.endswith("licenses/LICENSE") for n in names) and "rover_cosim/py.typed" in names
+    assert "License-Expression: Apache-2.0" in metadata and "Classifier: Typing :: Typed" in metadata
+    root = Path(__file__).resolve().parents[1]
+    assert "Apache License" in (root / "LICENSE").read_text() and "## Unreleased" in (root / "CHANGELOG.md").read_text()
+    citation = (root / "CITATION.cff").read_text()
+    assert "cff-version: 1.2.0" in citation and "Yoshikawa" in citation and "year: 2017" in citation

@@ -330,7 +330,9 @@ def test_cli_refuses_bad_input_naming_it(tmp_path, capsys):
     assert main(["montecarlo", "--workers", "0", "--model", str(model)]) == 2
     assert "--workers 0: expected >= 1" in capsys.readouterr().err
     assert main(["montecarlo", "--model", str(tmp_path / "none.json")]) == 2
-    assert "make identify" in capsys.readouterr().err
+    assert "make it with `rover-cosim identify`" in capsys.readouterr().err
+    assert main(["montecarlo", "--study", "nonexist", "--model", str(tmp_path / "none.json")]) == 2
+    assert "nonexist" in capsys.readouterr().err  # the study is named first, not the missing model
 
 
 def test_cli_runs_a_study_and_prints_the_share_meeting_1_n(model, fmu_dir, tmp_path, capsys):

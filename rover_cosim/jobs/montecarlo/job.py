@@ -219,10 +219,10 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     started = time.perf_counter()
     fmu_dir, model, out = Path(fmu_dir).resolve(), Path(model).resolve(), Path(out_dir)
     if not model.is_file():
-        raise FileNotFoundError(f"identified model {model} not found (run `make identify`)")
+        raise FileNotFoundError(f"identified model {model} not found (make it with `rover-cosim identify`)")
     for scenario in study.scenarios:
         if not (fmu_dir / FMUS[scenario]).is_file():
-            raise FileNotFoundError(f"FMU {fmu_dir / FMUS[scenario]} not found (run `make fmus`)")
+            raise FileNotFoundError(f"FMU {fmu_dir / FMUS[scenario]} not found (build them with `rover-cosim build-fmus`)")
     nominal_choice = choose(study.soil, study.wheel)
     models = ModelSet.read(model)
     identified = identified_on(models, nominal_choice)
