@@ -357,7 +357,8 @@ def _identify(args: argparse.Namespace) -> int:
         print(f"rover-cosim identify: --workers {args.workers}: expected >= 1", file=sys.stderr)
         return 2
     if not args.fmu.is_file():
-        print(f"rover-cosim identify: FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)", file=sys.stderr)
+        print(f"rover-cosim identify: FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)",
+              file=sys.stderr)
         return 2
     choice = _choice(args, "identify")
     if choice is None:
@@ -392,7 +393,8 @@ def _simulate(args: argparse.Namespace) -> int:
     if not _output_folder(args.out, "simulate"):
         return 2
     if not args.model.is_file():
-        print(f"rover-cosim simulate: identified model {args.model} not found (make it with `rover-cosim identify`)", file=sys.stderr)
+        print(f"rover-cosim simulate: identified model {args.model} not found (make it with `rover-cosim identify`)",
+              file=sys.stderr)
         return 2
     choice = _choice(args, "simulate")
     if choice is None:

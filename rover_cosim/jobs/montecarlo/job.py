@@ -222,7 +222,8 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
         raise FileNotFoundError(f"identified model {model} not found (make it with `rover-cosim identify`)")
     for scenario in study.scenarios:
         if not (fmu_dir / FMUS[scenario]).is_file():
-            raise FileNotFoundError(f"FMU {fmu_dir / FMUS[scenario]} not found (build them with `rover-cosim build-fmus`)")
+            raise FileNotFoundError(f"FMU {fmu_dir / FMUS[scenario]} not found (build them with "
+                                    "`rover-cosim build-fmus`)")
     nominal_choice = choose(study.soil, study.wheel)
     models = ModelSet.read(model)
     identified = identified_on(models, nominal_choice)
