@@ -126,6 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
                                 "monolithic one, Jacobi, Gauss-Seidel and iterative, steps 1-10 ms -> CSV + PNG")
     study.add_argument("--out", type=Path, default=Path("results/cosim_study"), help="output folder")
     study.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
+    study.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
     ident = commands.add_parser("identify", help="paper Sec. 3: step-torque sweep on SingleWheel.fmu, LUT and "
                                 "Fx(W, slip) fits, validation at 275/575/875 N -> results/identification/")
@@ -148,6 +149,7 @@ def build_parser() -> argparse.ArgumentParser:
                           help="only the paper's straight run, or only the path following (default: both)")
     simulate.add_argument("--allow-model-mismatch", action="store_true",
                           help="use a model identified on another soil or wheel (refused otherwise; recorded)")
+    simulate.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     _add_soil_options(simulate)
 
     monte = commands.add_parser("montecarlo", help="Monte Carlo over soil uncertainty: the paper's closed loop with "
@@ -333,14 +335,18 @@ def _cosim_study(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.cosim_study import write_cosim_study
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
+    from rover_cosim.progress import ProgressBar
 
     if not _output_folder(args.out, "cosim-study"):
         return 2
+    bar = ProgressBar("cosim-study", enabled=not args.quiet)
     try:
-        outcome = write_cosim_study(args.fmu_dir, args.out)
+        outcome = write_cosim_study(args.fmu_dir, args.out, progress=bar)
     except (SystemFileError, RunError) as error:
+        bar.close()
         print(f"rover-cosim cosim-study: {error} (nothing written)", file=sys.stderr)
         return 1
+    bar.close()
     print(outcome.table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     for path in outcome.files:
         print(f"wrote {path}")
@@ -389,6 +395,7 @@ def _simulate(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.simulate import run_simulation
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
+    from rover_cosim.progress import ProgressBar
 
     if not _output_folder(args.out, "simulate"):
         return 2
@@ -402,10 +409,17 @@ def _simulate(args: argparse.Namespace) -> int:
     try:
         allow = args.allow_model_mismatch
         if args.only != "path":
-            _print_straight(run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow))
+            bar = ProgressBar("simulate: the paper's straight run", enabled=not args.quiet)
+            straight = run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow,
+                                      progress=bar)
+            bar.close()
+            _print_straight(straight)
         if args.only != "straight":
-            _print_path(run_path_following(args.fmu_dir, args.model, args.out, choice=choice,
-                                           allow_model_mismatch=allow))
+            bar = ProgressBar("simulate: path following", enabled=not args.quiet)
+            path = run_path_following(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                                      progress=bar)
+            bar.close()
+            _print_path(path)
     except (SystemFileError, RunError, ValueError) as error:
         print(f"rover-cosim simulate: {error} (nothing written)", file=sys.stderr)
         return 1

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Callable
 from typing import TextIO
 
 
@@ -39,3 +40,17 @@ class ProgressBar:
         if self.drawn:
             self.stream.write("\n")
             self.stream.flush()
+
+
+class Stages:
+    """One progress callback over ``total`` stages of equal weight (the runs of a job):
+    ``stage(k)`` is the callback of stage ``k`` (0-based), telling ``progress`` (k + f) / total."""
+
+    def __init__(self, progress: Callable[[float], None] | None, total: int):
+        self.progress, self.total = progress, max(1, total)
+
+    def stage(self, k: int) -> Callable[[float], None] | None:
+        if self.progress is None:
+            return None
+        progress, total = self.progress, self.total
+        return lambda fraction: progress(min(1.0, (k + fraction) / total))

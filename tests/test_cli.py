@@ -95,3 +95,17 @@ def test_papercuts_are_messages_naming_the_value(tmp_path, capsys):
     assert "xc " in shown and "45 deg - phi/2" in shown
     assert main(["soils", "nothing_of_that_name"]) == 2
     assert "no shipped soil or wheel of that name" in capsys.readouterr().err
+
+
+def test_stages_report_one_rising_fraction_over_a_jobs_runs():
+    from rover_cosim.progress import Stages
+
+    told: list[float] = []
+    stages = Stages(told.append, 4)
+    for k in range(4):
+        callback = stages.stage(k)
+        assert callback is not None
+        for fraction in (0.0, 0.5, 1.0):
+            callback(fraction)
+    assert told == sorted(told) and told[0] == 0.0 and told[-1] == 1.0 and told[4] == 0.375
+    assert Stages(None, 3).stage(1) is None

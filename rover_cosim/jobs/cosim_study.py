@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import io
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,6 +25,7 @@ from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.system import System, load_system
+from rover_cosim.progress import Stages
 
 STEPS = (1e-3, 2e-3, 5e-3, 10e-3)  # s
 ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
@@ -42,30 +44,33 @@ def _system(name: str, fmu_dir: Path, **simulation: object) -> System:
     return replace_settings(load_system(path, fmu_dir=fmu_dir), name=f"{path.name} {simulation}", **simulation)
 
 
-def coupling_errors(fmu_dir: Path, steps: tuple[float, ...] = STEPS, stop_time: float = 6.0) -> pd.DataFrame:
+def coupling_errors(fmu_dir: Path, steps: tuple[float, ...] = STEPS, stop_time: float = 6.0,
+                    progress: Callable[[float], None] | None = None) -> pd.DataFrame:
     """One row per (algorithm, step): largest and RMS error of the body velocity [m/s], largest
     error of the wheel loads [N] and of the drawbar forces [N] over the run, wall times [s]."""
     rows = []
-    for step in steps:
-        for algorithm in ALGORITHMS:
-            mono_run = run(_system("rover_open_loop", fmu_dir, step=step, stop_time=stop_time, algorithm=algorithm))
-            mono = mono_run.data
-            cosim_run = run(_system("rover_cosim", fmu_dir, step=step, stop_time=stop_time, algorithm=algorithm))
-            cosim = cosim_run.data
-            dv = (cosim["body.v"] - mono["rover.v"]).to_numpy()
-            dfz = np.max([np.abs(cosim[f"wheel{i}.Fz"] - mono[f"rover.Fz[{i}]"]).max() for i in range(1, 7)])
-            dfx = np.max([np.abs(cosim[f"wheel{i}.Fx"] - mono[f"rover.Fx[{i}]"]).max() for i in range(1, 7)])
-            rows.append({
-                "algorithm": algorithm,
-                "step_s": step,
-                "max_abs_v_error_m_s": float(np.abs(dv).max()),
-                "rms_v_error_m_s": float(np.sqrt(np.mean(dv**2))),
-                "max_rel_v_error": float(np.abs(dv).max() / np.abs(mono["rover.v"]).max()),
-                "max_abs_Fz_error_N": float(dfz),
-                "max_abs_Fx_error_N": float(dfx),
-                "cosim_wall_s": cosim_run.wall_seconds,
-                "monolithic_wall_s": mono_run.wall_seconds,
-            })
+    stages = Stages(progress, 2 * len(steps) * len(ALGORITHMS))
+    for k, (step, algorithm) in enumerate((s, a) for s in steps for a in ALGORITHMS):
+        mono_run = run(_system("rover_open_loop", fmu_dir, step=step, stop_time=stop_time, algorithm=algorithm),
+                       progress=stages.stage(2 * k))
+        mono = mono_run.data
+        cosim_run = run(_system("rover_cosim", fmu_dir, step=step, stop_time=stop_time, algorithm=algorithm),
+                        progress=stages.stage(2 * k + 1))
+        cosim = cosim_run.data
+        dv = (cosim["body.v"] - mono["rover.v"]).to_numpy()
+        dfz = np.max([np.abs(cosim[f"wheel{i}.Fz"] - mono[f"rover.Fz[{i}]"]).max() for i in range(1, 7)])
+        dfx = np.max([np.abs(cosim[f"wheel{i}.Fx"] - mono[f"rover.Fx[{i}]"]).max() for i in range(1, 7)])
+        rows.append({
+            "algorithm": algorithm,
+            "step_s": step,
+            "max_abs_v_error_m_s": float(np.abs(dv).max()),
+            "rms_v_error_m_s": float(np.sqrt(np.mean(dv**2))),
+            "max_rel_v_error": float(np.abs(dv).max() / np.abs(mono["rover.v"]).max()),
+            "max_abs_Fz_error_N": float(dfz),
+            "max_abs_Fx_error_N": float(dfx),
+            "cosim_wall_s": cosim_run.wall_seconds,
+            "monolithic_wall_s": mono_run.wall_seconds,
+        })
     return pd.DataFrame(rows)
 
 
@@ -96,10 +101,11 @@ def figure_png(table: pd.DataFrame) -> bytes:
     return buffer.getvalue()
 
 
-def write_cosim_study(fmu_dir: Path, out_dir: Path) -> CosimStudyResult:
+def write_cosim_study(fmu_dir: Path, out_dir: Path,
+                      progress: Callable[[float], None] | None = None) -> CosimStudyResult:
     """Run the study and write coupling_error.csv, .png and .json into ``out_dir`` (all or none)."""
     started = time.perf_counter()
-    table = coupling_errors(fmu_dir)
+    table = coupling_errors(fmu_dir, progress=progress)
     record = run_record("rover-cosim cosim-study", {"fmu_dir": str(fmu_dir)})
     record["wall_seconds"] = time.perf_counter() - started
     files = {out_dir / "coupling_error.csv": table.to_csv(index=False, float_format="%.6g").encode(),

@@ -26,6 +26,7 @@ results/simulation/
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,6 +41,7 @@ from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
+from rover_cosim.progress import Stages
 from rover_cosim.terramechanics import Wheel
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
@@ -163,7 +165,8 @@ def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str
 
 
 def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SCENARIOS),
-                       choice: Choice | None = None, *, allow_model_mismatch: bool = False) -> PathResult:
+                       choice: Choice | None = None, *, allow_model_mismatch: bool = False,
+                       progress: Callable[[float], None] | None = None) -> PathResult:
     """Every scenario on both plants and with kinematic steering, on the soil and wheel of
     ``choice`` (default: the paper's); writes every file (all or none). A model identified on
     another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``."""
@@ -175,9 +178,10 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     builds = {"inverse": lambda s: monolithic_system(fmu_dir, models, s, choice=choice),
               "cosim": lambda s: cosim_system(fmu_dir, models, s, choice),
               "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice)}
-    for scenario in scenarios:
-        for label, build in builds.items():
-            outcome = run(build(scenario))
+    stages = Stages(progress, len(scenarios) * len(builds))
+    for i, scenario in enumerate(scenarios):
+        for j, (label, build) in enumerate(builds.items()):
+            outcome = run(build(scenario), progress=stages.stage(i * len(builds) + j))
             tables[scenario, label] = trajectories(outcome.data, cosim=label == "cosim")
             walls[f"{scenario}/{label}"] = outcome.wall_seconds
     rows = [{"scenario": s, "run": label, "target_speed_m_s": SCENARIOS[s], **metrics(tables[s, label], SCENARIOS[s])}

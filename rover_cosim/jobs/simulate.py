@@ -13,6 +13,7 @@ results/simulation/
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
@@ -28,6 +29,7 @@ from rover_cosim.identification.model_set import ModelMismatch, ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
+from rover_cosim.progress import Stages
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover, wire_hub
@@ -135,23 +137,26 @@ def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> 
 
 
 def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None, *,
-                   allow_model_mismatch: bool = False) -> SimulationResult:
+                   allow_model_mismatch: bool = False,
+                   progress: Callable[[float], None] | None = None) -> SimulationResult:
     """The closed loop on both plants and the ablation; writes every file (all or none). The
     FMUs run on the soil and wheel of ``choice`` (default: the paper's); a model identified on
-    another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``."""
+    another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``; ``progress``
+    is told how far the three runs are."""
     started = time.perf_counter()
+    stages = Stages(progress, 3)
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
     walls: dict[str, float] = {}
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
-    for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
-        outcome = run(build(fmu_dir, models, choice))
+    for k, (plant, build) in enumerate((("monolithic", monolithic_system), ("cosim", cosim_system))):
+        outcome = run(build(fmu_dir, models, choice), progress=stages.stage(k))
         tables[plant] = trajectories(outcome.data, plant)
         walls[plant] = outcome.wall_seconds
         results[plant] = checks(tables[plant])
-    ablation = rms(trajectories(run(monolithic_system(fmu_dir, models, choice, fixed_load=STATIC_LOAD)).data,
-                                "monolithic"))
+    ablation = rms(trajectories(run(monolithic_system(fmu_dir, models, choice, fixed_load=STATIC_LOAD),
+                                    progress=stages.stage(2)).data, "monolithic"))
     rms_mono, rms_cosim = rms(tables["monolithic"]), rms(tables["cosim"])
     ablation_table = pd.DataFrame({"limb": list(LIMBS), "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})
