@@ -16,6 +16,19 @@ from .participants import RunError
 from .recorder import RunResult
 
 
+def system_record(system: System) -> dict[str, Any]:
+    """What a record says of a system: every FMU (file, SHA-256, GUID, FMI version, interface and
+    every parameter and start value set) and every block (type, and its keys where it has them)."""
+    return {
+        "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid,
+                            "fmi_version": str(fmu.description.fmiVersion), "interface": fmu.interface,
+                            "parameters": dict(fmu.parameters), "start": dict(fmu.start)}
+                 for fmu in system.fmus},
+        "blocks": {block.name: block.kind for block in system.blocks},
+        "blocks_keys": {block.name: block.keys for block in system.blocks if block.keys is not None},
+    }
+
+
 def sidecar(system: System, result: RunResult, command: str,
             extra: dict[str, Any] | None = None) -> dict[str, object]:
     record = run_record(command, {"algorithm": system.algorithm, "step_s": system.step,
@@ -28,12 +41,7 @@ def sidecar(system: System, result: RunResult, command: str,
         "system_sha256": file_sha256(system.path) if system.path else None,
         "settings_from": system.settings_from,
         "stopped": result.stopped,
-        "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid,
-                            "fmi_version": str(fmu.description.fmiVersion), "interface": fmu.interface,
-                            "parameters": dict(fmu.parameters), "start": dict(fmu.start)}
-                 for fmu in system.fmus},
-        "blocks_keys": {block.name: block.keys for block in system.blocks if block.keys is not None},
-        "blocks": {block.name: block.kind for block in system.blocks},
+        **system_record(system),
         "steps": result.steps,
         "wall_seconds": result.wall_seconds,
         "participant_seconds": result.step_seconds,

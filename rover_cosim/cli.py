@@ -643,6 +643,9 @@ def _terminate(signum: int, frame: object) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    from rover_cosim.common.outputs import set_command_line
+
+    set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
     try:

@@ -140,3 +140,22 @@ def test_a_signal_ends_a_run_with_one_line_and_no_leftovers(fmu_dir, fmus, tmp_p
     assert process.returncode == 130, err
     assert "Traceback" not in err and err.strip().endswith("interrupted; nothing more written"), err
     assert not list(tmp_path.glob(f"{UNZIP_PREFIX}*")) and not (tmp_path / "out.csv").exists()
+
+
+def test_runs_on_two_soils_have_records_that_say_so(fmu_dir, fmus, tmp_path):
+    """`rover-cosim run ... --soil` on two soils: the records name the soil and wheel, hold every
+    FMU parameter set (the soil's among them) and the command line, and differ where results do."""
+    import json
+
+    records = {}
+    for soil in ("paper", "lete_sand"):
+        out = tmp_path / f"{soil}.csv"
+        assert main(["run", "single_wheel_step", "--fmu-dir", str(fmu_dir), "--soil", soil, "--stop-time", "0.2",
+                     "-o", str(out), "--quiet"]) == 0
+        records[soil] = json.loads(out.with_suffix(".json").read_text())
+    paper, lete = records["paper"], records["lete_sand"]
+    assert paper["soil"]["name"] == "paper" and lete["soil"]["name"] == "lete_sand"
+    assert paper["fmus"]["testbed"]["parameters"]["soil.c"] == 800.0
+    assert lete["fmus"]["testbed"]["parameters"]["soil.c"] == 1300.0
+    assert "--soil" in lete["command_line"] and "lete_sand" in lete["command_line"]
+    assert paper["fmus"]["testbed"]["sha256"] == lete["fmus"]["testbed"]["sha256"]

@@ -9,7 +9,7 @@ import platform
 import subprocess
 import sys
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
@@ -73,12 +73,22 @@ def json_bytes(value: object) -> bytes:
     return (json.dumps(value, indent=2, default=str) + "\n").encode()
 
 
+#: The command line of the command under way (rover_cosim.cli.main sets it); None: the process's.
+_COMMAND_LINE: list[str] | None = None
+
+
+def set_command_line(arguments: Sequence[str] | None) -> None:
+    """The command line records give (``rover-cosim`` and its arguments), or None for sys.argv."""
+    global _COMMAND_LINE
+    _COMMAND_LINE = None if arguments is None else list(arguments)
+
+
 def run_record(command: str, parameters: Mapping[str, object]) -> dict[str, object]:
     """What a run did: command (and the process's whole command line), parameters, versions, git
     commit, machine, time."""
     return {
         "command": command,
-        "command_line": list(sys.argv),
+        "command_line": list(_COMMAND_LINE) if _COMMAND_LINE is not None else list(sys.argv),
         "parameters": parameters,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "git_commit": _git_commit(),

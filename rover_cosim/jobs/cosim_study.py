@@ -24,6 +24,7 @@ from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.runs import system_record
 from rover_cosim.orchestrator.system import System, load_system
 from rover_cosim.progress import Stages
 
@@ -106,7 +107,10 @@ def write_cosim_study(fmu_dir: Path, out_dir: Path,
     """Run the study and write coupling_error.csv, .png and .json into ``out_dir`` (all or none)."""
     started = time.perf_counter()
     table = coupling_errors(fmu_dir, progress=progress)
-    record = run_record("rover-cosim cosim-study", {"fmu_dir": str(fmu_dir)})
+    record = run_record("rover-cosim cosim-study", {"fmu_dir": str(fmu_dir), "steps_s": list(STEPS),
+                                                    "algorithms": list(ALGORITHMS)})
+    record["systems"] = {name: system_record(load_system(example(name), fmu_dir=fmu_dir))
+                         for name in ("rover_open_loop", "rover_cosim")}
     record["wall_seconds"] = time.perf_counter() - started
     files = {out_dir / "coupling_error.csv": table.to_csv(index=False, float_format="%.6g").encode(),
              out_dir / "coupling_error.png": figure_png(table),

@@ -41,6 +41,7 @@ from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
+from rover_cosim.orchestrator.runs import system_record
 from rover_cosim.progress import Stages
 from rover_cosim.terramechanics import Wheel
 from rover_cosim.terramechanics.library import Choice, choose, describe
@@ -179,9 +180,12 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
               "cosim": lambda s: cosim_system(fmu_dir, models, s, choice),
               "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice)}
     stages = Stages(progress, len(scenarios) * len(builds))
+    systems: dict[str, Any] = {}
     for i, scenario in enumerate(scenarios):
         for j, (label, build) in enumerate(builds.items()):
-            outcome = run(build(scenario), progress=stages.stage(i * len(builds) + j))
+            system = build(scenario)
+            systems[f"{scenario}/{label}"] = system_record(system)
+            outcome = run(system, progress=stages.stage(i * len(builds) + j))
             tables[scenario, label] = trajectories(outcome.data, cosim=label == "cosim")
             walls[f"{scenario}/{label}"] = outcome.wall_seconds
     rows = [{"scenario": s, "run": label, "target_speed_m_s": SCENARIOS[s], **metrics(tables[s, label], SCENARIOS[s])}
@@ -195,7 +199,7 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
                          "algorithm": "gauss-seidel"})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
-                   "model_mismatch": mismatch,
+                   "model_mismatch": mismatch, "systems": systems,
                    "wall_seconds": time.perf_counter() - started,
                    "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
     out = Path(out_dir)

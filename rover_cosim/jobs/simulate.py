@@ -29,6 +29,7 @@ from rover_cosim.identification.model_set import ModelMismatch, ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
+from rover_cosim.orchestrator.runs import system_record
 from rover_cosim.progress import Stages
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
@@ -150,8 +151,11 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
     walls: dict[str, float] = {}
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
+    systems: dict[str, Any] = {}
     for k, (plant, build) in enumerate((("monolithic", monolithic_system), ("cosim", cosim_system))):
-        outcome = run(build(fmu_dir, models, choice), progress=stages.stage(k))
+        system = build(fmu_dir, models, choice)
+        systems[plant] = system_record(system)
+        outcome = run(system, progress=stages.stage(k))
         tables[plant] = trajectories(outcome.data, plant)
         walls[plant] = outcome.wall_seconds
         results[plant] = checks(tables[plant])
@@ -164,7 +168,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
                                                   "algorithm": "gauss-seidel", "fixed_load_ablation_N": STATIC_LOAD})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in ("Rover", "RoverBody", "Wheel")},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls,
-                   **describe(choice or choose()), "model_mismatch": mismatch,
+                   **describe(choice or choose()), "model_mismatch": mismatch, "systems": systems,
                    "wall_seconds": time.perf_counter() - started, "checks": results,
                    "rms_N": {"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
                              "fixed_load_ablation": ablation["rms_N"].tolist()}})
