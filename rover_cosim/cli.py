@@ -149,6 +149,9 @@ def build_parser() -> argparse.ArgumentParser:
                           help="only the paper's straight run, or only the path following (default: both)")
     simulate.add_argument("--allow-model-mismatch", action="store_true",
                           help="use a model identified on another soil or wheel (refused otherwise; recorded)")
+    simulate.add_argument("--record-interval", type=float, default=0.01,
+                          help="rows kept in the trajectory files [s] (a whole number of 1 ms steps; default 0.01; "
+                          "0.001: every step); metrics and figures use every step")
     simulate.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     _add_soil_options(simulate)
 
@@ -411,13 +414,13 @@ def _simulate(args: argparse.Namespace) -> int:
         if args.only != "path":
             bar = ProgressBar("simulate: the paper's straight run", enabled=not args.quiet)
             straight = run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow,
-                                      progress=bar)
+                                      progress=bar, record_interval=args.record_interval)
             bar.close()
             _print_straight(straight)
         if args.only != "straight":
             bar = ProgressBar("simulate: path following", enabled=not args.quiet)
             path = run_path_following(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
-                                      progress=bar)
+                                      progress=bar, record_interval=args.record_interval)
             bar.close()
             _print_path(path)
     except (SystemFileError, RunError, ValueError) as error:

@@ -152,6 +152,8 @@ def test_outputs_are_written(followed):
     for column in ("x", "y", "yaw", "cross_track", "Fx_1", "Fy_6", "Fz_3", "slip_2", "slipAngle_5", "steer_4",
                    "sinkage_1", "Fx_des_1", "Fy_des_6"):
         assert column in table
+    # the files keep a row every 10 ms (the runs step at 1 ms; the metrics use every step)
+    assert np.allclose(np.diff(table["time"].to_numpy())[:-1], 0.01)
 
 
 def test_report_shows_the_path_following(followed, results_root):

@@ -47,7 +47,7 @@ from rover_cosim.terramechanics import Wheel
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover
-from .simulate import checked_models, models_of
+from .simulate import RECORD_INTERVAL, checked_models, every, models_of, steps_between_rows
 
 STEP = 1e-3  # s
 WHEELS = range(1, 7)
@@ -167,11 +167,13 @@ def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str
 
 def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SCENARIOS),
                        choice: Choice | None = None, *, allow_model_mismatch: bool = False,
-                       progress: Callable[[float], None] | None = None) -> PathResult:
+                       progress: Callable[[float], None] | None = None,
+                       record_interval: float = RECORD_INTERVAL) -> PathResult:
     """Every scenario on both plants and with kinematic steering, on the soil and wheel of
     ``choice`` (default: the paper's); writes every file (all or none). A model identified on
     another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``."""
     started = time.perf_counter()
+    steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
     fmu_dir = Path(fmu_dir).resolve()
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     walls: dict[str, float] = {}
@@ -196,7 +198,7 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     record = run_record("rover-cosim simulate (path following)",
                         {"scenarios": {s: {"target_speed_m_s": SCENARIOS[s], "stop_time_s": stop_time(s)}
                                        for s in scenarios}, "step_s": STEP, "model": str(model),
-                         "algorithm": "gauss-seidel"})
+                         "algorithm": "gauss-seidel", "record_interval_s": record_interval})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
                    "model_mismatch": mismatch, "systems": systems,
@@ -204,8 +206,8 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
                    "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
     out = Path(out_dir)
     suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic"}
-    files = {out / f"path_{s}{suffix[label]}.csv": table.to_csv(index=False, float_format="%.8g").encode()
-             for (s, label), table in tables.items()}
+    files = {out / f"path_{s}{suffix[label]}.csv": every(table, record_interval, STEP).to_csv(
+        index=False, float_format="%.8g").encode() for (s, label), table in tables.items()}
     files.update({
         out / "path_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "path_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),

@@ -37,6 +37,8 @@ from .plants import add_plant_fmu, add_rover, wire_hub
 
 STOP_TIME = 20.0  # s
 STEP = 1e-3       # s
+#: s, the rows the trajectory files keep by default (the runs step at STEP; metrics use every step)
+RECORD_INTERVAL = 1e-2
 LIMBS = range(1, WHEELS + 1)
 STATIC_LOAD = STATIC_WHEEL_LOAD  # N, the fixed load of the ablation
 
@@ -126,6 +128,22 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
             "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
 
 
+def steps_between_rows(interval: float, step: float = STEP) -> int:
+    """Steps of ``step`` [s] between two kept rows; ValueError unless ``interval`` [s] is a whole
+    number (>= 1) of them."""
+    count = interval / step if isinstance(interval, (int, float)) and interval > 0 else 0.0
+    if round(count) < 1 or abs(count - round(count)) > 1e-9 * max(1.0, count):
+        raise ValueError(f"record interval {interval!r} s: expected a whole number of steps of {step} s")
+    return round(count)
+
+
+def every(table: pd.DataFrame, interval: float, step: float = STEP) -> pd.DataFrame:
+    """The rows of ``table`` (one per ``step`` [s]) every ``interval`` [s], and the last one."""
+    k = steps_between_rows(interval, step)
+    kept = sorted(set(range(0, len(table), k)) | {len(table) - 1})
+    return table.iloc[kept].reset_index(drop=True)
+
+
 def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> tuple[ModelSet, str | None]:
     """The models of ``model`` and why they do not belong to the soil and wheel of ``choice``
     (None: they do); ModelMismatch naming both unless ``allow_mismatch``."""
@@ -138,13 +156,15 @@ def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> 
 
 
 def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None, *,
-                   allow_model_mismatch: bool = False,
-                   progress: Callable[[float], None] | None = None) -> SimulationResult:
+                   allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
+                   record_interval: float = RECORD_INTERVAL) -> SimulationResult:
     """The closed loop on both plants and the ablation; writes every file (all or none). The
     FMUs run on the soil and wheel of ``choice`` (default: the paper's); a model identified on
     another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``; ``progress``
-    is told how far the three runs are."""
+    is told how far the three runs are; the trajectory files keep a row every ``record_interval``
+    [s] (the metrics and figures use every step)."""
     started = time.perf_counter()
+    steps_between_rows(record_interval)  # a bad interval refused before anything runs
     stages = Stages(progress, 3)
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
@@ -165,6 +185,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
     ablation_table = pd.DataFrame({"limb": list(LIMBS), "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})
     record = run_record("rover-cosim simulate", {"stop_time_s": STOP_TIME, "step_s": STEP, "model": str(model),
+                                                  "record_interval_s": record_interval,
                                                   "algorithm": "gauss-seidel", "fixed_load_ablation_N": STATIC_LOAD})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in ("Rover", "RoverBody", "Wheel")},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls,
@@ -174,8 +195,10 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
                              "fixed_load_ablation": ablation["rms_N"].tolist()}})
     out = Path(out_dir)
     files = {
-        out / "trajectories.csv": tables["monolithic"].to_csv(index=False, float_format="%.8g").encode(),
-        out / "trajectories_cosim.csv": tables["cosim"].to_csv(index=False, float_format="%.8g").encode(),
+        out / "trajectories.csv": every(tables["monolithic"], record_interval).to_csv(
+            index=False, float_format="%.8g").encode(),
+        out / "trajectories_cosim.csv": every(tables["cosim"], record_interval).to_csv(
+            index=False, float_format="%.8g").encode(),
         out / "rms.csv": rms_mono.to_csv(index=False, float_format="%.4f").encode(),
         out / "rms_cosim.csv": rms_cosim.to_csv(index=False, float_format="%.4f").encode(),
         out / "ablation_fixed_load.csv": ablation_table.to_csv(index=False, float_format="%.4f").encode(),
