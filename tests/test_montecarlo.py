@@ -233,7 +233,7 @@ def study_run(short_study, samples, fmu_dir, model, tmp_path_factory):
 def test_a_failing_sample_is_recorded_and_the_study_completes(study_run):
     runs = study_run.runs
     assert runs["status"].tolist() == ["ok", "ok", "ok", "failed"] and study_run.computed == 4
-    assert "phi=" in runs["error"].iloc[3] and "not physical" in runs["error"].iloc[3]
+    assert "phi_deg = 95.0 is not physical" in runs["error"].iloc[3]
     assert study_run.failures[["sample", "scenario"]].values.tolist() == [[3, "straight"]]
     assert study_run.failures["soil.phi_deg"].tolist() == [95.0]
     out = study_run.files[0].parent
