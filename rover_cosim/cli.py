@@ -34,10 +34,20 @@ def _slip_step(text: str) -> float:
     try:
         step = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"slip step={text!r}: expected a number in (0, 0.9]") from None
-    if not 0 < step <= 0.9:
-        raise argparse.ArgumentTypeError(f"slip step={step!r}: expected a number in (0, 0.9]")
+        raise argparse.ArgumentTypeError(f"slip step={text!r}: expected a number in (0, 2]") from None
+    if not 0 < step <= 2.0:
+        raise argparse.ArgumentTypeError(f"slip step={step!r}: expected a number in (0, 2]")
     return step
+
+
+def _slip_range(text: str) -> tuple[float, float]:
+    try:
+        first, last = (float(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"slip range={text!r}: expected FIRST,LAST (e.g. -0.5,0.9)") from None
+    if not -1.0 <= first < last <= 1.0:
+        raise argparse.ArgumentTypeError(f"slip range={text!r}: expected -1 <= FIRST < LAST <= 1")
+    return first, last
 
 
 def _add_soil_options(parser: argparse.ArgumentParser) -> None:
@@ -83,7 +93,9 @@ def build_parser() -> argparse.ArgumentParser:
     fig3.add_argument("--loads", type=_positive_loads, default=None,
                       help="comma-separated wheel loads [N] (default: 100,200,...,800)")
     fig3.add_argument("--slip-step", type=_slip_step, default=0.01,
-                      help="slip spacing over 0..0.9, adjusted so that 0.9 is a point (default: 0.01)")
+                      help="slip spacing, adjusted so that both ends of the range are points (default: 0.01)")
+    fig3.add_argument("--slip-range", type=_slip_range, default=(0.0, 0.9), metavar="FIRST,LAST",
+                      help="slip ratios from FIRST to LAST in [-1, 1] (negative: braking; default: 0,0.9)")
     _add_soil_options(fig3)
     run = commands.add_parser("run", help="co-simulate a system file (TOML or SSP) -> CSV + JSON sidecar")
     run.add_argument("system", help="system file (.toml, or an .ssp archive), one FMU (.fmu: run alone, with its "
@@ -623,7 +635,10 @@ def _fig3(args: argparse.Namespace) -> int:
     if choice is None or not _output_folder(args.out, "fig3"):
         return 2
     try:
-        written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step), choice)
+        first, last = args.slip_range
+        if args.slip_step > last - first:
+            raise ValueError(f"slip step={args.slip_step!r}: expected at most the range's width {last - first:g}")
+        written = write_fig3(args.out, args.loads or PAPER_LOADS, slip_grid(args.slip_step, last, first), choice)
     except ValueError as error:
         print(f"rover-cosim fig3: {error}", file=sys.stderr)
         return 2

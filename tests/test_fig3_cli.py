@@ -56,7 +56,7 @@ def test_failed_drawing_leaves_previous_results_untouched(tmp_path, monkeypatch)
     old = tmp_path / "fig3_fx_vs_slip.csv"
     old.write_text("previous\n")
 
-    def broken(table):
+    def broken(table, soil=""):
         raise RuntimeError("renderer failed")
 
     monkeypatch.setattr(fig3, "fig3_figure", broken)
@@ -72,3 +72,32 @@ def test_write_all_is_all_or_nothing(tmp_path):
     with pytest.raises(OSError):
         write_all({tmp_path / "a.csv": b"1", blocker / "b.csv": b"2"})
     assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_dir"]
+
+
+def test_a_slip_range_with_braking_and_files_named_by_the_soil(tmp_path):
+    """Negative slip (braking) mirrors driving in sign; another soil's files sit beside the paper's
+    (names carry the soil, and a --set change its digest) instead of replacing them."""
+    assert cli.main(["fig3", "--out", str(tmp_path), "--loads", "400", "--slip-range=-0.5,0.5",
+                     "--slip-step", "0.25"]) == 0
+    assert cli.main(["fig3", "--out", str(tmp_path), "--loads", "400", "--soil", "lete_sand"]) == 0
+    assert cli.main(["fig3", "--out", str(tmp_path), "--loads", "400", "--set", "soil.c=500"]) == 0
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert {"fig3_fx_vs_slip.csv", "fig3_fx_vs_slip_lete_sand.csv", "fig3_fx_vs_slip_lete_sand.png"} <= set(names)
+    assert len([n for n in names if n.startswith("fig3_fx_vs_slip_set-") and n.endswith(".json")]) == 1
+    table = pd.read_csv(tmp_path / "fig3_fx_vs_slip.csv")
+    np.testing.assert_allclose(table["slip"], [-0.5, -0.25, 0.0, 0.25, 0.5])
+    fx = table["Fx_N"].to_numpy()
+    assert fx[0] < fx[1] < 0 < fx[3] < fx[4]   # braking pulls back, driving pushes
+    record = json.loads((tmp_path / "fig3_fx_vs_slip_lete_sand.json").read_text())
+    assert record["parameters"]["choice"]["soil"]["name"] == "lete_sand"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--slip-range=0.5,0.2"], "expected -1 <= FIRST < LAST <= 1"),
+    (["--slip-range=-2,0.5"], "expected -1 <= FIRST < LAST <= 1"),
+    (["--slip-range", "one"], "expected FIRST,LAST"),
+])
+def test_bad_slip_ranges_are_named(tmp_path, capsys, args, message):
+    with pytest.raises(SystemExit):
+        cli.main(["fig3", "--out", str(tmp_path), *args])
+    assert message in capsys.readouterr().err

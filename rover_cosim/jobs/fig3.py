@@ -23,12 +23,35 @@ CSV_NAME = "fig3_fx_vs_slip.csv"
 PNG_NAME = "fig3_fx_vs_slip.png"
 RECORD_NAME = "fig3_fx_vs_slip.json"
 COLUMNS = ["load_N", "slip", "sinkage_m", "Fx_N", "Fz_N", "Tx_Nm"]
+STEM = "fig3_fx_vs_slip"
 
 
-def slip_grid(step: float, last: float = 0.9) -> tuple[float, ...]:
-    """Slip ratios 0, step, ..., last [-] (``last`` included, rounded to 10 decimals)."""
-    count = int(round(last / step)) + 1
-    return tuple(float(k) for k in np.round(np.linspace(0.0, last, count), 10))
+def file_names(choice: Choice) -> dict[str, str]:
+    """The names of Fig. 3's files for ``choice``: fig3_fx_vs_slip.* on the paper's soil and wheel,
+    fig3_fx_vs_slip_<soil>[_<wheel>][_set-<digest>].* otherwise, so that several soils share a folder."""
+    suffix = ""
+    if choice.soil_name != "paper":
+        suffix += f"_{_safe(choice.soil_name)}"
+    if choice.wheel_name != "paper":
+        suffix += f"_{_safe(choice.wheel_name)}"
+    if choice.overrides:
+        import hashlib
+
+        suffix += "_set-" + hashlib.sha256("\n".join(choice.overrides).encode()).hexdigest()[:8]
+    return {kind: f"{STEM}{suffix}.{kind}" for kind in ("csv", "png", "json")}
+
+
+def _safe(name: str) -> str:
+    import re
+
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", name)
+
+
+def slip_grid(step: float, last: float = 0.9, first: float = 0.0) -> tuple[float, ...]:
+    """Slip ratios first, first + step, ..., last [-] (both ends included, the spacing adjusted;
+    rounded to 10 decimals). Negative slip: braking."""
+    count = int(round((last - first) / step)) + 1
+    return tuple(float(k) for k in np.round(np.linspace(first, last, count), 10))
 
 
 PAPER_SLIPS = slip_grid(0.01)  # [-]
@@ -45,8 +68,9 @@ def fig3_table(loads: tuple[float, ...] = PAPER_LOADS, slips: tuple[float, ...] 
     }, columns=COLUMNS)
 
 
-def fig3_figure(table: pd.DataFrame) -> Figure:
-    """Fx against slip ratio, one curve per load, labelled as the paper's Fig. 3."""
+def fig3_figure(table: pd.DataFrame, soil: str = "the paper's soil and wheel") -> Figure:
+    """Fx against slip ratio, one curve per load, labelled as the paper's Fig. 3; ``soil`` names
+    the soil and wheel in the title."""
     figure = Figure(figsize=(7.2, 4.8), dpi=150)
     axes = figure.add_subplot()
     loads = sorted(table["load_N"].unique())
@@ -56,7 +80,10 @@ def fig3_figure(table: pd.DataFrame) -> Figure:
     axes.set_xlabel("Slip ratio κ [-]")
     axes.set_ylabel("Longitudinal force $F_x$ [N]")
     axes.set_title("Slip ratio and longitudinal force for wheel loads "
-                   f"{loads[0]:g}–{loads[-1]:g} N", fontsize=10)
+                   f"{loads[0]:g}–{loads[-1]:g} N\n{soil}", fontsize=10)
+    if table["slip"].min() < 0:
+        axes.axvline(0.0, color="0.5", lw=0.8)
+        axes.text(0.02, 0.95, "braking ← | → driving", transform=axes.transAxes, fontsize=8, color="0.3", va="top")
     axes.grid(True, alpha=0.3)
     handles, labels = axes.get_legend_handles_labels()
     axes.legend(handles[::-1], labels[::-1], loc="center left", bbox_to_anchor=(1.01, 0.5),
@@ -73,13 +100,16 @@ def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
     wheel, soil = choice.wheel, choice.soil
     table = fig3_table(loads, slips, wheel, soil)
     png = io.BytesIO()
-    fig3_figure(table).savefig(png, format="png")
+    label = (f"soil {choice.soil_name}, wheel {choice.wheel_name}"
+             + (f" ({', '.join(choice.overrides)})" if choice.overrides else ""))
+    fig3_figure(table, label).savefig(png, format="png")
     parameters = {"loads_N": list(loads), "slips": list(slips), "wheel": asdict(wheel), "soil": asdict(soil),
                   "choice": describe(choice)}
+    names = file_names(choice)
     files = {
-        out_dir / CSV_NAME: table.to_csv(index=False, float_format="%.10g").encode(),
-        out_dir / PNG_NAME: png.getvalue(),
-        out_dir / RECORD_NAME: json_bytes(run_record("rover-cosim fig3", parameters)),
+        out_dir / names["csv"]: table.to_csv(index=False, float_format="%.10g").encode(),
+        out_dir / names["png"]: png.getvalue(),
+        out_dir / names["json"]: json_bytes(run_record("rover-cosim fig3", parameters)),
     }
     write_all(files)
     return list(files)

@@ -47,7 +47,19 @@ def _record(*paths: Path) -> dict[str, Any]:
 def soil_record(results: Path) -> dict[str, Any]:
     """The soil and wheel the results were made with (from the jobs' records; {} if none say)."""
     return _record(results / "identification" / "identification.json", results / "simulation" / "simulation.json",
-                   results / "fig3_fx_vs_slip.json")
+                   *sorted(results.glob("fig3_fx_vs_slip*.json")))
+
+
+def fig3_file(results: Path, suffix: str) -> Path:
+    """Fig. 3's file (``suffix``: csv, png, json) of the results' soil and wheel: the one whose
+    record names them, else fig3_fx_vs_slip.<suffix>."""
+    record = soil_record(results)
+    soil, wheel = record.get("soil", {}).get("name"), record.get("wheel", {}).get("name")
+    for path in sorted(results.glob("fig3_fx_vs_slip*.json")):
+        choice = json.loads(path.read_text()).get("parameters", {}).get("choice", {})
+        if choice.get("soil", {}).get("name") == soil and choice.get("wheel", {}).get("name") == wheel:
+            return path.with_suffix(f".{suffix}")
+    return results / f"fig3_fx_vs_slip.{suffix}"
 
 
 def on_paper_soil(results: Path) -> bool:
@@ -89,7 +101,7 @@ def soil_section(results: Path) -> list[str]:
 
 def fig3_section(results: Path) -> list[str]:
     return ["<h2>Fig. 3: Fx against slip (numpy reference wheel)</h2>",
-            image(results / "fig3_fx_vs_slip.png", f"Fx(slip) for loads 100-800 N, {soil_label(results)}")]
+            image(fig3_file(results, "png"), f"Fx(slip) for loads 100-800 N, {soil_label(results)}")]
 
 
 def identification_section(identification: Path, paper_soil: bool = True) -> list[str]:
@@ -313,7 +325,7 @@ def montecarlo_section(montecarlo: Path) -> list[str]:
 def scope_section(results: Path) -> list[str]:
     """What the wheel does outside the paper's scenario, with numbers from the results."""
     lines = ["<h2>Behaviour outside the paper's scope</h2>", "<div class='note'><ul>"]
-    fig3 = results / "fig3_fx_vs_slip.csv"
+    fig3 = fig3_file(results, "csv")
     if fig3.exists():
         data = pd.read_csv(fig3)
         zero = data[data["slip"].abs() < 1e-12].sort_values("load_N")
@@ -343,7 +355,7 @@ def scope_section(results: Path) -> list[str]:
 
 
 def provenance_section(results: Path) -> list[str]:
-    records = [results / "fig3_fx_vs_slip.json", results / "identification" / "identification.json",
+    records = [fig3_file(results, "json"), results / "identification" / "identification.json",
                results / "simulation" / "simulation.json", results / "simulation" / "path_following.json"]
     if (results / "montecarlo" / "summary.json").exists():  # an optional study: listed only when run
         records.append(results / "montecarlo" / "summary.json")
