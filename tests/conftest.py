@@ -1,5 +1,6 @@
 """Shared fixtures: the FMUs of `make fmus`, built once per test session, and the pipeline's
-results (identification, then the closed loop), each computed once per test session."""
+results (identification, then the closed loop), each computed once per test session; the test
+FMU of our own with a variable of every FMI 2.0 type (tests/fmus/typed.c)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,17 @@ from rover_cosim.jobs.identify import IdentificationResult, run_identification
 from rover_cosim.jobs.simulate import SimulationResult, run_simulation
 
 REPOSITORY = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="session")
+def typed(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Typed.fmu (tests/typed_fmu.py), built once per session; skipped where it cannot be built."""
+    from typed_fmu import build_typed_fmu
+
+    built = build_typed_fmu(tmp_path_factory.mktemp("typed"))
+    if isinstance(built, str):
+        pytest.skip(f"the test FMU cannot be built here: {built}")
+    return built
 
 
 @pytest.fixture(scope="session")

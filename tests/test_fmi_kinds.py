@@ -14,7 +14,6 @@ from typing import Any
 import numpy as np
 import pytest
 from ball_fmus import E, G, build_ball2, build_ball3, exact_height
-from typed_fmu import build_typed_fmu
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, run
@@ -37,11 +36,6 @@ def ball2(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="module")
 def ball3(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return _built(build_ball3(tmp_path_factory.mktemp("ball3")))
-
-
-@pytest.fixture(scope="module")
-def typed(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return _built(build_typed_fmu(tmp_path_factory.mktemp("typed")))
 
 
 def _exact(times: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -11,21 +11,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from typed_fmu import build_typed_fmu
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, run
 from rover_cosim.orchestrator.blocks import CsvInput
 from rover_cosim.orchestrator.model import SystemFileError
 from rover_cosim.orchestrator.system import system_from_dict
-
-
-@pytest.fixture(scope="module")
-def typed(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    built = build_typed_fmu(tmp_path_factory.mktemp("typed"))
-    if isinstance(built, str):
-        pytest.skip(f"the test FMU cannot be built here: {built}")
-    return built
 
 
 @pytest.fixture()

@@ -12,7 +12,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from typed_fmu import build_typed_fmu
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, run
@@ -24,13 +23,6 @@ SSD_HEAD = ('<?xml version="1.0" encoding="UTF-8"?>\n<ssd:SystemStructureDescrip
             'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
             'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" version="1.0" name="foreign">')
 
-
-@pytest.fixture(scope="module")
-def typed(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    built = build_typed_fmu(tmp_path_factory.mktemp("typed"))
-    if isinstance(built, str):
-        pytest.skip(f"the test FMU cannot be built here: {built}")
-    return built
 
 
 def _component(name: str, source: str, inline: str = "") -> str:
