@@ -555,11 +555,11 @@ def _report(args: argparse.Namespace) -> int:
     from rover_cosim.report import build_report
 
     target = args.out or args.results / "report.html"
-    produced = [p for p in ("fig3_fx_vs_slip.csv", "identification/fit_models.csv", "simulation/rms.csv",
-                            "simulation/path_metrics.csv", "montecarlo/runs.csv") if (args.results / p).exists()]
+    produced = [p for p in ("fig3_fx_vs_slip*.csv", "identification/fit_models.csv", "simulation/rms.csv",
+                            "simulation/path_metrics.csv", "montecarlo/runs.csv") if any(args.results.glob(p))]
     if not produced:
         print(f"rover-cosim report: nothing to report in {args.results} (no results of fig3, identify or "
-              "simulate; run `make run`)", file=sys.stderr)
+              "simulate; make them with `rover-cosim fig3`, `identify`, `simulate`)", file=sys.stderr)
         return 1
     write_all({target: build_report(args.results).encode()})
     print(f"wrote {target}")
