@@ -160,6 +160,26 @@ def choose(soil: str | None = None, wheel: str | None = None, assignments: list[
                     tuple(assignments))
 
 
+def as_choice(value: Choice | Soil | Wheel | None = None, wheel: Wheel | None = None) -> Choice:
+    """A Choice from what a caller has: a Choice (as it is), a Soil and/or a Wheel built in code
+    (named "custom" in the records, the paper's for the other), or None (the paper's)."""
+    if isinstance(value, Choice):
+        if wheel is not None:
+            raise ValueError("as_choice: a Choice already has its wheel; give a Soil and a Wheel instead")
+        return value
+    if isinstance(value, Wheel) and wheel is None:
+        value, wheel = None, value
+    if value is not None and not isinstance(value, Soil):
+        raise ValueError(f"{value!r}: expected a Choice, a Soil or a Wheel")
+    paper = choose()
+    soil_entry = {"title": "a soil built in code", "source": "Python"} if value is not None else paper.soil_entry
+    wheel_entry = {"title": "a wheel built in code", "source": "Python"} if wheel is not None else paper.wheel_entry
+    soil_name = "custom" if value is not None else paper.soil_name
+    wheel_name = "custom" if wheel is not None else paper.wheel_name
+    return Choice(value if value is not None else paper.soil, wheel if wheel is not None else paper.wheel,
+                  soil_name, wheel_name, soil_entry, wheel_entry)
+
+
 def vary(choice: Choice, soil: Mapping[str, float] | None = None, wheel: Mapping[str, float] | None = None) -> Choice:
     """``choice`` with some values changed, exactly as ``--set`` changes them (SI; angles in
     degrees under ``phi_deg``, ``xc_deg``): ``vary(choice, soil={"c": 500.0, "phi_deg": 30.0})``.

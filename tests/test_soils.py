@@ -135,3 +135,18 @@ def test_the_destructive_angle_follows_phi_however_phi_is_entered(tmp_path):
     (tmp_path / "given.toml").write_text("phi_deg = 35.0\nxc_deg = 20.0\n")
     assert math.degrees(choose(soil=str(tmp_path / "given.toml")).soil.xc) == pytest.approx(20.0)
     assert math.degrees(Soil.from_degrees(35.0, xc=math.radians(20.0)).xc) == pytest.approx(20.0)
+
+
+def test_jobs_take_a_soil_built_in_code(tmp_path):
+    """write_fig3(out, choice=Soil(...)): the job takes the Soil (named "custom" in its record and
+    files), as it takes a Choice; a wrong kind of value is named."""
+    from rover_cosim.jobs.fig3 import write_fig3
+    from rover_cosim.terramechanics.library import as_choice
+
+    written = write_fig3(tmp_path, loads=(300.0,), slips=(0.0, 0.2), choice=Soil(c=500.0))
+    record = json.loads(next(p for p in written if p.suffix == ".json").read_text())
+    assert record["parameters"]["soil"]["c"] == 500.0 and record["parameters"]["choice"]["soil"]["name"] == "custom"
+    assert any(p.name == "fig3_fx_vs_slip_custom.csv" for p in written)
+    assert as_choice(Wheel(r=0.3)).wheel.r == 0.3 and as_choice(Wheel(r=0.3)).soil == Soil()
+    with pytest.raises(ValueError, match="expected a Choice, a Soil or a Wheel"):
+        as_choice("lete_sand")  # type: ignore[arg-type]

@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.terramechanics import Soil, Wheel, wheel_state
-from rover_cosim.terramechanics.library import Choice, choose, describe
+from rover_cosim.terramechanics.library import Choice, as_choice, describe
 
 CSV_NAME = "fig3_fx_vs_slip.csv"
 PNG_NAME = "fig3_fx_vs_slip.png"
@@ -93,10 +93,10 @@ def fig3_figure(table: pd.DataFrame, soil: str = "the paper's soil and wheel") -
 
 
 def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
-               slips: tuple[float, ...] = PAPER_SLIPS, choice: Choice | None = None) -> list[Path]:
+               slips: tuple[float, ...] = PAPER_SLIPS, choice: Choice | Soil | Wheel | None = None) -> list[Path]:
     """Compute, draw and write Fig. 3 (CSV, PNG and a JSON run record) into ``out_dir``, on the
     soil and wheel of ``choice`` (default: the paper's)."""
-    choice = choice or choose()
+    choice = as_choice(choice)
     wheel, soil = choice.wheel, choice.soil
     table = fig3_table(loads, slips, wheel, soil)
     png = io.BytesIO()

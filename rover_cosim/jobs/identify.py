@@ -50,7 +50,8 @@ from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.identification.sweep import SweepOutcome, SweepPlan, run_sweep
 from rover_cosim.identification.testbed import RECORDED, shared_test_bed
 from rover_cosim.identification.validate import validate
-from rover_cosim.terramechanics.library import Choice, choose, describe
+from rover_cosim.terramechanics import Soil, Wheel
+from rover_cosim.terramechanics.library import Choice, as_choice, describe
 
 MODELS = {"quadratic": 2, "linear": 1}  # label -> degree in slip; the first is recommended
 RECOMMENDED = "quadratic"
@@ -122,12 +123,12 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
                        lateral_plan: SweepPlan | None = None, workers: int | None = None,
                        scheduler: str | None = None, cache_dir: Path | None = None,
                        progress: Callable[[float], None] | None = None,
-                       choice: Choice | None = None) -> IdentificationResult:
+                       choice: Choice | Soil | Wheel | None = None) -> IdentificationResult:
     """Sweep, fit, validate and write every file of ``results/identification/`` (all or none):
     the paper's longitudinal model (``plan``) and the lateral model (``lateral_plan``), on the
     soil and wheel of ``choice`` (default: the paper's)."""
     started = time.perf_counter()
-    choice = choice or choose()
+    choice = as_choice(choice)
     plan = replace(plan or SweepPlan(), soil=choice.soil, wheel=choice.wheel)
     lateral_plan = replace(lateral_plan or LATERAL_PLAN, soil=choice.soil, wheel=choice.wheel)
     cache_dir = cache_dir or out_dir / "cache"

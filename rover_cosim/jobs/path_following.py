@@ -43,8 +43,8 @@ from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
 from rover_cosim.orchestrator.runs import system_record
 from rover_cosim.progress import Stages
-from rover_cosim.terramechanics import Wheel
-from rover_cosim.terramechanics.library import Choice, choose, describe
+from rover_cosim.terramechanics import Soil, Wheel
+from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover
 from .simulate import RECORD_INTERVAL, checked_models, every, models_of, steps_between_rows
@@ -166,13 +166,14 @@ def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str
 
 
 def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SCENARIOS),
-                       choice: Choice | None = None, *, allow_model_mismatch: bool = False,
+                       choice: Choice | Soil | Wheel | None = None, *, allow_model_mismatch: bool = False,
                        progress: Callable[[float], None] | None = None,
                        record_interval: float = RECORD_INTERVAL) -> PathResult:
     """Every scenario on both plants and with kinematic steering, on the soil and wheel of
     ``choice`` (default: the paper's); writes every file (all or none). A model identified on
     another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``."""
     started = time.perf_counter()
+    choice = as_choice(choice)
     steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
     fmu_dir = Path(fmu_dir).resolve()
     tables: dict[tuple[str, str], pd.DataFrame] = {}

@@ -31,7 +31,8 @@ from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
 from rover_cosim.orchestrator.runs import system_record
 from rover_cosim.progress import Stages
-from rover_cosim.terramechanics.library import Choice, choose, describe
+from rover_cosim.terramechanics import Soil, Wheel
+from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover, wire_hub
 
@@ -155,7 +156,7 @@ def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> 
     return models, why
 
 
-def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None, *,
+def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soil | Wheel | None = None, *,
                    allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
                    record_interval: float = RECORD_INTERVAL) -> SimulationResult:
     """The closed loop on both plants and the ablation; writes every file (all or none). The
@@ -164,6 +165,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | N
     is told how far the three runs are; the trajectory files keep a row every ``record_interval``
     [s] (the metrics and figures use every step)."""
     started = time.perf_counter()
+    choice = as_choice(choice)
     steps_between_rows(record_interval)  # a bad interval refused before anything runs
     stages = Stages(progress, 3)
     results: dict[str, Any] = {}
