@@ -73,6 +73,11 @@ class RunResult:
     #: Why an observer ended the run before its stop time (None: it ran to the end).
     stopped: str | None = None
 
+    def __repr__(self) -> str:
+        end = f", stopped: {self.stopped}" if self.stopped else ""
+        return (f"RunResult({len(self.data)} rows x {self.data.shape[1]} columns, {self.steps} steps in "
+                f"{self.wall_seconds:.3g} s{end})")
+
     @property
     def master_overhead_seconds(self) -> float:
         return self.wall_seconds - sum(self.step_seconds.values())

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -45,6 +46,21 @@ class WheelState:
     entry_angle: FloatArray  #: θf [rad], Eq. (1)
     exit_angle: FloatArray  #: θr [rad], Eq. (2), negative
     max_stress_angle: FloatArray  #: θm [rad], Eq. (3)
+
+    #: The table columns of each field, with their units (to_frame).
+    COLUMNS = {"load": "load_N", "slip": "slip", "sinkage": "sinkage_m", "Fx": "Fx_N", "Fz": "Fz_N", "Tx": "Tx_Nm",
+               "Fy": "Fy_N", "Fy_sidewall": "Fy_sidewall_N", "slip_angle": "slip_angle_rad",
+               "entry_angle": "entry_angle_rad", "exit_angle": "exit_angle_rad",
+               "max_stress_angle": "max_stress_angle_rad"}
+
+    def to_frame(self) -> Any:
+        """The state as a pandas DataFrame, one row per element (flattened), the columns named with
+        their units (load_N, slip, sinkage_m, Fx_N, ...)."""
+        import pandas as pd
+
+        shape = np.broadcast_shapes(*(np.shape(getattr(self, name)) for name in self.COLUMNS))
+        return pd.DataFrame({column: np.broadcast_to(np.asarray(getattr(self, name), dtype=float), shape).ravel()
+                             for name, column in self.COLUMNS.items()})
 
 
 def bekker_sinkage(load: ArrayLike, wheel: Wheel, soil: Soil) -> FloatArray:

@@ -104,3 +104,15 @@ def test_sinkage_matches_an_independent_root_finder_on_the_reference_integrals(l
     ref = reference_forces(h_ref, slip, wheel, soil)
     assert float(state.Fx) == pytest.approx(ref[0], rel=1e-6, abs=1e-6 * load)
     assert float(state.Tx) == pytest.approx(ref[2], rel=1e-6, abs=1e-6 * load * wheel.r)
+
+
+def test_a_wheel_state_is_a_table_with_units():
+    import numpy as np
+
+    from rover_cosim.terramechanics import Soil, Wheel, wheel_state
+
+    state = wheel_state(np.array([[200.0], [400.0]]), np.array([[0.1, 0.2, 0.3]]), Wheel(), Soil())
+    table = state.to_frame()
+    assert len(table) == 6 and list(table.columns[:6]) == ["load_N", "slip", "sinkage_m", "Fx_N", "Fz_N", "Tx_Nm"]
+    assert table["load_N"].tolist() == [200.0] * 3 + [400.0] * 3 and table["slip"].tolist()[:3] == [0.1, 0.2, 0.3]
+    np.testing.assert_array_equal(table["Fx_N"].to_numpy(), np.asarray(state.Fx).ravel())

@@ -205,3 +205,9 @@ def test_rover_cosim_run_runs_one_fmu_file_with_its_default_experiment(typed, tm
     assert len(pd.read_csv(out)) == 6
     assert main(["run", str(typed), "-o", str(out), "--step", "0", "--quiet"]) == 2
     assert "step: 0.0: expected a communication step > 0 s" in capsys.readouterr().err
+
+
+def test_results_have_short_reprs(typed):
+    result = run(SystemBuilder("r").simulation(stop_time=1.0, step=0.1).add_fmu("a", typed).build())
+    text = repr(result)
+    assert text.startswith("RunResult(11 rows x ") and "10 steps" in text and len(text) < 200

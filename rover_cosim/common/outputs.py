@@ -96,3 +96,14 @@ def run_record(command: str, parameters: Mapping[str, object]) -> dict[str, obje
         "platform": platform.platform(),
         "versions": {name: _version(name) for name in PACKAGES},
     }
+
+
+def summary_repr(kind: str, files: Sequence[Path] | None = None, **facts: object) -> str:
+    """A short repr of a job's result: its kind, where its files went, and a few facts (a result
+    holds whole tables, which a repr must not print)."""
+    parts = []
+    if files:
+        folders = sorted({str(Path(f).parent) for f in files})
+        parts.append(f"{len(files)} files in {', '.join(folders)}")
+    parts += [f"{key}={value}" for key, value in facts.items()]
+    return f"{kind}({'; '.join(parts)})"

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.common.outputs import json_bytes, run_record, summary_repr, write_all
 from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.master import run
@@ -38,6 +38,9 @@ class CosimStudyResult:
 
     table: pd.DataFrame
     files: list[Path]
+
+    def __repr__(self) -> str:
+        return summary_repr("CosimStudyResult", self.files, rows=len(self.table))
 
 
 def _system(name: str, fmu_dir: Path, **simulation: object) -> System:

@@ -31,7 +31,7 @@ from typing import Any
 
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.identification import figures, lateral_figures
 from rover_cosim.identification.fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
 from rover_cosim.identification.lateral import (
@@ -70,6 +70,11 @@ class IdentificationResult:
     model: dict[str, Any]       # model.json as written
     lateral_sweep: SweepOutcome  # the lateral sweep
     lateral_fit: pd.DataFrame    # lateral_fit_table.csv
+
+    def __repr__(self) -> str:
+        fits = ", ".join(f"{w:g} N: {f:.1f} %" for w, f in zip(self.fit["load_N"], self.fit["fit_percent"]))
+        return summary_repr("IdentificationResult", self.files, fit=f"[{fits}]",
+                            runs=f"{self.sweep.computed} computed, {self.sweep.cached} cached")
 
 
 def _sweep(fmu_path: Path, plan: SweepPlan, cache_dir: Path, workers: int | None, scheduler: str | None,

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.control import path_figures
 from rover_cosim.control.path_controller import PATHS, PathFollowingController
 from rover_cosim.identification.model_set import ModelSet
@@ -66,6 +66,9 @@ class PathResult:
     metrics: pd.DataFrame                        # path_metrics.csv
     agreement: pd.DataFrame                      # path_agreement.csv
     record: dict[str, Any]
+
+    def __repr__(self) -> str:
+        return summary_repr("PathResult", self.files, runs=len(self.tables))
 
 
 def stop_time(scenario: str) -> float:

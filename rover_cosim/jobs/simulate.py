@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
@@ -53,6 +53,10 @@ class SimulationResult:
     tables: dict[str, pd.DataFrame]     # per plant ("monolithic", "cosim"): trajectories.csv columns
     rms: dict[str, pd.DataFrame]        # per plant: limb, rms_N (Table 3)
     ablation: pd.DataFrame              # limb, rms_lut_N, rms_fixed_load_N
+
+    def __repr__(self) -> str:
+        worst = {plant: f"{float(table['rms_N'].max()):.3g} N" for plant, table in self.rms.items()}
+        return summary_repr("SimulationResult", self.files, largest_rms=worst)
 
 
 def models_of(model: ModelSet | Path) -> ModelSet:

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.parallel import parallel_map
 from rover_cosim.identification.cache import discard, remove_partial_files
 from rover_cosim.identification.model_set import ModelMismatch, ModelSet
@@ -54,6 +54,10 @@ class MonteCarloResult:
     computed: int                   # runs computed now (the others came from the cache)
     cached: int
     rejected: dict[Path, str] = field(default_factory=dict)  # cache files not whole, computed again (why)
+
+    def __repr__(self) -> str:
+        return summary_repr("MonteCarloResult", self.files, runs=len(self.runs), computed=self.computed,
+                            cached=self.cached, failed=len(self.failures))
 
 
 def _stop_time(study: Study, scenario: str) -> float:
