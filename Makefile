@@ -62,7 +62,15 @@ STUDY ?= lunar_regolith
 MC_RUNS ?=
 MC_WORKERS ?=
 MC_SCHEDULER ?=
-montecarlo: identify
+# The Monte Carlo needs an identified model: made once (identify), not again while it is newer
+# than the wheel FMU (a model of another soil is refused by the command, naming both).
+$(RESULTS)/identification/model.json: fmus/SingleWheel.fmu
+	$(MAKE) identify
+
+fmus/SingleWheel.fmu:
+	$(MAKE) fmus
+
+montecarlo: $(STAMP) $(RESULTS)/identification/model.json
 	$(VENV)/bin/rover-cosim montecarlo --study $(STUDY) $(if $(MC_RUNS),--runs $(MC_RUNS)) --out $(RESULTS)/montecarlo --fmu-dir fmus \
 		--model $(RESULTS)/identification/model.json $(if $(MC_WORKERS),--workers $(MC_WORKERS)) \
 		$(if $(MC_SCHEDULER),--scheduler $(MC_SCHEDULER))
