@@ -109,3 +109,11 @@ def test_stages_report_one_rising_fraction_over_a_jobs_runs():
             callback(fraction)
     assert told == sorted(told) and told[0] == 0.0 and told[-1] == 1.0 and told[4] == 0.375
     assert Stages(None, 3).stage(1) is None
+
+
+def test_every_command_says_what_it_does_with_an_example():
+    parser = build_parser()
+    commands = next(a for a in parser._actions if a.dest == "command").choices
+    for name, sub in commands.items():
+        assert sub.description and len(sub.description.splitlines()) == 1, name
+        assert f"rover-cosim {name}" in (sub.epilog or ""), name
