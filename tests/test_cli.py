@@ -114,6 +114,7 @@ def test_stages_report_one_rising_fraction_over_a_jobs_runs():
 def test_every_command_says_what_it_does_with_an_example():
     parser = build_parser()
     commands = next(a for a in parser._actions if a.dest == "command").choices
+    assert isinstance(commands, dict)
     for name, sub in commands.items():
         assert sub.description and len(sub.description.splitlines()) == 1, name
         assert f"rover-cosim {name}" in (sub.epilog or ""), name
