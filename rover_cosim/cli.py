@@ -509,6 +509,8 @@ def _montecarlo(args: argparse.Namespace) -> int:
 
 
 def _print_montecarlo(outcome) -> None:  # noqa: ANN001 - MonteCarloResult, imported lazily
+    for path, problem in outcome.rejected.items():
+        print(f"rover-cosim montecarlo: cache file {path}: {problem}; computed again", file=sys.stderr)
     summary = outcome.summary
     print(f"{outcome.computed} runs computed, {outcome.cached} from the cache, {summary['runs_failed']} failed, "
           f"{summary['wall_seconds']:.1f} s" + (f" ({summary['runs_per_minute']:.1f} runs/min)"

@@ -20,7 +20,6 @@ from __future__ import annotations
 import json
 import os
 import time
-import warnings
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -87,8 +86,7 @@ def _cached(specs: list[RunSpec]) -> tuple[dict[tuple[int, str], dict[str, Any]]
         if row is not None:
             found[spec.sample, spec.scenario] = row
         elif problem is not None:
-            rejected[Path(spec.target)] = problem
-            warnings.warn(f"Monte Carlo cache: {spec.target}: {problem}; computing it again", stacklevel=3)
+            rejected[Path(spec.target)] = problem  # said by the caller (the CLI prints one line each)
             discard(Path(spec.target))
     return found, rejected
 
