@@ -69,6 +69,22 @@ def _default_experiment(name: str) -> source.Experiment | None:
         return None
 
 
+def _class_documentation(name: str) -> str:
+    """The Documentation info (HTML) of the class ``name`` and of the records it uses, from our
+    own Modelica files ("" where a class has none)."""
+    import re
+
+    parts = []
+    for qualified in (f"{source.PACKAGE}.{name}", f"{source.PACKAGE}.Parameters.SoilParameters",
+                      f"{source.PACKAGE}.Parameters.WheelParameters"):
+        text = source.class_file(qualified).read_text()
+        found = re.search(r'info="(.*?)"\)', text, re.S)
+        if found:
+            inner = re.sub(r"</?html>", "", found.group(1)).replace('\\"', '"')
+            parts.append(f"<h3>{qualified.rsplit('.', 1)[-1]}</h3>{inner}")
+    return "\n".join(parts)
+
+
 def _class_description(name: str) -> str:
     text = source.class_file(f"{source.PACKAGE}.{name}").read_text()
     head = text.split("\n", 3)
@@ -141,6 +157,8 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
                   "parameters": model_layout.n_parameters, "observed": model_layout.n_observed}
         (root / "documentation").mkdir()
         (root / BUILD_RECORD).write_text(json.dumps(record, indent=2) + "\n")
+        (root / "documentation" / "index.html").write_text(
+            description.documentation_html(model_layout, _class_description(name), _class_documentation(name)))
         out_dir.mkdir(parents=True, exist_ok=True)
         partial = out_dir / f".{name}.fmu.partial"
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:

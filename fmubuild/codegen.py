@@ -61,6 +61,9 @@ class FmuVariable:
     unit: str | None
     description: str | None
     derivative_of: int | None = None  # value reference of the state, for derivatives
+    minimum: float | None = None      # the Modelica declaration's min, in ``unit``
+    maximum: float | None = None      # the Modelica declaration's max, in ``unit``
+    display_unit: str | None = None   # the Modelica declaration's displayUnit
 
 
 @dataclass(frozen=True)
@@ -135,7 +138,8 @@ def _variables(model: OdeModel, starts: list[float], calculated: list[bool]) -> 
     for name in model.parameters:
         v = info[name]
         add(name=name, kind="parameter", causality="parameter", variability="fixed", initial="exact",
-            start=model.parameter_values[name], unit=v.unit, description=v.description)
+            start=model.parameter_values[name], unit=v.unit, description=v.description, minimum=v.minimum,
+            maximum=v.maximum, display_unit=v.display_unit)
     state_refs = [add(name=name, kind="state", causality="output" if info[name].is_output else "local",
                       variability="continuous", initial="calculated" if calculated[i] else "exact",
                       start=None if calculated[i] else starts[i], unit=info[name].unit,
@@ -148,11 +152,12 @@ def _variables(model: OdeModel, starts: list[float], calculated: list[bool]) -> 
     for name in model.inputs:
         v = info[name]
         add(name=name, kind="input", causality="input", variability="continuous", initial=None,
-            start=v.start if v.start is not None else 0.0, unit=v.unit, description=v.description)
+            start=v.start if v.start is not None else 0.0, unit=v.unit, description=v.description, minimum=v.minimum,
+            maximum=v.maximum, display_unit=v.display_unit)
     for name in model.observed:
         v = info[name]
         add(name=name, kind="observed", causality="output" if v.is_output else "local", variability="continuous",
-            initial="calculated", start=None, unit=v.unit, description=v.description)
+            initial="calculated", start=None, unit=v.unit, description=v.description, display_unit=v.display_unit)
     for name in model.memories:
         v = info[name]
         add(name=name, kind="memory", causality="local", variability="continuous", initial="calculated", start=None,

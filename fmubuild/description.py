@@ -6,6 +6,7 @@ the initial unknowns)."""
 from __future__ import annotations
 
 import datetime
+import math
 import xml.etree.ElementTree as ET
 
 from rover_cosim.common.units import base_units
@@ -36,11 +37,21 @@ def _interfaces(root: ET.Element, model_layout: ModelLayout, sources: list[str])
                 ET.SubElement(files, "File", {"name": name})
 
 
+#: Display units the FMUs declare: (unit, display unit) -> factor (display = factor x value).
+DISPLAY_UNITS = {("rad", "deg"): 180.0 / math.pi, ("rad/s", "deg/s"): 180.0 / math.pi, ("m/s", "km/h"): 3.6}
+
+
+def _display_unit(v: FmuVariable) -> str | None:
+    """The variable's display unit where the FMU can declare it (one of DISPLAY_UNITS)."""
+    return v.display_unit if (v.unit, v.display_unit) in DISPLAY_UNITS else None
+
+
 def _unit_definitions(root: ET.Element, model_layout: ModelLayout) -> None:
-    """<UnitDefinitions>: every unit used, in SI base units."""
+    """<UnitDefinitions>: every unit used, in SI base units, with the display units of its variables."""
     units = sorted({v.unit for v in model_layout.variables if v.unit is not None})
     if not units:
         return
+    shown = {(v.unit, _display_unit(v)) for v in model_layout.variables if _display_unit(v)}
     definitions = ET.SubElement(root, "UnitDefinitions")
     for unit in units:
         exponents, factor = base_units(unit)
@@ -49,6 +60,8 @@ def _unit_definitions(root: ET.Element, model_layout: ModelLayout) -> None:
         if factor != 1.0:
             attributes["factor"] = _number(factor)
         ET.SubElement(node, "BaseUnit", attributes)
+        for display in sorted(d for u, d in shown if u == unit and d is not None):
+            ET.SubElement(node, "DisplayUnit", {"name": display, "factor": _number(DISPLAY_UNITS[unit, display])})
 
 
 def _scalar_variable(parent: ET.Element, v: FmuVariable, index: dict[int, int]) -> None:
@@ -62,6 +75,12 @@ def _scalar_variable(parent: ET.Element, v: FmuVariable, index: dict[int, int]) 
     real: dict[str, str] = {}
     if v.unit is not None:
         real["unit"] = v.unit
+    if _display_unit(v):
+        real["displayUnit"] = str(v.display_unit)
+    if v.minimum is not None:
+        real["min"] = _number(v.minimum)
+    if v.maximum is not None:
+        real["max"] = _number(v.maximum)
     if v.start is not None:
         real["start"] = _number(v.start)
     if v.derivative_of is not None:
@@ -137,3 +156,34 @@ def _dependencies(v: FmuVariable, model_layout: ModelLayout, index: dict[int, in
     else:
         refs = model_layout.dependencies.get(v.value_reference, [])
     return " ".join(str(index[r]) for r in refs)
+
+
+def documentation_html(model_layout: ModelLayout, description: str, documentation: str = "") -> str:
+    """documentation/index.html of an FMU: what it is, every variable a user sets or reads (name,
+    causality, unit and display unit, start, min, max, description), and ``documentation`` (the
+    Modelica class's own Documentation: equations and sources; our own text, inserted as HTML)."""
+    import html
+
+    rows = []
+    for v in model_layout.variables:
+        if v.causality not in ("parameter", "input", "output"):
+            continue
+        unit = (v.unit or "") + (f" (shown in {v.display_unit})" if _display_unit(v) else "")
+        cells = [v.name, v.causality, unit, "" if v.start is None else _number(v.start),
+                 "" if v.minimum is None else _number(v.minimum), "" if v.maximum is None else _number(v.maximum),
+                 v.description or ""]
+        rows.append("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in cells) + "</tr>")
+    style = ("body{font-family:sans-serif;font-size:15px;max-width:1000px;margin:1.5em auto;padding:0 12px}"
+             "table{border-collapse:collapse;font-size:13px}td,th{border:1px solid #bbb;padding:3px 7px;"
+             "text-align:left}th{background:#f2f2f2}")
+    return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+            f"<title>{html.escape(model_layout.name)}</title><style>{style}</style></head><body>"
+            f"<h1>{html.escape(model_layout.name)}</h1><p>{html.escape(description)}</p>"
+            "<p>FMI 2.0, Model Exchange and Co-Simulation. Units are SI; min and max are the closed range a "
+            "value must lie in (where the model needs a strict bound, e.g. 0 &lt; phi, the FMU also refuses the "
+            "end itself at initialization, naming the variable)."
+            + (" A load W of 0 N is taken as 1e-3 N (the contact needs a load to be defined)." if any(
+                v.name == "W" and v.causality == "input" for v in model_layout.variables) else "") + "</p>"
+            "<h2>Variables</h2><table><tr><th>name</th><th>causality</th><th>unit</th><th>start</th><th>min</th>"
+            "<th>max</th><th>description</th></tr>" + "".join(rows) + "</table>"
+            + (f"<h2>Model</h2>{documentation}" if documentation else "") + "</body></html>\n")

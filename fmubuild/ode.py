@@ -44,6 +44,9 @@ class Variable:
     description: str | None
     start: float | None
     is_output: bool = False  # a top-level output (a state can be one too)
+    minimum: float | None = None   # the declaration's min (a literal), in ``unit``
+    maximum: float | None = None   # the declaration's max (a literal), in ``unit``
+    display_unit: str | None = None  # the declaration's displayUnit (e.g. deg for an angle in rad)
 
 
 @dataclass(frozen=True)
@@ -269,6 +272,16 @@ def _role(scalar: str, info: Mapping[str, Any], flat_name: str, parameters: _Par
     return "output" if causality == "Output" and "." not in flat_name else "local"
 
 
+def declared_bound(info: Mapping[str, Any], key: str) -> float | None:
+    """The literal ``min`` or ``max`` (``key``) a Modelica declaration gives, or None."""
+    bound = info.get(key)
+    if isinstance(bound, dict) and "Literal" in bound:
+        return float(literal(bound["Literal"]))
+    if isinstance(bound, dict) and "Unary" in bound and "Literal" in bound["Unary"].get("rhs", {}):
+        return -float(literal(bound["Unary"]["rhs"]["Literal"]))
+    return None
+
+
 def declared_start(info: Mapping[str, Any], locate: _Locator) -> float | None:
     """The start value the Modelica source declares for a variable (``start=0``), or None. rumoca
     fills in 0.0 for an undeclared start; a declared one's source span is the literal itself."""
@@ -297,7 +310,8 @@ def _variables(infos: dict[str, Info], types: Mapping[str, str], parameters: _Pa
             start = declared_start(info, locate)  # an input the source gives a default, or None
         is_output = _role_names(info)[1] == "Output" and "." not in flat_name
         variables[s] = Variable(s, _role(s, info, flat_name, parameters, inputs, states), types.get(flat_name, "Real"),
-                                info["unit"], info["description"], start, is_output)
+                                info["unit"], info["description"], start, is_output, declared_bound(info, "min"),
+                                declared_bound(info, "max"), info.get("display_unit") or None)
     return variables
 
 

@@ -63,6 +63,15 @@ UNITS = {"c": "Pa", "phi": "rad", "kc": "N/m^(n+1)", "kphi": "N/m^(n+2)", "n": "
          "lam": "1", "kx_beta": "m/rad", "ky": "m", "ky_beta": "m/rad", "rho": "kg/m^3", "gravity": "m/s^2",
          "xc": "rad", "r": "m", "b": "m", "J": "kg.m^2"}
 
+#: The closed range [min, max] (SI; None: unbounded) of every Soil and Wheel field: the FMUs'
+#: min/max (the Modelica records declare them, tests/test_parameters.py keeps the two equal), and
+#: what Soil and Wheel accept (where a bound is strict, e.g. 0 < phi, they also refuse the end).
+RANGES: dict[str, tuple[float | None, float | None]] = {
+    "c": (0.0, None), "phi": (0.0, math.pi / 2), "kc": (0.0, None), "kphi": (0.0, None), "n": (0.0, None),
+    "kx": (0.0, None), "a0": (0.0, 1.0), "a1": (0.0, 1.0), "lam": (0.0, 1.0), "kx_beta": (0.0, None),
+    "ky": (0.0, None), "ky_beta": (0.0, None), "rho": (0.0, None), "gravity": (0.0, None),
+    "xc": (0.0, math.pi / 2), "r": (0.0, None), "b": (0.0, None), "J": (0.0, None)}
+
 #: The value of ``Soil.xc`` that stands for "from φ": 45° - φ/2 (a NaN, replaced on construction).
 XC_FROM_PHI = float("nan")
 

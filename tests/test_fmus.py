@@ -71,6 +71,29 @@ def test_fmu_is_me_and_cs_with_sources_units_and_solver_parameters(fmus, name: s
     assert len(md.derivatives) == sum(v.derivative is not None for v in md.modelVariables) > 0
 
 
+@pytest.mark.parametrize("name", ["SingleWheel", "Wheel", "Rover"])
+def test_fmu_metadata_carries_ranges_display_units_and_its_documentation(fmus, name: str):
+    """min/max of every soil and wheel parameter from the one range table, angles shown in deg
+    (declared in UnitDefinitions), documentation/index.html listing the variables with units."""
+    from rover_cosim.terramechanics.library import MODELICA_NAMES
+    from rover_cosim.terramechanics.parameters import RANGES
+
+    md = fmpy.read_model_description(str(fmus[name]))
+    names = {v.name: v for v in md.modelVariables}
+    prefix = next(p for p in ("soil.", "rover.soil.", "wheel1.soil.") if f"{p}c" in names)
+    for field, (low, high) in RANGES.items():
+        kind = "wheel." if field in ("r", "b", "J") else "soil."
+        variable = names[prefix.replace("soil.", kind) + MODELICA_NAMES.get(field, field)]
+        assert (variable.min, variable.max) == (low, high), variable.name
+    phi = names[f"{prefix}phi"]
+    assert phi.displayUnit == "deg" and phi.unit == "rad"
+    rad = next(u for u in md.unitDefinitions if u.name == "rad")
+    assert any(d.name == "deg" and abs(d.factor - 57.29577951308232) < 1e-12 for d in rad.displayUnits)
+    with zipfile.ZipFile(fmus[name]) as archive:
+        page = archive.read("documentation/index.html").decode()
+    assert f"<h1>{name}</h1>" in page and f"{prefix}phi" in page and "rad (shown in deg)" in page
+
+
 def test_model_description_interfaces_match_the_modelica_readme(fmus):
     """The interfaces DESIGN.md and modelica/README.md promise (spot checks per FMU)."""
     single = variables(fmus["SingleWheel"])

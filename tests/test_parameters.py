@@ -62,3 +62,23 @@ def test_numpy_scalars_are_accepted_as_floats():
     wheel = Wheel(r=np.float32(0.3), b=np.int64(1))  # type: ignore[arg-type]  # numpy scalars, converted
     assert type(wheel.r) is float and type(wheel.b) is float
     assert wheel.r == pytest.approx(0.3)
+
+
+def test_the_modelica_records_declare_the_ranges_of_the_python_table():
+    """One range table (terramechanics.parameters.RANGES): the Modelica records' min/max (and so
+    the FMUs') equal it, field by field."""
+    import re
+    from pathlib import Path
+
+    from rover_cosim.terramechanics.library import MODELICA_NAMES
+    from rover_cosim.terramechanics.parameters import RANGES
+
+    root = Path(__file__).resolve().parents[1] / "modelica" / "RoverTerramechanics" / "Parameters"
+    declared: dict[str, tuple[float | None, float | None]] = {}
+    for record in ("SoilParameters.mo", "WheelParameters.mo"):
+        for name, attributes in re.findall(r"parameter Real (\w+)\(([^)]*)\)", (root / record).read_text()):
+            found = dict(re.findall(r"(min|max)=([-0-9.e]+)", attributes))
+            declared[name] = (float(found["min"]) if "min" in found else None,
+                              float(found["max"]) if "max" in found else None)
+    for field, bounds in RANGES.items():
+        assert declared[MODELICA_NAMES.get(field, field)] == bounds, field

@@ -1,20 +1,20 @@
 within RoverTerramechanics.Parameters;
 record SoilParameters "Loose lunar-simulant soil of the paper's Table 2 (Bekker, Janosi-Hanamoto, Wong-Reece)"
-  parameter Real c(unit="Pa") = 800 "Cohesion stress, Eq. (8)";
-  parameter Real phi(unit="rad", displayUnit="deg") = 0.6492624817418906 "Internal friction angle (37.2 deg), Eq. (8)";
-  parameter Real kc(unit="N/m2") = 1.37e3 "Cohesive pressure-sinkage modulus, Eq. (5); unit N/m^(n+1), N/m2 for n = 1";
-  parameter Real kphi(unit="N/m3") = 8.14e5 "Frictional pressure-sinkage modulus, Eq. (5); unit N/m^(n+2), N/m3 for n = 1";
-  parameter Real n(unit="1") = 1.0 "Sinkage exponent, Eq. (5)";
-  parameter Real kx(unit="m") = 0.036 "Shear deformation modulus, Eq. (9)";
-  parameter Real a0(unit="1") = 0.4 "Constant of the maximum-stress angle, Eq. (3)";
-  parameter Real a1(unit="1") = 0.15 "Slip coefficient of the maximum-stress angle, Eq. (3)";
-  parameter Real lam(unit="1") = 0.90 "Wheel sinkage ratio of the exit angle, Eq. (2)";
-  parameter Real kxBeta(unit="m/rad") = 0.043 "Growth of kx with the slip angle: kx + kxBeta*|beta| (Ishigami et al. 2007)";
-  parameter Real ky(unit="m") = 0.013 "Lateral shear deformation modulus at zero slip angle (Ishigami et al. 2007)";
-  parameter Real kyBeta(unit="m/rad") = 0.020 "Growth of ky with the slip angle: ky + kyBeta*|beta| (Ishigami et al. 2007)";
-  parameter Real rho(unit="kg/m3") = 1.6e3 "Dry density of the soil, for the sidewall resistance (Ishigami et al. 2007)";
-  parameter Real gravity(unit="m/s2") = 1.62 "Gravity acting on the soil (lunar): rho*gravity is its weight density";
-  parameter Real xc(unit="rad", displayUnit="deg") = 0.4607669225265029 "Destructive angle of the soil piled against the wheel's side, 45 deg - phi/2 = 26.4 deg";
+  parameter Real c(unit="Pa", min=0) = 800 "Cohesion stress, Eq. (8)";
+  parameter Real phi(unit="rad", displayUnit="deg", min=0, max=1.5707963267948966) = 0.6492624817418906 "Internal friction angle (37.2 deg), Eq. (8)";
+  parameter Real kc(unit="N/m2", min=0) = 1.37e3 "Cohesive pressure-sinkage modulus, Eq. (5); unit N/m^(n+1), N/m2 for n = 1";
+  parameter Real kphi(unit="N/m3", min=0) = 8.14e5 "Frictional pressure-sinkage modulus, Eq. (5); unit N/m^(n+2), N/m3 for n = 1";
+  parameter Real n(unit="1", min=0) = 1.0 "Sinkage exponent, Eq. (5)";
+  parameter Real kx(unit="m", min=0) = 0.036 "Shear deformation modulus, Eq. (9)";
+  parameter Real a0(unit="1", min=0, max=1.0) = 0.4 "Constant of the maximum-stress angle, Eq. (3)";
+  parameter Real a1(unit="1", min=0, max=1.0) = 0.15 "Slip coefficient of the maximum-stress angle, Eq. (3)";
+  parameter Real lam(unit="1", min=0, max=1.0) = 0.90 "Wheel sinkage ratio of the exit angle, Eq. (2)";
+  parameter Real kxBeta(unit="m/rad", min=0) = 0.043 "Growth of kx with the slip angle: kx + kxBeta*|beta| (Ishigami et al. 2007)";
+  parameter Real ky(unit="m", min=0) = 0.013 "Lateral shear deformation modulus at zero slip angle (Ishigami et al. 2007)";
+  parameter Real kyBeta(unit="m/rad", min=0) = 0.020 "Growth of ky with the slip angle: ky + kyBeta*|beta| (Ishigami et al. 2007)";
+  parameter Real rho(unit="kg/m3", min=0) = 1.6e3 "Dry density of the soil, for the sidewall resistance (Ishigami et al. 2007)";
+  parameter Real gravity(unit="m/s2", min=0) = 1.62 "Gravity acting on the soil (lunar): rho*gravity is its weight density";
+  parameter Real xc(unit="rad", displayUnit="deg", min=0, max=1.5707963267948966) = 0.4607669225265029 "Destructive angle of the soil piled against the wheel's side, 45 deg - phi/2 = 26.4 deg";
   annotation (Documentation(info="<html>
 <p>Table 2 of Yoshikawa et al. Field names match <code>terramechanics.Soil</code>. The units of
 <code>kc</code> and <code>kphi</code> depend on <code>n</code> (N/m<sup>n+1</sup> and
