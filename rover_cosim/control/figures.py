@@ -13,24 +13,30 @@ import pandas as pd
 #: Line styles of limbs 1-3: curves that coincide (the limbs share one Fx_des, and their forces
 #: follow it closely) stay visible as dashes and dots over the solid line.
 STYLES = {1: dict(ls="-", lw=2.2), 2: dict(ls="--", lw=1.6), 3: dict(ls=":", lw=1.6)}
-PANELS = (("tau", "(a) wheel torque [N·m]"), ("Tx", "(b) resistance torque [N·m]"), ("Fz", "(c) vertical force [N]"),
-          ("sinkage", "(d) sinkage [m]"), ("slip", "(e) slip ratio [-]"), ("Fx", "(f) longitudinal force [N]"))
+#: (column, panel title, y-axis label with its unit)
+PANELS = (("tau", "(a) wheel torque", "τ [N·m]"), ("Tx", "(b) resistance torque", "T_x [N·m]"),
+          ("Fz", "(c) vertical force", "F_z [N]"), ("sinkage", "(d) sinkage", "h [m]"),
+          ("slip", "(e) slip ratio", "κ [-]"), ("Fx", "(f) longitudinal force", "F_x [N]"))
 
 
 def fig10(table: pd.DataFrame, plant: str) -> bytes:
-    fig, axes = plt.subplots(4, 2, figsize=(11, 12), sharex=True)
+    fig, axes = plt.subplots(4, 2, figsize=(11, 12), sharex=True, layout="constrained")
     flat = axes.ravel()
-    for ax, (name, title) in zip(flat, PANELS):
+    for ax, (name, title, label) in zip(flat, PANELS):
         for i in (1, 2, 3):
             ax.plot(table["time"], table[f"{name}_{i}"], label=f"limb {i}", **STYLES[i])
         ax.set_title(title)
+        ax.set_ylabel(label)
         ax.legend(fontsize=8)
-    flat[6].plot(table["time"], table["v"], "k-")
-    flat[6].axhline(1.0, color="gray", ls=":")
-    flat[6].set_title("(g) rover velocity [m/s]")
+    flat[6].plot(table["time"], table["v"], "k-", label="v")
+    flat[6].axhline(1.0, color="gray", ls=":", label="target 1.0 m/s")
+    flat[6].set_title("(g) rover velocity")
+    flat[6].set_ylabel("v [m/s]")
+    flat[6].legend(fontsize=8)
     flat[7].plot(table["time"], table["Fx_1"], label="Fx limb 1")
     flat[7].plot(table["time"], table["Fx_des_1"], "--", label="Fx_des limb 1")
-    flat[7].set_title("(h) actual and desired Fx, limb 1 [N]")
+    flat[7].set_title("(h) actual and desired Fx, limb 1")
+    flat[7].set_ylabel("F_x [N]")
     flat[7].legend(fontsize=8)
     for ax in flat:
         ax.grid(alpha=0.3)
@@ -70,7 +76,8 @@ def tracking(mono: pd.DataFrame, cosim: pd.DataFrame) -> bytes:
 
 
 def _png(fig) -> bytes:  # noqa: ANN001 - a matplotlib Figure
-    fig.tight_layout()
+    if fig.get_layout_engine() is None:  # a figure laid out as it was made keeps its layout
+        fig.tight_layout()
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=100)
     plt.close(fig)
