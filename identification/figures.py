@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import io
-
 import matplotlib
 
 matplotlib.use("Agg")
@@ -11,6 +9,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from matplotlib.lines import Line2D
+
+from rover_cosim.common.figures import render
 
 from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, IdentifiedModel
 
@@ -24,11 +24,11 @@ def finish(axes, legend: bool = True) -> None:  # noqa: ANN001 - matplotlib Axes
 
 
 def png_bytes(fig) -> bytes:
-    buffer = io.BytesIO()
+    """The figure as PNG (110 dpi, or the --dpi asked for), with the other --figures formats attached."""
     fig.tight_layout()
-    fig.savefig(buffer, format="png", dpi=110)
+    rendered = render(fig, 110)
     plt.close(fig)
-    return buffer.getvalue()
+    return rendered
 
 
 def fig5_fx_vs_slip(table: pd.DataFrame, per_load: pd.DataFrame) -> bytes:

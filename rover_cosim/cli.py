@@ -40,6 +40,16 @@ def _slip_step(text: str) -> float:
     return step
 
 
+def _figure_formats(text: str) -> tuple[str, ...]:
+    from rover_cosim.common.figures import FORMATS
+
+    formats = tuple(part.strip().lower() for part in text.split(",") if part.strip())
+    unknown = [f for f in formats if f not in FORMATS]
+    if unknown or not formats:
+        raise argparse.ArgumentTypeError(f"figures={text!r}: expected some of {', '.join(FORMATS)}, comma-separated")
+    return formats
+
+
 def _slip_range(text: str) -> tuple[float, float]:
     try:
         first, last = (float(part) for part in text.split(","))
@@ -85,6 +95,10 @@ class _Help(argparse.RawDescriptionHelpFormatter):
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="rover-cosim", description=__doc__, formatter_class=_Help)
     parser.add_argument("--version", action="version", version=f"rover-cosim {__version__}")
+    parser.add_argument("--figures", type=_figure_formats, default=("png",), metavar="FORMATS",
+                        help="formats every figure is written in, beside PNG: e.g. png,pdf,svg (default: png)")
+    parser.add_argument("--dpi", type=float, default=None,
+                        help="resolution of the PNG figures (default: each figure's own, 100-150)")
     commands = parser.add_subparsers(dest="command", required=True)
     original = commands.add_parser
     commands.add_parser = lambda *a, **k: original(*a, formatter_class=_Help, **k)  # type: ignore[method-assign]
@@ -697,7 +711,14 @@ def _terminate(signum: int, frame: object) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    from rover_cosim.common import figures
     from rover_cosim.common.outputs import set_command_line
+
+    try:
+        figures.configure(args.figures, args.dpi)
+    except ValueError as error:
+        print(f"rover-cosim: {error}", file=sys.stderr)
+        return 2
 
     set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
     main_thread = threading.current_thread() is threading.main_thread()

@@ -101,3 +101,23 @@ def test_bad_slip_ranges_are_named(tmp_path, capsys, args, message):
     with pytest.raises(SystemExit):
         cli.main(["fig3", "--out", str(tmp_path), *args])
     assert message in capsys.readouterr().err
+
+
+def test_figures_in_other_formats_and_at_a_chosen_resolution(tmp_path, capsys):
+    from PIL import Image
+
+    from rover_cosim.common import figures
+
+    try:
+        assert cli.main(["--figures", "png,svg,pdf", "--dpi", "60", "fig3", "--out", str(tmp_path / "a"),
+                         "--loads", "300", "--slip-step", "0.3"]) == 0
+        assert (tmp_path / "a" / "fig3_fx_vs_slip.svg").read_bytes().lstrip().startswith(b"<?xml")
+        assert (tmp_path / "a" / "fig3_fx_vs_slip.pdf").read_bytes().startswith(b"%PDF")
+        small = Image.open(tmp_path / "a" / "fig3_fx_vs_slip.png").size
+    finally:
+        figures.configure()  # this process's settings back to PNG only
+    assert cli.main(["fig3", "--out", str(tmp_path / "b"), "--loads", "300", "--slip-step", "0.3"]) == 0
+    assert not (tmp_path / "b" / "fig3_fx_vs_slip.svg").exists()
+    assert Image.open(tmp_path / "b" / "fig3_fx_vs_slip.png").size[0] > 2 * small[0]  # 150 dpi against 60
+    assert cli.main(["--dpi", "5", "fig3", "--out", str(tmp_path / "c")]) == 2
+    assert "dpi 5.0: expected 20 to 1200" in capsys.readouterr().err

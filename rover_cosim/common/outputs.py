@@ -28,6 +28,7 @@ def write_all(files: Mapping[Path, bytes]) -> None:
     failure leaves no half-written result and no stray temporary.
     """
     staged: list[tuple[Path, Path]] = []
+    files = _with_other_renderings(files)
     try:
         for target, payload in files.items():
             target.parent.mkdir(parents=True, exist_ok=True)
@@ -41,6 +42,16 @@ def write_all(files: Mapping[Path, bytes]) -> None:
     finally:
         for temporary, _ in staged:
             temporary.unlink(missing_ok=True)
+
+
+def _with_other_renderings(files: Mapping[Path, bytes]) -> dict[Path, bytes]:
+    """``files`` and, beside each figure rendered in other formats too (common.figures), those."""
+    expanded: dict[Path, bytes] = {}
+    for target, payload in files.items():
+        expanded[target] = payload
+        for suffix, data in getattr(payload, "others", {}).items():
+            expanded[Path(target).with_suffix(suffix)] = data
+    return expanded
 
 
 def _version(package: str) -> str | None:

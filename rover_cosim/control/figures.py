@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import io
-
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import pandas as pd
+
+from rover_cosim.common.figures import render
 
 #: Line styles of limbs 1-3: curves that coincide (the limbs share one Fx_des, and their forces
 #: follow it closely) stay visible as dashes and dots over the solid line.
@@ -78,7 +78,6 @@ def tracking(mono: pd.DataFrame, cosim: pd.DataFrame) -> bytes:
 def _png(fig) -> bytes:  # noqa: ANN001 - a matplotlib Figure
     if fig.get_layout_engine() is None:  # a figure laid out as it was made keeps its layout
         fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100)
+    rendered = render(fig, 100)
     plt.close(fig)
-    return buffer.getvalue()
+    return rendered

@@ -11,7 +11,6 @@ the inputs interpolated over the step.
 
 from __future__ import annotations
 
-import io
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -20,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.figures import render
 from rover_cosim.common.outputs import json_bytes, run_record, summary_repr, write_all
 from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.examples import example
@@ -99,10 +99,9 @@ def figure_png(table: pd.DataFrame) -> bytes:
         ax.legend()
     fig.suptitle("Co-simulated rover (RoverBody + 6 Wheel) against the monolithic Rover.fmu, 6 s open loop")
     fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=120)
+    rendered = render(fig, 120)
     plt.close(fig)
-    return buffer.getvalue()
+    return rendered
 
 
 def write_cosim_study(fmu_dir: Path, out_dir: Path,

@@ -6,7 +6,6 @@ apart; only ``write_fig3`` touches the file system, and it writes all of its fil
 
 from __future__ import annotations
 
-import io
 from dataclasses import asdict
 from pathlib import Path
 
@@ -14,6 +13,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from rover_cosim.common.figures import render
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.terramechanics import Soil, Wheel, wheel_state
@@ -99,16 +99,15 @@ def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
     choice = as_choice(choice)
     wheel, soil = choice.wheel, choice.soil
     table = fig3_table(loads, slips, wheel, soil)
-    png = io.BytesIO()
     label = (f"soil {choice.soil_name}, wheel {choice.wheel_name}"
              + (f" ({', '.join(choice.overrides)})" if choice.overrides else ""))
-    fig3_figure(table, label).savefig(png, format="png")
+    png = render(fig3_figure(table, label), 150)
     parameters = {"loads_N": list(loads), "slips": list(slips), "wheel": asdict(wheel), "soil": asdict(soil),
                   "choice": describe(choice)}
     names = file_names(choice)
     files = {
         out_dir / names["csv"]: table.to_csv(index=False, float_format="%.10g").encode(),
-        out_dir / names["png"]: png.getvalue(),
+        out_dir / names["png"]: png,
         out_dir / names["json"]: json_bytes(run_record("rover-cosim fig3", parameters)),
     }
     write_all(files)
