@@ -31,7 +31,7 @@ def png_bytes(fig) -> bytes:
     return rendered
 
 
-def fig5_fx_vs_slip(table: pd.DataFrame, per_load: pd.DataFrame) -> bytes:
+def fig5_fx_vs_slip(table: pd.DataFrame, per_load: pd.DataFrame, soil: str = "") -> bytes:
     """Settled (slip, Fx) of the fitted runs and the per-load line Fx = a slip + b (Eq. 14), over
     the fitted range of slip (the runs left out, spun out or beyond the rover's torques, are
     counted in the title, not drawn: they would stretch the axis to slip 1)."""
@@ -56,8 +56,8 @@ def fig5_fx_vs_slip(table: pd.DataFrame, per_load: pd.DataFrame) -> bytes:
     ax.legend(handles, labels, ncol=2, fontsize=8, title="load W")
     ax.set_xlabel("slip ratio [-]")
     ax.set_ylabel("Fx [N]")
-    ax.set_title(f"Fig. 5: settled Fx against slip over the fitted range ({left_out} runs outside it not drawn)",
-                 fontsize=10)
+    ax.set_title(f"Fig. 5: settled Fx against slip over the fitted range ({left_out} runs outside it not drawn)"
+                 + (f"\n{soil}" if soil else ""), fontsize=10)
     ax.grid(alpha=0.3)
     return png_bytes(fig)
 
@@ -91,7 +91,7 @@ def fig_coefficient(per_load: pd.DataFrame, model: IdentifiedModel, k: int, name
     return png_bytes(fig)
 
 
-def fig8_validation(run: pd.DataFrame, load: float, labels: list[str]) -> bytes:
+def fig8_validation(run: pd.DataFrame, load: float, labels: list[str], soil: str = "") -> bytes:
     fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     axes[0].plot(run["time"], run["Fx"], "k-", label="SingleWheel.fmu (terramechanics)")
     axes[1].plot(run["time"], run["slip"], "k-", label="SingleWheel.fmu")
@@ -101,6 +101,6 @@ def fig8_validation(run: pd.DataFrame, load: float, labels: list[str]) -> bytes:
     axes[0].set_ylabel("Fx [N]")
     axes[1].set_ylabel("slip [-]")
     axes[1].set_xlabel("time [s]")
-    axes[0].set_title(f"Fig. 8: torque staircase 5-40 N·m at W = {load:.0f} N")
+    axes[0].set_title(f"Fig. 8: torque staircase 5-40 N·m at W = {load:.0f} N" + (f", {soil}" if soil else ""))
     finish(axes)
     return png_bytes(fig)

@@ -222,6 +222,12 @@ def from_fmu_parameters(values: dict[str, float]) -> tuple[Soil, Wheel]:
     return Soil(**soil), Wheel(**wheel)
 
 
+def soil_label(choice: Choice) -> str:
+    """"soil NAME, wheel NAME (changes)": how figures and pages name a Choice."""
+    return (f"soil {choice.soil_name}, wheel {choice.wheel_name}"
+            + (f" ({', '.join(choice.overrides)})" if choice.overrides else ""))
+
+
 def describe(choice: Choice) -> dict[str, Any]:
     """What a results folder records: names, titles, sources and every value (SI)."""
     return {"soil": {"name": choice.soil_name, "title": choice.soil_entry.get("title"),

@@ -17,7 +17,7 @@ from rover_cosim.common.figures import render
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.terramechanics import Soil, Wheel, wheel_state
-from rover_cosim.terramechanics.library import Choice, as_choice, describe
+from rover_cosim.terramechanics.library import Choice, as_choice, describe, soil_label
 
 CSV_NAME = "fig3_fx_vs_slip.csv"
 PNG_NAME = "fig3_fx_vs_slip.png"
@@ -99,9 +99,7 @@ def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
     choice = as_choice(choice)
     wheel, soil = choice.wheel, choice.soil
     table = fig3_table(loads, slips, wheel, soil)
-    label = (f"soil {choice.soil_name}, wheel {choice.wheel_name}"
-             + (f" ({', '.join(choice.overrides)})" if choice.overrides else ""))
-    png = render(fig3_figure(table, label), 150)
+    png = render(fig3_figure(table, soil_label(choice)), 150)
     parameters = {"loads_N": list(loads), "slips": list(slips), "wheel": asdict(wheel), "soil": asdict(soil),
                   "choice": describe(choice)}
     names = file_names(choice)

@@ -51,7 +51,7 @@ from rover_cosim.identification.sweep import SweepOutcome, SweepPlan, run_sweep
 from rover_cosim.identification.testbed import RECORDED, shared_test_bed
 from rover_cosim.identification.validate import validate
 from rover_cosim.terramechanics import Soil, Wheel
-from rover_cosim.terramechanics.library import Choice, as_choice, describe
+from rover_cosim.terramechanics.library import Choice, as_choice, describe, soil_label
 
 MODELS = {"quadratic": 2, "linear": 1}  # label -> degree in slip; the first is recommended
 RECOMMENDED = "quadratic"
@@ -191,12 +191,13 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
         out / "fit_models.csv": fit_models.to_csv(index=False, float_format="%.3f").encode(),
         out / "fit_detail.csv": validation.detail.to_csv(index=False, float_format="%.6g").encode(),
         out / "failures.csv": failures.to_csv(index=False).encode(),
-        out / "fig5_fx_vs_slip.png": figures.fig5_fx_vs_slip(table, per_load),
+        out / "fig5_fx_vs_slip.png": figures.fig5_fx_vs_slip(table, per_load, soil_label(choice)),
         out / "fig6_a_of_W.png": figures.fig_coefficient(per_load, models["linear"], 1, "a(W)", "N",
                                                           "Fig. 6: slope a of Fx = a slip + b against load"),
         out / "fig7_b_of_W.png": figures.fig_coefficient(per_load, models["linear"], 0, "b(W)", "N",
                                                           "Fig. 7: offset b of Fx = a slip + b against load"),
-        out / "fig8_validation_575N.png": figures.fig8_validation(validation.runs[575.0], 575.0, list(MODELS)),
+        out / "fig8_validation_575N.png": figures.fig8_validation(validation.runs[575.0], 575.0, list(MODELS),
+                                                                  soil_label(choice)),
         out / "fig_model_coefficients.png":
             figures.fig_model_coefficients(fx_per_load(table, MODELS[RECOMMENDED]), models[RECOMMENDED]),
         out / "identification.json": json_bytes(record),
