@@ -101,7 +101,9 @@ def test_fmu_and_numpy_wheel_agree_on_another_soil_given_as_parameters(fmus, soi
 def test_fig3_records_the_soil_it_used(tmp_path, capsys):
     assert main(["fig3", "--out", str(tmp_path), "--loads", "300", "--slip-step", "0.3",
                  "--soil", "dry_sand", "--set", "soil.c=900"]) == 0
-    record = json.loads((tmp_path / "fig3_fx_vs_slip.json").read_text())
+    written = sorted(tmp_path.glob("fig3_fx_vs_slip_dry_sand_set-*.json"))  # named by the soil and the change
+    assert len(written) == 1
+    record = json.loads(written[0].read_text())
     assert record["parameters"]["choice"]["soil"]["name"] == "dry_sand"
     assert record["parameters"]["soil"]["c"] == 900.0 and record["parameters"]["choice"]["set"] == ["soil.c=900"]
     assert main(["fig3", "--out", str(tmp_path), "--soil", "mud"]) == 2
