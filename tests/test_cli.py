@@ -118,3 +118,37 @@ def test_every_command_says_what_it_does_with_an_example():
     for name, sub in commands.items():
         assert sub.description and len(sub.description.splitlines()) == 1, name
         assert f"rover-cosim {name}" in (sub.epilog or ""), name
+
+
+@pytest.mark.parametrize("signal_name", ["SIGKILL", "SIGTERM"])
+def test_workers_die_with_their_parent_however_it_dies(tmp_path, signal_name):
+    """parallel_map's local workers (as identify and montecarlo use them), their parent killed
+    while they work: none is alive a few seconds later."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    psutil = pytest.importorskip("psutil", reason="psutil not installed")
+    script = ("import time, signal\n"
+              "from rover_cosim.common.parallel import parallel_map\n"
+              "def interrupt(*_):\n    raise KeyboardInterrupt\n"
+              "signal.signal(signal.SIGTERM, interrupt)\n"  # as the CLI does
+              "print('ready', flush=True)\n"
+              "for _ in parallel_map(time.sleep, [(60,), (60,), (60,)], workers=2):\n    pass\n")
+    parent = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert parent.stdout is not None and parent.stdout.readline().strip() == "ready"
+    deadline = time.monotonic() + 30
+    children: list = []
+    while time.monotonic() < deadline and len(children) < 2:
+        children = [c for c in psutil.Process(parent.pid).children() if "python" in c.name().lower()]
+        time.sleep(0.2)
+    assert len(children) >= 2, "the workers did not start"
+    time.sleep(1.0)  # they are in their task now
+    os.kill(parent.pid, getattr(signal, signal_name))
+    parent.wait(timeout=30)
+    gone, alive = psutil.wait_procs(children, timeout=10)
+    for process in alive:
+        process.kill()
+    assert not alive, f"{len(alive)} workers outlived their parent ({signal_name})"

@@ -5,8 +5,9 @@ The function must be importable by name (the workers import it) and should not r
 its own failures in what it returns, so that one failing call does not stop the others. The
 local worker processes end with the caller: on an error, Ctrl-C or SIGTERM (raised as
 KeyboardInterrupt by the CLI) or the consumer closing the generator, the pool is cancelled and
-its workers terminated; and each worker asks Linux to end it when its parent dies
-(PR_SET_PDEATHSIG), so a killed caller leaves no workers behind.
+its workers terminated; and each worker asks Linux to kill it when its parent dies
+(PR_SET_PDEATHSIG, SIGKILL) and takes the default signal handlers back, so a caller killed in
+any way (kill -9 included) leaves no workers behind.
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     if workers == 1 or len(arguments) <= 1:
         yield from (function(*a) for a in arguments)
         return
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_end_with_parent)
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_end_with_parent, initargs=(os.getpid(),))
     try:
         for future in as_completed([pool.submit(function, *a) for a in arguments]):
             yield future.result()
@@ -58,12 +59,21 @@ def _stop(pool: ProcessPoolExecutor) -> None:
         process.join(timeout=5)
 
 
-def _end_with_parent() -> None:
-    """In a worker: ask the kernel for SIGTERM when the parent process dies (Linux only)."""
+def _end_with_parent(parent: int | None = None) -> None:
+    """In a worker: die with the parent. The kernel sends SIGKILL when the parent dies (Linux,
+    PR_SET_PDEATHSIG; nothing in the worker can turn it into something else); the handlers
+    inherited from the command (SIGTERM raised as KeyboardInterrupt) are put back to the
+    defaults, so a SIGTERM ends the worker instead of failing its task; a parent already gone
+    before this ran ends it at once. Ctrl-C is left to the parent, which stops the pool."""
+    import signal
+
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         import ctypes
-        import signal
 
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG = 1
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
     except (OSError, AttributeError):
         pass
+    if parent is not None and os.getppid() != parent:
+        os._exit(1)
