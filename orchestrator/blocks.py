@@ -227,6 +227,7 @@ def make_block(name: str, kind: str, params: Mapping[str, Any], folder: Path | N
     if kind not in BLOCK_TYPES:
         raise ValueError(f"block {name!r}: type {kind!r}: expected one of {', '.join([*BLOCK_TYPES, 'python'])}")
     _check_keys(name, f"type {kind!r}", BLOCK_TYPES[kind], params)
+    _check_numbers(name, kind, params)
     if kind == "csv" and folder is not None and isinstance(params.get("file"), str) \
             and not Path(params["file"]).is_absolute():
         params = {**params, "file": folder / params["file"]}
@@ -234,6 +235,26 @@ def make_block(name: str, kind: str, params: Mapping[str, Any], folder: Path | N
         return BLOCK_TYPES[kind](name=name, **params)
     except TypeError as error:
         raise ValueError(f"block {name!r} (type {kind}): {error}") from None
+
+
+#: Keys of the built-in blocks that are not numbers (the others are, and are checked as numbers).
+TEXT_KEYS = {"unit", "file", "hold", "types"}
+
+
+def _check_numbers(name: str, kind: str, params: Mapping[str, Any]) -> None:
+    """ValueError naming the key, unless every numeric key of a built-in block is a real number
+    (a list of them for a table's time and values): true, "575" or NaN are not."""
+    def real(value: Any) -> bool:
+        return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+    for key, value in params.items():
+        if key in TEXT_KEYS:
+            continue
+        if kind == "table" and key in ("time", "values"):
+            if not isinstance(value, (list, tuple)) or not all(real(v) for v in value):
+                raise ValueError(f"block {name!r} (type {kind}): {key} = {value!r}: expected a list of finite numbers")
+        elif not real(value):
+            raise ValueError(f"block {name!r} (type {kind}): {key} = {value!r}: expected a finite number")
 
 
 def _import(module_name: str, folder: Path | None) -> Any:

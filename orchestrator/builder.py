@@ -24,6 +24,7 @@ run.
 from __future__ import annotations
 
 import json
+import math
 import re
 import zipfile
 from collections.abc import Iterable, Mapping
@@ -59,6 +60,12 @@ SIMULATION_DEFAULTS: dict[str, Any] = {"start_time": 0.0, "algorithm": "gauss-se
                                        "allow_algebraic_loops": False, "threads": None, "native": True,
                                        "relative_tolerance": 1e-6, "output_interval": None}
 ITERATION_KEYS = ("tolerance", "max_iterations", "relaxation")
+#: Limits a run is checked against before anything is allocated: the communication steps of a
+#: run, the bytes of its recorded rows, the threads stepping FMUs, the largest time [s].
+MAX_STEPS = 100_000_000
+MAX_RECORD_BYTES = 8 * 2**30
+MAX_THREADS = 256
+MAX_TIME = 1e12
 
 
 def number(value: Any, where: str) -> float:
@@ -227,15 +234,23 @@ class SystemBuilder:
         values, where = self._settings.values, self._settings.where
         if "step" not in values or "stop_time" not in values:
             return  # checked once both are there (build() says which is missing)
-        step = self._number(values["step"], f"{where} step")
-        stop_time = self._number(values["stop_time"], f"{where} stop_time")
         start_time = self._number(values["start_time"], f"{where} start_time")
+        stop_time = self._number(values["stop_time"], f"{where} stop_time")
+        step = self._number(values["step"], f"{where} step")
+        for key, value in (("start_time", start_time), ("stop_time", stop_time), ("step", step)):
+            if not math.isfinite(value) or abs(value) > MAX_TIME:
+                raise self.error(f"{where} {key}", f"{value!r}: expected a finite time within ±{MAX_TIME:g} s")
         if not step > 0:
             raise self.error(f"{where} step", f"{step!r}: expected a communication step > 0 s")
         if not stop_time > start_time:
             raise self.error(f"{where} stop_time", f"{stop_time!r}: expected a stop time > start time {start_time} s")
         if step > stop_time - start_time:
             raise self.error(f"{where} step", f"{step!r} s is longer than the run ({stop_time - start_time!r} s)")
+        steps = (stop_time - start_time) / step
+        if steps > MAX_STEPS:
+            raise self.error(f"{where} step", f"{step!r} s makes {steps:.3g} communication steps of a "
+                             f"{stop_time - start_time!r} s run: more than the {MAX_STEPS:,} a run may take "
+                             "(a larger step, or a shorter run)")
         interval = values.get("output_interval")
         if interval is not None:
             interval = self._number(interval, f"{where} output_interval")
@@ -253,9 +268,10 @@ class SystemBuilder:
         if not isinstance(allow, bool):
             raise self.error(f"{where} allow_algebraic_loops", f"{allow!r}: expected true or false")
         threads = values["threads"]
-        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int) or threads < 1):
-            raise self.error(f"{where} threads", f"{threads!r}: expected a whole number >= 1 (FMUs stepped "
-                             "at the same time)")
+        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int)
+                                    or not 1 <= threads <= MAX_THREADS):
+            raise self.error(f"{where} threads", f"{threads!r}: expected a whole number from 1 to {MAX_THREADS} "
+                             "(FMUs stepped at the same time)")
         tolerance = self._number(values["relative_tolerance"], f"{where} relative_tolerance")
         if not 0 < tolerance < 1:
             raise self.error(f"{where} relative_tolerance", f"{tolerance!r}: expected 0 < relative_tolerance < 1 "
@@ -586,6 +602,12 @@ class SystemBuilder:
         self._check_capabilities()
         order = self._order()
         record = self._record if self._record is not None else [p for i in order for p in self._outputs(i)]
+        rows = (float(values["stop_time"]) - float(values["start_time"])) / float(values["step"]) + 2
+        if rows * max(1, len(record)) * 8 > MAX_RECORD_BYTES:
+            raise self.error("record", f"{len(record)} recorded variables over {rows:.3g} communication points "
+                             f"would take {rows * len(record) * 8 / 2**30:.3g} GiB: more than the "
+                             f"{MAX_RECORD_BYTES / 2**30:g} GiB a run records (record fewer variables, or a larger "
+                             "step)")
         iteration = self._iteration()
         loop = self._loop()
         return System(self.path, [_copy_fmu(f) for f in self._fmus.values()],

@@ -28,6 +28,7 @@ from typing import Any
 
 from lxml import etree
 
+from rover_cosim.common.outputs import result_mode
 from rover_cosim.common.units import base_units
 
 from .blocks import BLOCK_TYPES, REGISTERED_FACTORIES, make_block
@@ -262,6 +263,7 @@ def _write_zip(out: Path, files: dict[str, bytes]) -> None:
         with open(handle, "wb") as stream, zipfile.ZipFile(stream, "w", zipfile.ZIP_DEFLATED) as archive:
             for name, data in files.items():
                 archive.writestr(name, data)
+        os.chmod(temporary, result_mode())  # mkstemp makes 0600; an archive is an ordinary result
         Path(temporary).replace(out)
     finally:
         Path(temporary).unlink(missing_ok=True)

@@ -519,6 +519,9 @@ def _montecarlo(args: argparse.Namespace) -> int:
         return 1
     bar.close()
     _print_montecarlo(outcome)
+    if len(outcome.runs) and outcome.summary["runs_failed"] == len(outcome.runs):
+        print(f"rover-cosim montecarlo: every run failed (see {args.out / 'failures.csv'})", file=sys.stderr)
+        return 1
     return 0
 
 

@@ -159,3 +159,36 @@ def test_runs_on_two_soils_have_records_that_say_so(fmu_dir, fmus, tmp_path):
     assert lete["fmus"]["testbed"]["parameters"]["soil.c"] == 1300.0
     assert "--soil" in lete["command_line"] and "lete_sand" in lete["command_line"]
     assert paper["fmus"]["testbed"]["sha256"] == lete["fmus"]["testbed"]["sha256"]
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"simulation": {"stop_time": float("inf")}}, "stop_time: inf: expected a finite time"),
+    ({"simulation": {"stop_time": 1e300}}, "stop_time: 1e+300: expected a finite time"),
+    ({"simulation": {"start_time": float("nan")}}, "start_time: nan: expected a finite time"),
+    ({"simulation": {"step": 1e-300}}, "more than the 100,000,000 a run may take"),
+    ({"simulation": {"threads": 10000}}, "threads: 10000: expected a whole number from 1 to 256"),
+    ({"block": {"height": True}}, "height = True: expected a finite number"),
+    ({"block": {"height": "575"}}, "height = '575': expected a finite number"),
+])
+def test_absurd_settings_and_untyped_block_values_are_refused_at_load(fmu_dir, fmus, change, message):
+    data = example("single_wheel_step")
+    data["simulation"].update(change.get("simulation", {}))
+    if "block" in change:
+        data["block"][0].update(change["block"])
+        data["block"][0]["type"] = "step"
+        data["block"][0] = {k: v for k, v in data["block"][0].items() if k in ("name", "type", "height", "time",
+                                                                                "offset", "unit")}
+    with pytest.raises(SystemFileError, match=message.replace("(", r"\(").replace(")", r"\)").replace("+", r"\+")):
+        system_from_dict(data, name="t.toml", base=fmu_dir)
+
+
+def test_an_exported_archive_is_an_ordinary_result_file(fmu_dir, fmus, tmp_path):
+    import os
+
+    from rover_cosim.common.outputs import result_mode
+    from rover_cosim.orchestrator.ssp import export_ssp
+
+    archive = export_ssp(system_from_dict(example("single_wheel_step"), name="t.toml", base=fmu_dir),
+                         tmp_path / "x.ssp").path
+    assert os.stat(archive).st_mode & 0o777 == result_mode() == (tmp_path / "x.ssp").stat().st_mode & 0o777
+    assert result_mode() & 0o044  # readable by others under the usual umask, as the CSV results are

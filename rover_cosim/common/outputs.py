@@ -36,12 +36,17 @@ def write_all(files: Mapping[Path, bytes]) -> None:
             staged.append((Path(name), target))
             with os.fdopen(handle, "wb") as stream:
                 stream.write(payload)
-            os.chmod(name, 0o666 & ~_UMASK)  # mkstemp makes 0600; results are ordinary files
+            os.chmod(name, result_mode())  # mkstemp makes 0600; results are ordinary files
         for temporary, target in staged:
             os.replace(temporary, target)
     finally:
         for temporary, _ in staged:
             temporary.unlink(missing_ok=True)
+
+
+def result_mode() -> int:
+    """The file mode of every result: 0666 less the process's umask (0644 under the usual 022)."""
+    return 0o666 & ~_UMASK
 
 
 def _with_other_renderings(files: Mapping[Path, bytes]) -> dict[Path, bytes]:

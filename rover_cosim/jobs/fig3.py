@@ -24,6 +24,8 @@ PNG_NAME = "fig3_fx_vs_slip.png"
 RECORD_NAME = "fig3_fx_vs_slip.json"
 COLUMNS = ["load_N", "slip", "sinkage_m", "Fx_N", "Fz_N", "Tx_Nm"]
 STEM = "fig3_fx_vs_slip"
+#: Most (load, slip) points Fig. 3 computes (a grid beyond it is refused before any memory is taken).
+MAX_POINTS = 1_000_000
 
 
 def file_names(choice: Choice) -> dict[str, str]:
@@ -51,6 +53,9 @@ def slip_grid(step: float, last: float = 0.9, first: float = 0.0) -> tuple[float
     """Slip ratios first, first + step, ..., last [-] (both ends included, the spacing adjusted;
     rounded to 10 decimals). Negative slip: braking."""
     count = int(round((last - first) / step)) + 1
+    if count > MAX_POINTS:
+        raise ValueError(f"slip step {step!r} makes {count:,} slips from {first:g} to {last:g}: more than the "
+                         f"{MAX_POINTS:,} points Fig. 3 computes (a larger --slip-step)")
     return tuple(float(k) for k in np.round(np.linspace(first, last, count), 10))
 
 
@@ -97,6 +102,9 @@ def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
     """Compute, draw and write Fig. 3 (CSV, PNG and a JSON run record) into ``out_dir``, on the
     soil and wheel of ``choice`` (default: the paper's)."""
     choice = as_choice(choice)
+    if len(loads) * len(slips) > MAX_POINTS:
+        raise ValueError(f"{len(loads)} loads x {len(slips)} slips = {len(loads) * len(slips):,} wheel states: more "
+                         f"than the {MAX_POINTS:,} Fig. 3 computes (fewer loads, or a larger --slip-step)")
     wheel, soil = choice.wheel, choice.soil
     table = fig3_table(loads, slips, wheel, soil)
     png = render(fig3_figure(table, soil_label(choice)), 150)
