@@ -1,10 +1,13 @@
 """The sweep's cache of runs: each run is a CSV written with a checksum beside it, and is only
 used when it is whole.
 
-``W575_tau20.csv`` goes with ``W575_tau20.csv.sha256`` (JSON: SHA-256 of the CSV's bytes, its
-rows and columns), both written to temporary names and renamed, the checksum last. A run file is
-used only if its checksum file exists and matches, and it has the expected rows and columns; any
-other file is reported (a warning naming it and why) and computed again. Partial files of an
+``W575_tau20.csv`` goes with ``W575_tau20.csv.sha256`` (JSON: the case the file was computed for,
+its key; SHA-256 of that key and the CSV's bytes together; its rows and columns), both written to
+temporary names and renamed, the checksum last. A run file is used only if its checksum file
+exists and matches, it was computed for the case it stands for (its key: the file's place in the
+cache, whose folders are the digests of the FMU, soil and plan, so a file copied or moved from
+another case, with its own checksum, is refused), and it has the expected rows and columns; any
+other file is reported (naming it and why) and computed again. Partial files of an
 interrupted sweep (``.*.part``) are removed when the next sweep starts.
 """
 
@@ -37,13 +40,29 @@ def _atomic_write(target: Path, data: bytes) -> None:
         Path(temporary).unlink(missing_ok=True)
 
 
+def case_key(path: Path) -> str:
+    """The case a cache file stands for: its path below the cache folder (folders named by the
+    digests of what it was computed from, and its own name; outside a folder named cache, its
+    name and the two folders above it), so that moving the whole results folder keeps it."""
+    parts = Path(path).parts
+    below = [k for k, part in enumerate(parts[:-1]) if part == "cache"]
+    return "/".join(parts[below[-1] + 1:] if below else parts[-3:])
+
+
+def _digest(key: str, payload: bytes) -> str:
+    """SHA-256 of a cache file's key and content together."""
+    return hashlib.sha256(key.encode() + b"\n" + payload).hexdigest()
+
+
 def write_run(target: Path, data: pd.DataFrame, float_format: str | None = "%.12g") -> None:
-    """The run's CSV, then its checksum (so a checksum always describes a whole file).
-    ``float_format`` None writes every float exactly (shortest repr that reads back the same)."""
+    """The run's CSV, then its checksum (so a checksum always describes a whole file, and the
+    case it was computed for). ``float_format`` None writes every float exactly (shortest repr
+    that reads back the same)."""
     target = Path(target)
     payload = data.to_csv(index=False, float_format=float_format).encode()
     _atomic_write(target, payload)
-    record = {"sha256": hashlib.sha256(payload).hexdigest(), "rows": len(data), "columns": list(data.columns)}
+    key = case_key(target)
+    record = {"key": key, "sha256": _digest(key, payload), "rows": len(data), "columns": list(data.columns)}
     _atomic_write(checksum_file(target), json.dumps(record).encode())
 
 
@@ -64,7 +83,12 @@ def read_run(path: Path, rows: int, columns: list[str], exact: bool = False) -> 
         return None, f"{Path(missing.filename).name} is missing"
     except (OSError, ValueError) as error:
         return None, f"unreadable checksum ({error})"
-    if not isinstance(record, dict) or hashlib.sha256(payload).hexdigest() != record.get("sha256"):
+    key = case_key(path)
+    if not isinstance(record, dict) or "key" not in record:
+        return None, "its checksum names no case (a cache of an older version, or not ours)"
+    if record["key"] != key:
+        return None, f"it was computed for {record['key']!r}, not for {key!r} (copied or moved from another case)"
+    if _digest(key, payload) != record.get("sha256"):
         return None, "its content does not match its checksum (cut short or changed)"
     try:
         data = pd.read_csv(io.BytesIO(payload), **_ROUND_TRIP if exact else {})

@@ -90,3 +90,29 @@ def test_the_workers_end_with_the_sweep(fmus, tmp_path, sent):
     process.wait(timeout=30)
     gone, alive = psutil.wait_procs(workers, timeout=15)
     assert not alive, f"workers still running after {sent!r}: {[p.pid for p in alive]}"
+
+
+def test_a_cache_file_copied_over_another_case_with_its_checksum_is_refused(tmp_path):
+    """Each checksum carries the case it was computed for: a run file and its checksum copied over
+    another case's (the poisoning of issue 30) are named and computed again; a results folder moved
+    as a whole keeps its cache."""
+    import shutil
+
+    import pandas as pd
+
+    from rover_cosim.identification.cache import checksum_file, read_run, write_run
+
+    folder = tmp_path / "results" / "identification" / "cache" / "fmu-digest" / "plan-digest"
+    folder.mkdir(parents=True)
+    a, b = folder / "W275_tau20.csv", folder / "W575_tau20.csv"
+    write_run(a, pd.DataFrame({"time": [0.0, 1.0], "Fx": [1.0, 2.0]}))
+    write_run(b, pd.DataFrame({"time": [0.0, 1.0], "Fx": [5.0, 6.0]}))
+    shutil.copy(b, a)
+    shutil.copy(checksum_file(b), checksum_file(a))
+    data, problem = read_run(a, 2, ["time", "Fx"])
+    assert data is None and "computed for 'fmu-digest/plan-digest/W575_tau20.csv'" in str(problem)
+    assert read_run(b, 2, ["time", "Fx"])[0] is not None
+    moved = tmp_path / "elsewhere"
+    shutil.move(str(tmp_path / "results"), moved)
+    assert read_run(moved / "identification" / "cache" / "fmu-digest" / "plan-digest" / "W575_tau20.csv", 2,
+                    ["time", "Fx"])[0] is not None
