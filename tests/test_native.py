@@ -93,3 +93,28 @@ def test_without_a_compiler_the_masters_stay_in_python_and_say_why(fmu_dir, fmus
         native._library.cache_clear()
         native.load_library.cache_clear()
     assert native.unavailable_reason() is None
+
+
+@pytest.mark.parametrize("damage", ["truncated", "foreign"])
+def test_a_damaged_library_in_the_native_cache_is_compiled_again(fmu_dir, fmus, tmp_path, damage):
+    """A stepper library cut short (it crashed every run with SIGBUS) or another library under its
+    name: the next run names it in one line, compiles it again and runs natively, exit 0."""
+    import os
+    import subprocess
+    import sys
+
+    cache = tmp_path / "cache"
+    env = {**os.environ, "ROVER_COSIM_CACHE": str(cache)}
+    command = [sys.executable, "-m", "rover_cosim", "run", "single_wheel_step", "--fmu-dir", str(fmu_dir),
+               "--stop-time", "0.05", "-o", str(tmp_path / "run.csv"), "-q"]
+    first = subprocess.run(command, env=env, capture_output=True, text=True, timeout=300)
+    assert first.returncode == 0, first.stderr
+    library = next(cache.glob("stepper-*.so"))
+    if damage == "truncated":
+        library.write_bytes(library.read_bytes()[:4096])
+    else:
+        library.write_bytes(library.read_bytes()[::-1])  # not the library compiled here
+    again = subprocess.run(command, env=env, capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"native cache {library}: its content does not match its checksum" in again.stderr
+    assert again.stderr.count("native cache") == 1

@@ -24,6 +24,7 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -83,24 +84,58 @@ def _declare(library: ctypes.CDLL) -> ctypes.CDLL:
     return library
 
 
+def _checksum(target: Path) -> Path:
+    return target.with_name(target.name + ".sha256")
+
+
+def _cache_problem(target: Path) -> str | None:
+    """Why the cached library ``target`` may not be loaded (None: it is the one we compiled,
+    whole): no checksum beside it, or a content that does not match it (cut short, or another
+    library under its name). Checked before loading: a truncated library would crash the process."""
+    try:
+        expected = _checksum(target).read_text().strip()
+    except OSError:
+        return "it has no checksum beside it (not compiled here, or its compilation was cut short)"
+    if hashlib.sha256(target.read_bytes()).hexdigest() != expected:
+        return "its content does not match its checksum (cut short or replaced)"
+    return None
+
+
+def _write_checksum(target: Path) -> None:
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+    with os.fdopen(handle, "w") as stream:
+        stream.write(hashlib.sha256(target.read_bytes()).hexdigest() + "\n")
+    os.replace(temporary, _checksum(target))
+
+
 @cache
-def load_library(source: Path) -> ctypes.CDLL | str:
-    """The C file ``source`` compiled into a shared library (cached by its digest) and loaded,
-    or why that failed."""
+def load_library(source: Path, symbols: tuple[str, ...] = ()) -> ctypes.CDLL | str:
+    """The C file ``source`` compiled into a shared library (cached by its digest, with a
+    checksum beside it) and loaded, or why that failed. A cached library that is not whole or
+    not ours is named in one line on stderr and compiled again; ``symbols``: functions it must have."""
     digest = hashlib.sha256(source.read_bytes()).hexdigest()[:16]
     target = cache_folder() / f"{source.stem}-{digest}.so"
     try:
-        if not target.exists():
+        problem = _cache_problem(target) if target.exists() else "absent"
+        if problem is not None:
+            if problem != "absent":
+                print(f"rover-cosim: native cache {target}: {problem}; compiled again", file=sys.stderr)
             _compile(source, target)
-        return ctypes.CDLL(str(target))
+            _write_checksum(target)
+        library = ctypes.CDLL(str(target))
     except OSError as error:
         return str(error)
+    missing = [name for name in symbols if not hasattr(library, name)]
+    if missing:
+        return f"{target} lacks {', '.join(missing)} (remove it to have it compiled again)"
+    return library
 
 
 @cache
 def _library() -> ctypes.CDLL | str:
     """The loaded stepper library, or why there is none."""
-    library = load_library(SOURCE)
+    library = load_library(SOURCE, ("stepper_new", "stepper_step", "stepper_group", "stepper_run",
+                                     "stepper_failed_call", "stepper_status", "stepper_seconds", "stepper_free"))
     if isinstance(library, str):
         return f"native stepper unavailable ({library}); the masters step FMUs from Python"
     return _declare(library)
