@@ -118,7 +118,7 @@ def load_library(source: Path, symbols: tuple[str, ...] = ()) -> ctypes.CDLL | s
     try:
         problem = _cache_problem(target) if target.exists() else "absent"
         if problem is not None:
-            if problem != "absent":
+            if problem != "absent" and _checksum(target).exists():  # no checksum: a cache of an older version
                 print(f"rover-cosim: native cache {target}: {problem}; compiled again", file=sys.stderr)
             _compile(source, target)
             _write_checksum(target)
