@@ -21,6 +21,7 @@ import fmpy
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.scratch import scratch_prefix
 from rover_cosim.orchestrator.model import FmuEntry, Value
 from rover_cosim.orchestrator.participants import FmuParticipant
 
@@ -58,7 +59,7 @@ class WheelTestBed:
 
     def __init__(self, fmu_path: Path):
         self.path = Path(fmu_path)
-        self._folder = tempfile.TemporaryDirectory(prefix="testbed-")
+        self._folder = tempfile.TemporaryDirectory(prefix=scratch_prefix("testbed"))
         self.description = fmpy.read_model_description(str(self.path))
         names = {v.name for v in self.description.modelVariables}
         self.radius = float(next((v.start for v in self.description.modelVariables if v.name == "wheel.r"), 0.355))

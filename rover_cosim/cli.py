@@ -349,7 +349,10 @@ def _run(args: argparse.Namespace) -> int:
         choice = _choice(args, "run")
         if choice is None:
             return 2
-    with tempfile.TemporaryDirectory(prefix="rover-cosim-ssp-") as unpack:
+    from rover_cosim.common.scratch import remove_stale_folders, scratch_prefix
+
+    remove_stale_folders()
+    with tempfile.TemporaryDirectory(prefix=scratch_prefix("ssp")) as unpack:
         try:
             system, path = _load_run_system(args, Path(unpack))
         except SystemFileError as error:

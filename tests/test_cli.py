@@ -152,3 +152,27 @@ def test_workers_die_with_their_parent_however_it_dies(tmp_path, signal_name):
     for process in alive:
         process.kill()
     assert not alive, f"{len(alive)} workers outlived their parent ({signal_name})"
+
+
+def _leave_a_scratch_folder(k: int) -> int:
+    """A worker's task that, like the wheel test bed, leaves its temporary folder to the exit."""
+    import tempfile
+
+    from rover_cosim.common.scratch import scratch_prefix
+
+    _leave_a_scratch_folder.kept = tempfile.TemporaryDirectory(prefix=scratch_prefix("testbed"))  # type: ignore[attr-defined]
+    return k
+
+
+def test_pool_workers_leave_no_temporary_folders(tmp_path, monkeypatch):
+    import os
+    import tempfile
+
+    from rover_cosim.common.parallel import parallel_map
+
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    assert sorted(parallel_map(_leave_a_scratch_folder, [(k,) for k in range(4)], workers=2)) == [0, 1, 2, 3]
+    left = [p.name for p in tmp_path.iterdir() if p.name.startswith("rover-cosim-")
+            and f"-{os.getpid()}-" not in p.name]
+    assert not left, left

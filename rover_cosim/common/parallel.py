@@ -17,6 +17,8 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any, TypeVar
 
+from .scratch import remove_stale_folders
+
 Result = TypeVar("Result")
 
 
@@ -45,8 +47,10 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
             yield future.result()
     except BaseException:  # Ctrl-C, SIGTERM (raised as KeyboardInterrupt by the CLI), the consumer closing
         _stop(pool)
+        remove_stale_folders()
         raise
     pool.shutdown()
+    remove_stale_folders()  # the workers' temporary folders (they exit without clean-ups)
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:

@@ -1,0 +1,44 @@
+"""Temporary folders of a process, named so that another process can tell when they are left
+over: ``<tmp>/rover-cosim-<kind>-<pid>-<random>`` (kind: run, ssp, testbed). Each is removed by
+its owner when it is done; the ones of processes that are gone (killed with SIGKILL, or pool
+workers, which exit without running clean-ups) are removed by the next command, and by a pool's
+parent once its workers have ended."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import tempfile
+from pathlib import Path
+
+#: The start of every such folder's name.
+PREFIX = "rover-cosim-"
+_NAME = re.compile(rf"{PREFIX}([a-z]+)-(\d+)-")
+
+
+def scratch_prefix(kind: str) -> str:
+    """The ``prefix`` of tempfile's folders of ``kind`` for this process."""
+    return f"{PREFIX}{kind}-{os.getpid()}-"
+
+
+def remove_stale_folders() -> list[Path]:
+    """Remove the temporary folders of processes that are gone; returns what was removed."""
+    removed = []
+    for folder in Path(tempfile.gettempdir()).glob(f"{PREFIX}*-*-*"):
+        found = _NAME.match(folder.name)
+        if found is None or int(found.group(2)) == os.getpid() or _alive(int(found.group(2))):
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
+        removed.append(folder)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
