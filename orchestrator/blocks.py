@@ -237,24 +237,33 @@ def make_block(name: str, kind: str, params: Mapping[str, Any], folder: Path | N
         raise ValueError(f"block {name!r} (type {kind}): {error}") from None
 
 
-#: Keys of the built-in blocks that are not numbers (the others are, and are checked as numbers).
-TEXT_KEYS = {"unit", "file", "hold", "types"}
+def _real(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+#: What each key that is not a single number must be: (check, what is expected).
+_SHAPES: dict[str, tuple[Any, str]] = {
+    "unit": (lambda v: isinstance(v, str) and bool(v), "text"),
+    "file": (lambda v: isinstance(v, str) and bool(v), "text"),
+    "hold": (lambda v: isinstance(v, (list, tuple)) and all(isinstance(x, str) for x in v), "a list of column names"),
+    "types": (lambda v: isinstance(v, dict) and all(isinstance(x, str) for x in v.values()), "a table of type names"),
+}
 
 
 def _check_numbers(name: str, kind: str, params: Mapping[str, Any]) -> None:
-    """ValueError naming the key, unless every numeric key of a built-in block is a real number
-    (a list of them for a table's time and values): true, "575" or NaN are not."""
-    def real(value: Any) -> bool:
-        return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-
+    """ValueError naming the key, unless every key of a built-in block has its shape: numbers are
+    finite real numbers (true, "575" or NaN are not), a table's time and values lists of them,
+    unit and file text, hold a list of names, types a table of type names."""
     for key, value in params.items():
-        if key in TEXT_KEYS:
-            continue
-        if kind == "table" and key in ("time", "values"):
-            if not isinstance(value, (list, tuple)) or not all(real(v) for v in value):
-                raise ValueError(f"block {name!r} (type {kind}): {key} = {value!r}: expected a list of finite numbers")
-        elif not real(value):
-            raise ValueError(f"block {name!r} (type {kind}): {key} = {value!r}: expected a finite number")
+        if key in _SHAPES:
+            check, expected = _SHAPES[key]
+        elif kind == "table" and key in ("time", "values"):
+            check, expected = (lambda v: isinstance(v, (list, tuple)) and all(_real(x) for x in v),
+                               "a list of finite numbers")
+        else:
+            check, expected = _real, "a finite number"
+        if not check(value):
+            raise ValueError(f"block {name!r} (type {kind}): {key} = {value!r}: expected {expected}")
 
 
 def _import(module_name: str, folder: Path | None) -> Any:

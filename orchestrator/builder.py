@@ -66,6 +66,8 @@ MAX_STEPS = 100_000_000
 MAX_RECORD_BYTES = 8 * 2**30
 MAX_THREADS = 256
 MAX_TIME = 1e12
+#: The longest instance name (it names a folder).
+MAX_NAME = 100
 
 
 def number(value: Any, where: str) -> float:
@@ -88,7 +90,12 @@ def parse_port(text: Any, where: str) -> Port:
 def read_fmu(fmu_path: Path, where: str) -> Any:
     """The model description of an FMI 2.0 or 3.0 FMU file with a Co-Simulation or Model
     Exchange interface (``where``: the label of messages); SystemFileError for anything else."""
-    if not fmu_path.is_file():
+    try:
+        found = fmu_path.is_file()
+    except OSError as error:  # a name too long, a path through a file
+        raise SystemFileError(f"{where}: FMU file {str(fmu_path)[:200]!r}: not a usable path "
+                              f"({error.strerror})") from None
+    if not found:
         raise SystemFileError(f"{where}: FMU file {fmu_path} not found (build them with `rover-cosim build-fmus`)")
     try:
         description = fmpy.read_model_description(str(fmu_path))
@@ -299,9 +306,10 @@ class SystemBuilder:
     # --- components -----------------------------------------------------------------------------
     def claim(self, instance: Any, where: str) -> str:
         """Reserve the instance name ``instance`` (an identifier used once)."""
-        if not isinstance(instance, str) or not IDENTIFIER.fullmatch(instance):
-            raise self.error(where, f"name = {instance!r}: expected an identifier (letters, digits and _, not "
-                             "starting with a digit; it names the instance and its folder)")
+        if not isinstance(instance, str) or not IDENTIFIER.fullmatch(instance) or len(instance) > MAX_NAME:
+            shown = instance if not isinstance(instance, str) or len(instance) <= 80 else instance[:60] + "..."
+            raise self.error(where, f"name = {shown!r}: expected an identifier of at most {MAX_NAME} characters "
+                             "(letters, digits and _, not starting with a digit; it names the instance and its folder)")
         if instance in self._claimed:
             raise self.error(where, f"name {instance!r} is used twice")
         self._claimed.add(instance)
@@ -487,8 +495,14 @@ class SystemBuilder:
         if not compatible_types(source_type, target_type):
             raise self.error(where, f"type mismatch: {source_port} is {source_type}, {target_port} is {target_type} "
                              "(a connection joins variables of the same type; Integer and Enumeration may meet)")
-        if source_unit is not None and target_unit is not None and base_units(source_unit) != base_units(target_unit):
-            raise self.error(where, f"unit mismatch: {source_port} is in {source_unit}, {target_port} in {target_unit}")
+        if source_unit is not None and target_unit is not None:
+            try:
+                same = base_units(source_unit) == base_units(target_unit)
+            except ValueError as problem:
+                raise self.error(where, str(problem)) from None
+            if not same:
+                raise self.error(where, f"unit mismatch: {source_port} is in {source_unit}, {target_port} in "
+                                 f"{target_unit}")
         if target_port in self._driven:
             raise self.error(where, f"input {target_port} is connected twice (also by {self._driven[target_port]})")
         self._driven[target_port] = label

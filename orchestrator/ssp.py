@@ -274,9 +274,15 @@ def validate_ssd(archive: Path) -> None:
     1.0 schema FMPy ships."""
     from fmpy.ssp.ssd import validate_tree
 
-    with zipfile.ZipFile(archive) as zf:
-        root = etree.fromstring(zf.read("SystemStructure.ssd"))
-        parameter_sets = [etree.fromstring(zf.read(n)) for n in zf.namelist() if n.endswith(".ssv")]
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    try:
+        with zipfile.ZipFile(archive) as zf:
+            root = etree.fromstring(zf.read("SystemStructure.ssd"), parser)
+            parameter_sets = [etree.fromstring(zf.read(n), parser) for n in zf.namelist() if n.endswith(".ssv")]
+    except KeyError:
+        raise SspError(f"{archive}: no SystemStructure.ssd at the top of the archive") from None
+    except etree.XMLSyntaxError as error:
+        raise SspError(f"{archive}: not well-formed XML ({error})") from None
     try:
         validate_tree(root, "SystemStructureDescription.xsd")
         for parameter_set in parameter_sets:

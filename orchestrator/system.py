@@ -109,6 +109,8 @@ def load_system(path: Path | str, *, fmu_dir: Path | None = None) -> System:
         raise SystemFileError(f"{path}: cannot be read as a system file ({type(error).__name__})") from None
     except tomllib.TOMLDecodeError as error:
         raise SystemFileError(f"{path}: not valid TOML: {error}") from None
+    except RecursionError:
+        raise SystemFileError(f"{path}: nested too deeply to be a system file") from None
     return system_from_dict(data, name=str(path), base=fmu_dir or path.parent, path=path)
 
 

@@ -377,6 +377,10 @@ def _run_system(args: argparse.Namespace, system, path: Path,  # noqa: ANN001 - 
     except ValueError as error:
         print(f"rover-cosim run: {error}", file=sys.stderr)
         return 2
+    problem = _unwritable(output)
+    if problem:  # said before the run, not after it
+        print(f"rover-cosim run: output {output}: {problem}", file=sys.stderr)
+        return 2
     bar = ProgressBar(path.stem, enabled=not args.quiet)
     partial = PartialWriter(system, output)
     try:
@@ -464,6 +468,10 @@ def _simulate(args: argparse.Namespace) -> int:
     from rover_cosim.progress import ProgressBar
 
     if not _output_folder(args.out, "simulate"):
+        return 2
+    if not args.fmu_dir.is_dir():
+        print(f"rover-cosim simulate: --fmu-dir {args.fmu_dir}: no such folder (build the FMUs with "
+              "`rover-cosim build-fmus`)", file=sys.stderr)
         return 2
     if not args.model.is_file():
         print(f"rover-cosim simulate: identified model {args.model} not found (make it with `rover-cosim identify`)",
@@ -617,7 +625,17 @@ def _report(args: argparse.Namespace) -> int:
         print(f"rover-cosim report: nothing to report in {args.results} (no results of fig3, identify or "
               "simulate; make them with `rover-cosim fig3`, `identify`, `simulate`)", file=sys.stderr)
         return 1
-    write_all({target: build_report(args.results).encode()})
+    problem = _unwritable(target)
+    if problem:
+        print(f"rover-cosim report: --out {target}: {problem}", file=sys.stderr)
+        return 2
+    try:
+        page = build_report(args.results)
+    except (KeyError, ValueError, OSError) as error:  # a results file not as its job writes it
+        print(f"rover-cosim report: {args.results}: a results file is not as its command writes it "
+              f"({type(error).__name__}: {error}); nothing written", file=sys.stderr)
+        return 1
+    write_all({target: page.encode()})
     print(f"wrote {target}")
     return 0
 
@@ -627,6 +645,23 @@ def _blocks(args: argparse.Namespace) -> int:
 
     print(describe_blocks())
     return 0
+
+
+def _unwritable(target: Path) -> str | None:
+    """Why ``target`` (a file to write) cannot be written, or None: a folder in its place, a file
+    where its folder should be, a folder we may not write."""
+    import os
+
+    if target.is_dir():
+        return "is a folder: expected a file name"
+    folder = target.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        return f"{folder} is a file, not a folder"
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return f"the folder {folder} cannot be written"
+    return None
 
 
 def _output_folder(out: Path, command: str) -> bool:
@@ -698,6 +733,10 @@ def _fig3(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"rover-cosim fig3: {error}", file=sys.stderr)
         return 2
+    except RuntimeError as error:  # the wheel model cannot find an equilibrium on this soil
+        print(f"rover-cosim fig3: {error} (the soil cannot carry the wheel here: look at its moduli and the "
+              "loads; nothing written)", file=sys.stderr)
+        return 1
     for path in written:
         print(f"wrote {path}")
     return 0

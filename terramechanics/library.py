@@ -85,7 +85,10 @@ def entry(kind: str, spec: str) -> tuple[str, dict[str, Any]]:
                              "a TOML file; or FILE:NAME)")
         raise ValueError(f"{kind} {spec!r}: expected one of {', '.join(library)}, a TOML file or FILE:NAME")
     tables = _tables(Path(path))
-    if any(isinstance(v, (int, float)) for v in tables.values()):
+    if not tables:
+        raise ValueError(f"{kind} {spec!r}: {path} is empty: expected the {kind}'s values (e.g. c = 800.0, "
+                         "phi_deg = 37.2) or tables of them")
+    if not any(isinstance(v, dict) and k != "notes" for k, v in tables.items()):
         return Path(path).stem, dict(tables)   # the file is one soil (or wheel)
     if name or len(tables) == 1:
         name = name or next(iter(tables))
