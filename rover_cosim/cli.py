@@ -138,6 +138,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--input", type=Path, default=None, metavar="CSV",
                      help="one FMU run alone: input signals, first column time [s], one column per input "
                      "(continuous Real inputs interpolated, the others held; a repeated time is a step)")
+    run.add_argument("--overwrite", action="store_true",
+                     help="replace --output even if it is not a result of rover-cosim run")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     _add_soil_options(run)
 
@@ -145,6 +147,8 @@ def build_parser() -> argparse.ArgumentParser:
                               "FMPy, libcosim and OMSimulator read")
     ssp.add_argument("system", help="system file, or the name of a shipped example: " + ", ".join(EXAMPLES))
     ssp.add_argument("-o", "--output", type=Path, required=True, help="the .ssp archive to write")
+    ssp.add_argument("--overwrite", action="store_true",
+                     help="replace --output even if it is not an archive this command wrote")
     ssp.add_argument("--fmu-dir", type=Path, default=None,
                      help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
 
@@ -209,6 +213,8 @@ def build_parser() -> argparse.ArgumentParser:
     report = commands.add_parser("report", help="results/report.html: figures and tables beside the paper's")
     report.add_argument("--results", type=Path, default=Path("results"), help="the results folder")
     report.add_argument("--out", type=Path, default=None, help="HTML file (default: <results>/report.html)")
+    report.add_argument("--overwrite", action="store_true",
+                        help="replace --out even if it is not a report this command wrote")
 
     build = commands.add_parser("build-fmus", help="build the FMI 2.0 FMUs (ME + CS) from modelica/ into fmus/")
     build.add_argument("models", nargs="*", help="models to build (default: SingleWheel Rover RoverBody Wheel "
@@ -324,6 +330,10 @@ def _export_ssp(args: argparse.Namespace) -> int:
     from rover_cosim.orchestrator.system import SystemFileError, load_system
 
     path, fmu_dir = _system_path(args)
+    problem = _unwritable(args.output) or (None if args.overwrite else _foreign(args.output, "export-ssp"))
+    if problem:
+        print(f"rover-cosim export-ssp: -o {args.output}: {problem}", file=sys.stderr)
+        return 2
     try:
         exported = export_ssp(load_system(path, fmu_dir=fmu_dir), args.output)
         validate_ssd(exported.path)
@@ -377,7 +387,7 @@ def _run_system(args: argparse.Namespace, system, path: Path,  # noqa: ANN001 - 
     except ValueError as error:
         print(f"rover-cosim run: {error}", file=sys.stderr)
         return 2
-    problem = _unwritable(output)
+    problem = _unwritable(output) or (None if args.overwrite else _foreign(output, "run"))
     if problem:  # said before the run, not after it
         print(f"rover-cosim run: output {output}: {problem}", file=sys.stderr)
         return 2
@@ -625,7 +635,7 @@ def _report(args: argparse.Namespace) -> int:
         print(f"rover-cosim report: nothing to report in {args.results} (no results of fig3, identify or "
               "simulate; make them with `rover-cosim fig3`, `identify`, `simulate`)", file=sys.stderr)
         return 1
-    problem = _unwritable(target)
+    problem = _unwritable(target) or (None if args.overwrite else _foreign(target, "report"))
     if problem:
         print(f"rover-cosim report: --out {target}: {problem}", file=sys.stderr)
         return 2
@@ -645,6 +655,31 @@ def _blocks(args: argparse.Namespace) -> int:
 
     print(describe_blocks())
     return 0
+
+
+def _foreign(target: Path, command: str) -> str | None:
+    """Why ``target`` may not be replaced by ``command``'s result without --overwrite (None: it is
+    absent, or a previous result of that command)."""
+    import json
+    import zipfile
+
+    if not target.exists() or target.is_dir():
+        return None
+    try:
+        if command == "run":
+            sidecar = target.with_suffix(".json")
+            if sidecar.is_file() and json.loads(sidecar.read_text()).get("command") == "rover-cosim run":
+                return None
+        elif command == "report":
+            if b"rover-cosim report" in target.read_bytes()[:4096]:
+                return None
+        elif command == "export-ssp":
+            with zipfile.ZipFile(target) as archive:
+                if b"org.rover-cosim" in archive.read("SystemStructure.ssd"):
+                    return None
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile):
+        pass
+    return (f"{target} exists and is not a result of rover-cosim {command}: pass --overwrite to replace it")
 
 
 def _unwritable(target: Path) -> str | None:

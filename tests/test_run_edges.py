@@ -192,3 +192,31 @@ def test_an_exported_archive_is_an_ordinary_result_file(fmu_dir, fmus, tmp_path)
                          tmp_path / "x.ssp").path
     assert os.stat(archive).st_mode & 0o777 == result_mode() == (tmp_path / "x.ssp").stat().st_mode & 0o777
     assert result_mode() & 0o044  # readable by others under the usual umask, as the CSV results are
+
+
+def test_outputs_do_not_replace_what_the_command_did_not_write(fmu_dir, fmus, tmp_path, capsys):
+    """report --out, run -o and export-ssp -o refuse a file that is not their own earlier result
+    (the report once overwrote an .fmu), unless --overwrite; their own results they replace."""
+    victim = tmp_path / "precious.fmu"
+    victim.write_bytes(fmus["Wheel"].read_bytes())
+    results = tmp_path / "results"
+    (results).mkdir()
+    (results / "fig3_fx_vs_slip.csv").write_text("load_N,slip,Fx_N\n100,0.0,1.0\n100,0.1,5.0\n")
+    assert main(["report", "--results", str(results), "--out", str(victim)]) == 2
+    assert "is not a result of rover-cosim report: pass --overwrite" in capsys.readouterr().err
+    assert victim.read_bytes() == fmus["Wheel"].read_bytes()
+    page = tmp_path / "page.html"
+    assert main(["report", "--results", str(results), "--out", str(page)]) == 0
+    assert main(["report", "--results", str(results), "--out", str(page)]) == 0   # its own: replaced
+    assert main(["report", "--results", str(results), "--out", str(victim), "--overwrite"]) == 0
+    notes = tmp_path / "notes.csv"
+    notes.write_text("mine\n")
+    run = ["run", "single_wheel_step", "--fmu-dir", str(fmu_dir), "--stop-time", "0.05", "-q"]
+    assert main([*run, "-o", str(notes)]) == 2 and notes.read_text() == "mine\n"
+    assert main([*run, "-o", str(tmp_path / "r.csv")]) == 0 and main([*run, "-o", str(tmp_path / "r.csv")]) == 0
+    capsys.readouterr()
+    export = ["export-ssp", "single_wheel_step", "--fmu-dir", str(fmu_dir), "-o"]
+    assert main([*export, str(notes.with_suffix(".ssp"))]) == 0
+    (tmp_path / "other.ssp").write_text("not mine")
+    assert main([*export, str(tmp_path / "other.ssp")]) == 2
+    assert (tmp_path / "other.ssp").read_text() == "not mine"
