@@ -93,7 +93,9 @@ class _Help(argparse.RawDescriptionHelpFormatter):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="rover-cosim", description=__doc__, formatter_class=_Help)
+    parser = argparse.ArgumentParser(prog="rover-cosim", description=__doc__, formatter_class=_Help,
+                                     epilog="exit codes: 0 done; 1 the work failed (a run, a study where every "
+                                     "run failed); 2 bad input (nothing computed); 130 interrupted")
     parser.add_argument("--version", action="version", version=f"rover-cosim {__version__}")
     parser.add_argument("--figures", type=_figure_formats, default=("png",), metavar="FORMATS",
                         help="formats every figure is written in, beside PNG: e.g. png,pdf,svg (default: png)")

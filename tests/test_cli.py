@@ -176,3 +176,7 @@ def test_pool_workers_leave_no_temporary_folders(tmp_path, monkeypatch):
     left = [p.name for p in tmp_path.iterdir() if p.name.startswith("rover-cosim-")
             and f"-{os.getpid()}-" not in p.name]
     assert not left, left
+
+
+def test_the_exit_codes_are_documented():
+    assert "exit codes: 0 done; 1 the work failed" in build_parser().format_help()
