@@ -180,3 +180,14 @@ def test_pool_workers_leave_no_temporary_folders(tmp_path, monkeypatch):
 
 def test_the_exit_codes_are_documented():
     assert "exit codes: 0 done; 1 the work failed" in build_parser().format_help()
+
+
+def test_a_scheduler_that_does_not_answer_is_named(monkeypatch):
+    import time
+
+    pytest.importorskip("distributed", reason="dask.distributed not installed")
+    from rover_cosim.common.parallel import parallel_map
+
+    monkeypatch.setenv("ROVER_COSIM_SCHEDULER_TIMEOUT", "2")
+    with pytest.raises(RuntimeError, match=r"Dask scheduler tcp://127.0.0.1:1: no Dask scheduler answered within 2 s"):
+        list(parallel_map(time.sleep, [(0,)], scheduler="tcp://127.0.0.1:1"))

@@ -20,6 +20,8 @@ from typing import Any, TypeVar
 from .scratch import remove_stale_folders
 
 Result = TypeVar("Result")
+#: s, how long a Dask scheduler may take to answer (ROVER_COSIM_SCHEDULER_TIMEOUT sets another).
+SCHEDULER_TIMEOUT = 30.0
 
 
 def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any, ...]], workers: int | None = None,
@@ -31,7 +33,14 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
         from dask.distributed import Client
         from dask.distributed import as_completed as dask_completed
 
-        with Client(scheduler) as client:
+        timeout = float(os.environ.get("ROVER_COSIM_SCHEDULER_TIMEOUT", SCHEDULER_TIMEOUT))
+        try:
+            client = Client(scheduler, timeout=timeout)
+        except Exception as error:  # noqa: BLE001 - no answer, a refusal, or something else answering there
+            raise RuntimeError(f"Dask scheduler {scheduler}: no Dask scheduler answered within {timeout:g} s "
+                               f"({type(error).__name__}: {str(error)[:200]}); is it running, and is the address "
+                               "right?") from None
+        with client:
             for future in dask_completed([client.submit(function, *a, pure=False) for a in arguments]):
                 yield future.result()
         return
