@@ -1,4 +1,5 @@
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -121,3 +122,34 @@ def test_figures_in_other_formats_and_at_a_chosen_resolution(tmp_path, capsys):
     assert Image.open(tmp_path / "b" / "fig3_fx_vs_slip.png").size[0] > 2 * small[0]  # 150 dpi against 60
     assert cli.main(["--dpi", "5", "fig3", "--out", str(tmp_path / "c")]) == 2
     assert "dpi 5.0: expected 20 to 1200" in capsys.readouterr().err
+
+
+def test_two_writers_of_the_same_files_leave_one_set_never_a_mix(tmp_path, monkeypatch):
+    """Two commands writing r.csv and r.json at once (a delay between the renames, where the mix
+    happened): the pair on disk is always one writer's (the renames are under the folder's lock)."""
+    import os
+    import threading
+    import time
+
+    from rover_cosim.common import outputs
+
+    real_replace = os.replace
+
+    def slow_replace(source, target):  # noqa: ANN001 - os.replace's arguments
+        slow = Path(target).suffix == ".csv" and Path(source).read_bytes().startswith(b"A")
+        real_replace(source, target)
+        if slow:  # writer A waits between its two renames: B's pair lands in between
+            time.sleep(0.02)
+
+    monkeypatch.setattr(outputs.os, "replace", slow_replace)
+    csv, record = tmp_path / "r.csv", tmp_path / "r.json"
+    for round_ in range(20):
+        writers = [threading.Thread(target=write_all, args=({csv: f"{t}{round_}".encode(),
+                                                              record: f"{t}{round_}".encode()},))
+                   for t in "AB"]
+        writers[0].start()
+        time.sleep(0.005)
+        writers[1].start()
+        for writer in writers:
+            writer.join()
+        assert csv.read_bytes() == record.read_bytes(), round_

@@ -9,7 +9,8 @@ import platform
 import subprocess
 import sys
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import ExitStack, contextmanager
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
@@ -25,7 +26,9 @@ def write_all(files: Mapping[Path, bytes]) -> None:
 
     Each payload goes to a temporary file beside its target first; only when all temporaries
     are complete are they renamed into place (a rename within a directory is atomic), so a
-    failure leaves no half-written result and no stray temporary.
+    failure leaves no half-written result and no stray temporary. The renames happen under a lock
+    of each target folder (a lock file in the temporary folder, named by the folder's digest), so
+    two commands writing the same files at once leave one's set or the other's, never a mix.
     """
     staged: list[tuple[Path, Path]] = []
     files = _with_other_renderings(files)
@@ -37,11 +40,27 @@ def write_all(files: Mapping[Path, bytes]) -> None:
             with os.fdopen(handle, "wb") as stream:
                 stream.write(payload)
             os.chmod(name, result_mode())  # mkstemp makes 0600; results are ordinary files
-        for temporary, target in staged:
-            os.replace(temporary, target)
+        with _folder_locks(sorted({target.parent for _, target in staged})):
+            for temporary, target in staged:
+                os.replace(temporary, target)
     finally:
         for temporary, _ in staged:
             temporary.unlink(missing_ok=True)
+
+
+@contextmanager
+def _folder_locks(folders: list[Path]) -> Iterator[None]:
+    """Exclusive locks (flock) on ``folders`` (taken in order, so two writers cannot deadlock)."""
+    import fcntl
+
+    with ExitStack() as stack:
+        for folder in folders:
+            name = hashlib.sha256(str(folder.resolve()).encode()).hexdigest()[:24]
+            lock = Path(tempfile.gettempdir()) / f"rover-cosim-lock-{name}"
+            handle = stack.enter_context(open(lock, "a"))  # noqa: SIM115 - held open while locked
+            fcntl.flock(handle, fcntl.LOCK_EX)
+            stack.callback(fcntl.flock, handle, fcntl.LOCK_UN)
+        yield
 
 
 def result_mode() -> int:
