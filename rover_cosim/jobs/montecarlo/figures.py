@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from rover_cosim.identification.figures import finish, png_bytes
 
@@ -99,8 +99,10 @@ def scatter(runs: pd.DataFrame, parameters: list[str], labels: dict[str, str], n
         if name in logarithmic:
             ax.set_xscale("log")
             values = runs[name].to_numpy(float)
-            if np.nanmax(values) >= 10 * np.nanmin(values):   # decades labelled: the minor labels would overlap
-                ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.xaxis.set_minor_formatter(NullFormatter())  # the minor labels of a log axis overlap
+            if np.nanmax(values) < 10 * np.nanmin(values):  # less than a decade: 1-2-5 steps, labelled, few
+                ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0), numticks=6))
+                ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:.2g}"))
         if spread:
             ax.set_yscale("log")
         ax.set_xlabel(labels.get(name, name))
