@@ -358,6 +358,7 @@ class SystemBuilder:
         variables = fmu.variables()
         checked: dict[str, Value] = {}
         for variable, value in values.items():
+            variable, value = self._degrees(variable, value, variables, f"{where} {key}")
             if variable not in variables:
                 raise self.error(f"{where} {key}", f"{fmu.name} has no variable {variable!r}")
             v = variables[variable]
@@ -385,6 +386,16 @@ class SystemBuilder:
         if variable.type in ("Binary", "Clock"):
             raise self.error(where, f"{fmu.name}.{variable.name} is a {variable.type}: FMI 3.0 Binary and Clock "
                              "variables are not supported")
+
+    def _degrees(self, variable: str, value: Any, variables: Mapping[str, Any], where: str) -> tuple[str, Any]:
+        """``NAME_deg`` of an angle variable NAME in rad, as --set takes it (soil.phi_deg = 35):
+        (NAME, the value in rad); any other (variable, value) as it is."""
+        base = variable[:-4] if variable.endswith("_deg") else None
+        if variable in variables or base not in variables or variables[base].unit != "rad":
+            return variable, value
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.error(f"{where} {variable}", f"{value!r}: expected a number of degrees")
+        return base, math.radians(value)
 
     def set_parameters(self, instance: str, values: Mapping[str, Any], *, where: str | None = None,
                        only_known: bool = False) -> SystemBuilder:

@@ -259,3 +259,14 @@ def test_the_readme_example_builds_and_runs_the_co_simulated_rover(fmus, monkeyp
     assert result.stopped.startswith("body.x = ") and result.data["body.v"].iloc[-1] > 0
     assert result.data["body.x"].iloc[-2] < 1.0 <= result.data["body.x"].iloc[-1]
     assert "wheel1.slip" in capsys.readouterr().out
+
+
+def test_an_angle_may_be_given_in_degrees_as_set_takes_it(fmu_dir, fmus):
+    import math
+
+    system = (SystemBuilder("deg").simulation(stop_time=0.1, step=0.01)
+              .add_fmu("w", fmu_dir / "SingleWheel.fmu", parameters={"soil.phi_deg": 35.0},
+                       start={"tau": 10.0, "W": 400.0}).build())
+    assert system.fmus[0].parameters["soil.phi"] == math.radians(35.0)
+    with pytest.raises(SystemFileError, match="expected a number of degrees"):
+        SystemBuilder("bad").add_fmu("w", fmu_dir / "SingleWheel.fmu", parameters={"soil.phi_deg": "35"})
