@@ -390,7 +390,7 @@ class SystemBuilder:
     def _degrees(self, variable: str, value: Any, variables: Mapping[str, Any], where: str) -> tuple[str, Any]:
         """``NAME_deg`` of an angle variable NAME in rad, as --set takes it (soil.phi_deg = 35):
         (NAME, the value in rad); any other (variable, value) as it is."""
-        base = variable[:-4] if variable.endswith("_deg") else None
+        base = variable[:-4] if variable.endswith("_deg") else ""
         if variable in variables or base not in variables or variables[base].unit != "rad":
             return variable, value
         if isinstance(value, bool) or not isinstance(value, (int, float)):
