@@ -50,14 +50,22 @@ def write_all(files: Mapping[Path, bytes]) -> None:
 
 @contextmanager
 def _folder_locks(folders: list[Path]) -> Iterator[None]:
-    """Exclusive locks (flock) on ``folders`` (taken in order, so two writers cannot deadlock)."""
-    import fcntl
-
+    """Exclusive locks (flock) on ``folders`` (taken in order, so two writers cannot deadlock);
+    where there is no flock (Windows) or the lock file cannot be opened (another user's), the
+    renames go on without it."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX
+        yield
+        return
     with ExitStack() as stack:
         for folder in folders:
             name = hashlib.sha256(str(folder.resolve()).encode()).hexdigest()[:24]
             lock = Path(tempfile.gettempdir()) / f"rover-cosim-lock-{name}"
-            handle = stack.enter_context(open(lock, "a"))  # noqa: SIM115 - held open while locked
+            try:
+                handle = stack.enter_context(open(lock, "a"))  # noqa: SIM115 - held open while locked
+            except OSError:
+                continue
             fcntl.flock(handle, fcntl.LOCK_EX)
             stack.callback(fcntl.flock, handle, fcntl.LOCK_UN)
         yield
