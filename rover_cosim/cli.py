@@ -8,6 +8,7 @@ import sys
 import tempfile
 import threading
 from collections.abc import Sequence
+from contextlib import nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -805,8 +806,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
+    from rover_cosim.common.outputs import Busy, writing
+
+    target = getattr(args, "out", None) or getattr(args, "output", None)
     try:
-        return COMMANDS[args.command](args)
+        with writing(target, f"rover-cosim {args.command}") if target is not None else nullcontext():
+            return COMMANDS[args.command](args)
+    except Busy as busy:
+        print(f"rover-cosim {args.command}: {busy}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(f"rover-cosim {args.command}: interrupted; nothing more written", file=sys.stderr)
         return 130

@@ -153,3 +153,17 @@ def test_two_writers_of_the_same_files_leave_one_set_never_a_mix(tmp_path, monke
         for writer in writers:
             writer.join()
         assert csv.read_bytes() == record.read_bytes(), round_
+
+
+def test_a_second_command_on_the_same_results_is_refused_naming_the_first(tmp_path, capsys):
+    import os
+
+    from rover_cosim.common.outputs import writing
+
+    out = tmp_path / "results"
+    with writing(out, "rover-cosim identify"):
+        assert cli.main(["fig3", "--out", str(out), "--loads", "300", "--slip-step", "0.3"]) == 2
+        err = capsys.readouterr().err
+        assert f"is being written by PID {os.getpid()} (rover-cosim identify)" in err
+        assert not out.exists()
+    assert cli.main(["fig3", "--out", str(out), "--loads", "300", "--slip-step", "0.3"]) == 0  # free again

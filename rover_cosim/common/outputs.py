@@ -150,3 +150,43 @@ def summary_repr(kind: str, files: Sequence[Path] | None = None, **facts: object
         parts.append(f"{len(files)} files in {', '.join(folders)}")
     parts += [f"{key}={value}" for key, value in facts.items()]
     return f"{kind}({'; '.join(parts)})"
+
+
+class Busy(RuntimeError):
+    """Another command is writing the same results; the message names it and its PID."""
+
+
+@contextmanager
+def writing(target: Path, command: str) -> Iterator[None]:
+    """Hold ``target`` (a results folder or file) for ``command`` while it computes and writes:
+    a second command on the same target is refused (Busy, naming the first and its PID) instead
+    of the two mixing their files. Best effort where there is no flock (Windows)."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    name = hashlib.sha256(str(Path(target).resolve()).encode()).hexdigest()[:24]
+    lock = Path(tempfile.gettempdir()) / f"rover-cosim-busy-{name}"
+    try:
+        handle = open(lock, "a+")  # noqa: SIM115 - held for the whole command
+    except OSError:
+        yield
+        return
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            holder = handle.read().strip() or "another process"
+            raise Busy(f"{target} is being written by {holder}; wait for it to end, or write elsewhere") from None
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"PID {os.getpid()} ({command})")
+        handle.flush()
+        try:
+            yield
+        finally:
+            handle.seek(0)
+            handle.truncate()
+            fcntl.flock(handle, fcntl.LOCK_UN)
