@@ -106,14 +106,8 @@ class Exchange:
         turns its failure into the participant's error)."""
         for kind, (references, positions, buffer) in self.groups.items():
             chosen = values[positions].tolist()
-            if kind == "String":
-                buffer[:] = [self.strings.text(v).encode() for v in chosen]
-            elif kind in ("Real", "Float64", "Float32"):
-                buffer[:] = chosen
-            elif kind == "Boolean":
-                buffer[:] = [(v != 0.0) if self.version == 3 else int(v != 0.0) for v in chosen]
-            else:
-                buffer[:] = [int(round(v)) for v in chosen]
+            buffer[:] = c_values(self.version, kind, [self.strings.text(v) for v in chosen] if kind == "String"
+                                 else chosen)
             call(f"fmi{self.version}Set{kind}", partial(raw_call(fmu, self.version, "Set", kind), references,
                                                          len(references), buffer))
 
@@ -137,13 +131,18 @@ def set_by_name(fmu: Any, version: int, values: dict[str, Any], types: dict[str,
         groups.setdefault(call_kind(version, types[name]), []).append((refs[name], value))
     for kind, pairs in groups.items():
         references = (ctypes.c_uint * len(pairs))(*[r for r, _ in pairs])
-        if kind == "String":
-            converted: list[Any] = [str(v).encode() for _, v in pairs]
-        elif kind in ("Real", "Float64", "Float32"):
-            converted = [float(v) for _, v in pairs]
-        elif kind == "Boolean":
-            converted = [bool(v) if version == 3 else int(bool(v)) for _, v in pairs]
-        else:
-            converted = [int(v) for _, v in pairs]
-        buffer = (c_type(version, kind) * len(pairs))(*converted)
+        buffer = (c_type(version, kind) * len(pairs))(*c_values(version, kind, [v for _, v in pairs]))
         call(f"fmi{version}Set{kind}", partial(raw_call(fmu, version, "Set", kind), references, len(pairs), buffer))
+
+
+def c_values(version: int, kind: str, values: list[Any]) -> list[Any]:
+    """Python values as the C type of the function family ``kind`` takes them: text as bytes,
+    floats for Real/Float, Booleans as int (FMI 2.0) or bool (FMI 3.0; a value vector's 1.0/0.0
+    too), whole numbers as int (rounded from the value vector's floats, exact for Python ints)."""
+    if kind == "String":
+        return [str(v).encode() for v in values]
+    if kind in ("Real", "Float64", "Float32"):
+        return [float(v) for v in values]
+    if kind == "Boolean":
+        return [bool(v) if version == 3 else int(bool(v)) for v in values]
+    return [v if isinstance(v, int) else int(round(v)) for v in values]

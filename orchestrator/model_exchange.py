@@ -84,7 +84,6 @@ class ModelExchangeParticipant(FmuParticipant):
         self.solver: _Solver | None = None
         self.next_event = math.inf   # s, the next time event the FMU announced
         self._discrete = np.zeros(0, dtype=bool)
-        self._started = False
         #: Whether CVode may go on from where it stopped (nothing changed since: no restart needed).
         self._fresh = False
         self._step_start = 0.0  # s, where the step under way began (an end inside it is reported from there)
@@ -143,7 +142,6 @@ class ModelExchangeParticipant(FmuParticipant):
         self._event_iteration(t0)
         self._mode("continuous", t0)
         self._make_solver(t0)
-        self._started = True
         self._fresh = True
         return self.get_outputs(t0)
 
@@ -236,7 +234,7 @@ class ModelExchangeParticipant(FmuParticipant):
     def reset(self) -> None:
         """Back to the state after instantiation; the integrator is made anew at the next start."""
         super().reset()
-        self.solver, self._started, self.next_event, self._fresh = None, False, math.inf, False
+        self.solver, self.next_event, self._fresh = None, math.inf, False
 
 
 def make_fmu_participant(entry: FmuEntry, unzip_root: Path, strings: StringTable,

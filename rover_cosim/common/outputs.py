@@ -48,6 +48,13 @@ def write_all(files: Mapping[Path, bytes]) -> None:
             temporary.unlink(missing_ok=True)
 
 
+def _lock_file(target: Path, kind: str) -> Path:
+    """The lock file of ``target`` (kind: lock, for the renames; busy, for a whole command), in the
+    temporary folder, named by the digest of the target's path."""
+    name = hashlib.sha256(str(target.resolve()).encode()).hexdigest()[:24]
+    return Path(tempfile.gettempdir()) / f"rover-cosim-{kind}-{name}"
+
+
 @contextmanager
 def _folder_locks(folders: list[Path]) -> Iterator[None]:
     """Exclusive locks (flock) on ``folders`` (taken in order, so two writers cannot deadlock);
@@ -60,10 +67,8 @@ def _folder_locks(folders: list[Path]) -> Iterator[None]:
         return
     with ExitStack() as stack:
         for folder in folders:
-            name = hashlib.sha256(str(folder.resolve()).encode()).hexdigest()[:24]
-            lock = Path(tempfile.gettempdir()) / f"rover-cosim-lock-{name}"
             try:
-                handle = stack.enter_context(open(lock, "a"))  # noqa: SIM115 - held open while locked
+                handle = stack.enter_context(open(_lock_file(folder, "lock"), "a"))  # noqa: SIM115 - held open while locked
             except OSError:
                 continue
             fcntl.flock(handle, fcntl.LOCK_EX)
@@ -166,10 +171,8 @@ def writing(target: Path, command: str) -> Iterator[None]:
     except ImportError:
         yield
         return
-    name = hashlib.sha256(str(Path(target).resolve()).encode()).hexdigest()[:24]
-    lock = Path(tempfile.gettempdir()) / f"rover-cosim-busy-{name}"
     try:
-        handle = open(lock, "a+")  # noqa: SIM115 - held for the whole command
+        handle = open(_lock_file(Path(target), "busy"), "a+")  # noqa: SIM115 - held for the whole command
     except OSError:
         yield
         return
