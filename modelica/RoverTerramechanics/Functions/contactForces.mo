@@ -36,12 +36,14 @@ protected
   Real depth(unit="m") "Depth of the soil piled against the side at theta";
   Real d1(unit="1") "Hegedus D1";
   Real d2(unit="1") "Hegedus D2";
+  Real xc(unit="rad") "Destructive angle: soil.xc, or 45 deg - phi/2 where soil.xc is 0";
 algorithm
   kx := soil.kx + soil.kxBeta*noEvent(abs(slipAngle));
   ky := soil.ky + soil.kyBeta*noEvent(abs(slipAngle));
   tanBeta := tan(slipAngle);
-  d1 := 1/tan(soil.xc) + tan(soil.xc + soil.phi);
-  d2 := 1/tan(soil.xc) + tan(soil.phi)/tan(soil.xc)^2;
+  xc := if soil.xc > 0 then soil.xc else 0.7853981633974483 - soil.phi/2;
+  d1 := 1/tan(xc) + tan(xc + soil.phi);
+  d2 := 1/tan(xc) + tan(soil.phi)/tan(xc)^2;
   sumFy := 0;
   sumPile := 0;
   depth := 0;
