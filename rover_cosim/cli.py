@@ -168,6 +168,9 @@ def build_parser() -> argparse.ArgumentParser:
     ident.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
     ident.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
     ident.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    ident.add_argument("--record-interval", type=float, default=0.001,
+                       help="rows kept in runs.csv [s] (a whole number of the sweep's 0.1 ms samples; default "
+                       "0.001; 0.0001: every sample); the fits use every sample")
     _add_soil_options(ident)
     ident.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
@@ -455,7 +458,8 @@ def _identify(args: argparse.Namespace) -> int:
     bar = ProgressBar("sweep", enabled=not args.quiet)
     try:
         outcome = run_identification(args.fmu, args.out, workers=args.workers, scheduler=args.scheduler,
-                                     cache_dir=args.cache, progress=bar, choice=choice)
+                                     cache_dir=args.cache, progress=bar, choice=choice,
+                                     record_interval=args.record_interval)
     except (OSError, RuntimeError, ValueError) as error:
         bar.close()
         print(f"rover-cosim identify: {error} (nothing written)", file=sys.stderr)
