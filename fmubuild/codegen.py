@@ -86,7 +86,11 @@ def _functions(model: OdeModel) -> list[ca.Function]:
     du = ca.MX.sym("du", u.numel())
     knowns = ca.vertcat(x, u)
     seeds = ca.vertcat(dx, du)
-    sensitivity = ca.jtimes(ca.vertcat(model.xdot, model.y), knowns, seeds) if knowns.numel() else ca.MX(
+    # Derivatives from the graphs with the implicit solves' derivatives (fmubuild.implicit): the
+    # same values as model_evaluate's, the derivative of the solution rather than of its iterations.
+    xdot_d = model.xdot if model.xdot_derivative is None else model.xdot_derivative
+    y_d = model.y if model.y_derivative is None else model.y_derivative
+    sensitivity = ca.jtimes(ca.vertcat(xdot_d, y_d), knowns, seeds) if knowns.numel() else ca.MX(
         model.xdot.numel() + model.y.numel(), 1)
     nx = x.numel()
     return [
@@ -100,7 +104,7 @@ def _functions(model: OdeModel) -> list[ca.Function]:
                     ["t", "x", "u", "p", "m"], ["xdot", "y", "holds", "values"]),
         ca.Function("model_initial", [p], [model.x0], ["p"], ["x0"]),
         ca.Function("model_ode_jacobian", [t, x, u, p, m],
-                    [ca.densify(ca.jacobian(model.xdot, x)), ca.densify(ca.jacobian(model.xdot, t))],
+                    [ca.densify(ca.jacobian(xdot_d, x)), ca.densify(ca.jacobian(xdot_d, t))],
                     ["t", "x", "u", "p", "m"], ["dfdx", "dfdt"]),
         ca.Function("model_directional", [t, x, u, p, m, dx, du],
                     [ca.densify(sensitivity[:nx]), ca.densify(sensitivity[nx:])],
@@ -244,6 +248,7 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path) -
     x_start = model_layout.state_starts
     calculated = [1 if v.initial == "calculated" else 0 for v in states]
     memory_source = [model.observed.index(source) for source in model.memory_sources]
+    y_is_output = [1 if v.causality == "output" else 0 for v in by_kind.get("observed", [])]
     names = ",\n    ".join(_c_string(v.name) for v in model_layout.variables)
     asserts = model.asserts
     value_start = [0]
@@ -266,6 +271,7 @@ static const double X_START[] = {_c_doubles(x_start)};
 static const int X_START_CALCULATED[] = {{{", ".join(map(str, calculated)) or "0"}}};
 static const double M_DEFAULT[] = {_c_doubles(model.memory_defaults)};
 static const int M_SOURCE[] = {{{", ".join(map(str, memory_source)) or "0"}}};
+static const int Y_IS_OUTPUT[] = {{{", ".join(map(str, y_is_output)) or "0"}}};
 static const char *const REAL_NAMES[] = {{
     {names}
 }};
@@ -275,7 +281,7 @@ const ModelInfo model_info = {{
     {model_layout.n_states}, {model_layout.n_inputs}, {model_layout.n_parameters}, {model_layout.n_observed},
     P_DEFAULT, U_DEFAULT, X_START, X_START_CALCULATED, REAL_NAMES,
     {len(asserts)}, ASSERT_MESSAGES, ASSERT_IS_ERROR, ASSERT_VALUE_START, ASSERT_VALUE_NAMES,
-    {len(model.memories)}, M_DEFAULT, M_SOURCE
+    {len(model.memories)}, M_DEFAULT, M_SOURCE, Y_IS_OUTPUT
 }};
 """
     (directory / "model_data.c").write_text(data)

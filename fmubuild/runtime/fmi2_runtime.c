@@ -850,8 +850,10 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component component, const fmi2Value
     if (seed(c, vKnown_ref, nKnown, dvKnown) != fmi2OK) return fmi2Error;
     for (size_t k = 0; k < nUnknown; k++) {
         int r = real_index(vUnknown_ref[k]);
-        if (!(r >= off_x() && r < vr_rtol()))
-            return fail(c, F, REJECTED, "unknown %u (%s): expected a derivative, an output or a local variable",
+        int allowed = (r >= off_x() && r < off_u()) ||  /* a state or a derivative */
+                      (r >= off_y() && r < off_m() && model_info.y_is_output[r - off_y()]);
+        if (!allowed)
+            return fail(c, F, REJECTED, "unknown %u (%s): expected a state, a derivative or an output",
                         vUnknown_ref[k], real_name(vUnknown_ref[k]));
     }
     if (c->mode == MODE_INITIALIZATION && initial_states(c, F) != fmi2OK) return fmi2Error;
@@ -866,7 +868,6 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component component, const fmi2Value
         int r = real_index(vUnknown_ref[k]);
         if (r < off_dx()) dvUnknown[k] = c->seed_x[r - off_x()];
         else if (r < off_u()) dvUnknown[k] = c->sens_x[r - off_dx()];
-        else if (r < off_y()) dvUnknown[k] = c->seed_u[r - off_u()];
         else dvUnknown[k] = c->sens_y[r - off_y()];
     }
     return fmi2OK;

@@ -30,6 +30,7 @@ typedef struct {
     int nm;                           /* memories: values the runtime keeps from the previous step */
     const double *m_default;          /* [nm] their value before the first step */
     const int *m_source;              /* [nm] index into y of the variable each one remembers */
+    const int *y_is_output;           /* [ny] 1: an output (causality output), 0: a local variable */
 } ModelInfo;
 
 extern const ModelInfo model_info;
