@@ -177,7 +177,7 @@ def test_directional_derivatives_along_a_trajectory(fmus, tmp_path, name):
             checked += 1
             if not error <= TOLERANCE:
                 failures.append(f"ME t={t + STEP:.3f} {where} (column error {error:.2e})")
-    assert checked >= 5 * len(cs.inputs)
+    assert checked >= (STEPS // 100) * (2 * len(cs.inputs) + len(me.states))
     assert not failures, "\n".join(failures[:20])
     for instance in (cs, me):
         instance.fmu.terminate()
@@ -199,3 +199,5 @@ def test_directional_derivatives_refuse_unknowns_that_are_no_output_state_or_der
             instance.fmu.getDirectionalDerivative([instance.refs[unknown]], [instance.refs["tau"]], [1.0])
     fine = instance.fmu.getDirectionalDerivative([instance.refs["Fx"]], [instance.refs["tau"]], [1.0])
     assert math.isfinite(fine[0])
+    instance.fmu.terminate()
+    instance.fmu.freeInstance()
