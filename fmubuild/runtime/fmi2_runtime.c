@@ -86,7 +86,8 @@ static const struct {
     [F_GetEventIndicators] = {"fmi2GetEventIndicators", NOT_ERROR},
     [F_GetContinuousStates] = {"fmi2GetContinuousStates", NOT_ERROR},
     [F_GetNominalsOfContinuousStates] = {"fmi2GetNominalsOfContinuousStates", NOT_ERROR},
-    [F_SetRealInputDerivatives] = {"fmi2SetRealInputDerivatives", ANY_MODE},
+    [F_SetRealInputDerivatives] = {"fmi2SetRealInputDerivatives",
+                                   S(MODE_INSTANTIATED) | S(MODE_INITIALIZATION) | S(MODE_STEP)},
     [F_GetRealOutputDerivatives] = {"fmi2GetRealOutputDerivatives", ANY_MODE},
     [F_DoStep] = {"fmi2DoStep", S(MODE_STEP)},
     [F_CancelStep] = {"fmi2CancelStep", ANY_MODE},
@@ -97,16 +98,20 @@ static const struct {
     [F_GetStringStatus] = {"fmi2GetStringStatus", ANY_MODE},
 };
 
-#define FMU_STATE_MAGIC 0x524f5645u /* "ROVE": layout 3, with a checksum and the memories */
+#define FMU_STATE_MAGIC 0x524f5646u /* layout 4: the interface kind, input derivatives and statistics */
 
 /* What fmi2Get/SetFMUstate save and restore. */
 typedef struct {
     unsigned magic, nx, nu, np, nm;
+    int type;           /* fmi2ModelExchange or fmi2CoSimulation: a state is restored into its own kind only */
     int mode;
     int f0_valid, jac_valid, jac_current, jac_age;  /* integrator memory, so a restored run repeats exactly */
-    double t, rtol, max_step, h;
+    int interpolating;  /* input derivatives set for the next step (u_der follows the inputs) */
+    double t, rtol, max_step, h, t_step;
+    long steps, rejected, jacobians, rhs_calls;    /* the statistics */
+    unsigned long long evaluations, reused;
     uint64_t checksum;  /* FNV-1a of the header (this field zero) and the doubles that follow */
-    /* followed by x[nx], u[nu], p[np], x_set[nx], F0[nx], J[nx*nx], m[nm] (doubles) */
+    /* followed by x[nx], u[nu], u_der[nu], p[np], x_set[nx], F0[nx], J[nx*nx], m[nm] (doubles) */
 } StateHeader;
 
 /* The last evaluation of the model (model_evaluate) and the exact point (t, x, u) and memories m
@@ -122,7 +127,7 @@ typedef struct {
     fmi2CallbackFunctions cb;
     char *name;
     fmi2Type type;
-    int logging;
+    unsigned log_mask;  /* bit k: LOG_CATEGORIES[k] is logged (errors always are) */
     Mode mode;
     double t, t_stop;
     int has_stop;
@@ -172,6 +177,18 @@ static const char *real_name(fmi2ValueReference vr) {
 }
 
 /* ---- logging and the one error path -------------------------------------------------------- */
+/* The log categories of the model description (fmubuild.description), in this order. */
+static const char *const LOG_CATEGORIES[] = {"logStatusError", "logStatusWarning", "logStatistics"};
+#define N_LOG_CATEGORIES 3
+#define ALL_CATEGORIES ((1u << N_LOG_CATEGORIES) - 1u)
+#define DEFAULT_CATEGORIES 3u /* without debug logging: errors and warnings */
+
+static int log_category(const char *name) {
+    for (int k = 0; k < N_LOG_CATEGORIES; k++)
+        if (name && strcmp(name, LOG_CATEGORIES[k]) == 0) return k;
+    return -1;
+}
+
 static void log_text(const fmi2CallbackFunctions *cb, fmi2String name, fmi2Status status, const char *category,
                      const char *text) {
     if (!cb || !cb->logger) return;
@@ -188,7 +205,8 @@ static void log_text(const fmi2CallbackFunctions *cb, fmi2String name, fmi2Statu
 }
 
 static void log_message(Instance *c, fmi2Status status, const char *category, const char *format, ...) {
-    if (!c || (status == fmi2OK && !c->logging)) return;
+    int k = log_category(category);
+    if (!c || (status != fmi2Error && (k < 0 || !(c->log_mask & (1u << k))))) return;
     char buffer[1024];
     va_list args;
     va_start(args, format);
@@ -395,6 +413,9 @@ static void set_defaults(Instance *c) {
     c->mode = MODE_INSTANTIATED;
     c->solver.h = 0.0;
     c->solver.jac_valid = 0;
+    c->solver.steps = c->solver.rejected = c->solver.jacobians = c->solver.rhs_calls = 0;
+    c->eval.evaluations = c->eval.reused = 0;
+    c->t_step = 0.0;
     forget_evaluation(c);
     invalidate(c);
 }
@@ -407,7 +428,16 @@ fmi2Status fmi2SetDebugLogging(fmi2Component component, fmi2Boolean loggingOn, s
                                const fmi2String categories[]) {
     ENTER(F_SetDebugLogging);
     NOT_NULL(F_SetDebugLogging, categories, nCategories);
-    c->logging = loggingOn;
+    unsigned listed = 0;
+    for (size_t i = 0; i < nCategories; i++) {
+        int k = log_category(categories[i]);
+        if (k < 0)
+            return fail(c, F_SetDebugLogging, REJECTED, "log category %.100s: expected one of logStatusError, "
+                        "logStatusWarning, logStatistics", categories[i] ? categories[i] : "(null)");
+        listed |= 1u << k;
+    }
+    if (nCategories == 0) c->log_mask = loggingOn ? ALL_CATEGORIES : 1u; /* errors are always logged */
+    else c->log_mask = loggingOn ? (listed | 1u) : ((c->log_mask & ~listed) | 1u);
     return fmi2OK;
 }
 
@@ -497,7 +527,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     if (!c) return NULL;
     c->cb = *functions;
     c->type = fmuType;
-    c->logging = loggingOn;
+    c->log_mask = loggingOn ? ALL_CATEGORIES : DEFAULT_CATEGORIES;
     c->name = functions->allocateMemory(strlen(instanceName) + 1, 1);
     if (c->name) memcpy(c->name, instanceName, strlen(instanceName) + 1);
     if (!c->name || !allocate_work(c, functions)) {
@@ -673,8 +703,8 @@ NO_VARIABLES_OF_TYPE(fmi2SetString, F_SetString, "String", const fmi2String)
  * fmi2SerializeFMUstate hands out: a StateHeader and the doubles after it. */
 static size_t state_size(void) {
     return sizeof(StateHeader) +
-           sizeof(double) * (size_t)(3 * model_info.nx + model_info.nu + model_info.np + model_info.nx * model_info.nx +
-                                     model_info.nm);
+           sizeof(double) * (size_t)(3 * model_info.nx + 2 * model_info.nu + model_info.np +
+                                     model_info.nx * model_info.nx + model_info.nm);
 }
 
 static uint64_t fnv1a(uint64_t hash, const unsigned char *bytes, size_t n) {
@@ -696,7 +726,13 @@ static void state_write(const Instance *c, unsigned char *payload) {
     head.magic = FMU_STATE_MAGIC;
     head.nx = (unsigned)model_info.nx; head.nu = (unsigned)model_info.nu; head.np = (unsigned)model_info.np;
     head.nm = (unsigned)model_info.nm;
+    head.type = (int)c->type;
     head.mode = (int)c->mode;
+    head.interpolating = c->interpolating;
+    head.t_step = c->t_step;
+    head.steps = c->solver.steps; head.rejected = c->solver.rejected;
+    head.jacobians = c->solver.jacobians; head.rhs_calls = c->solver.rhs_calls;
+    head.evaluations = c->eval.evaluations; head.reused = c->eval.reused;
     head.f0_valid = c->solver.f0_valid; head.jac_valid = c->solver.jac_valid;
     head.jac_current = c->solver.jac_current; head.jac_age = c->solver.jac_age;
     head.t = c->t; head.rtol = c->rtol; head.max_step = c->max_step; head.h = c->solver.h;
@@ -704,6 +740,7 @@ static void state_write(const Instance *c, unsigned char *payload) {
     double *v = (double *)(payload + sizeof head);
     memcpy(v, c->x, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->u, sizeof(double) * model_info.nu); v += model_info.nu;
+    memcpy(v, c->u_der, sizeof(double) * model_info.nu); v += model_info.nu;
     memcpy(v, c->p, sizeof(double) * model_info.np); v += model_info.np;
     memcpy(v, c->x_set, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->solver.F0, sizeof(double) * model_info.nx); v += model_info.nx;
@@ -713,8 +750,9 @@ static void state_write(const Instance *c, unsigned char *payload) {
     memcpy(payload, &head, sizeof head);
 }
 
-/* Why ``payload`` of ``size`` bytes is not a state of this model, or NULL if it is one. */
-static const char *state_refusal(const unsigned char *payload, size_t size) {
+/* Why ``payload`` of ``size`` bytes is not a state of this model (for an instance of kind
+ * ``type``), or NULL if it is one. */
+static const char *state_refusal(const unsigned char *payload, size_t size, fmi2Type type) {
     StateHeader head;
     if (size != state_size()) return "its size does not match this model's FMU state";
     memcpy(&head, payload, sizeof head);
@@ -722,8 +760,12 @@ static const char *state_refusal(const unsigned char *payload, size_t size) {
         head.np != (unsigned)model_info.np || head.nm != (unsigned)model_info.nm)
         return "it was not saved by this model";
     if (head.checksum != state_checksum(payload, size)) return "its checksum does not match (corrupted)";
+    if (head.type != (int)type)
+        return head.type == fmi2ModelExchange ? "it was saved by a Model Exchange instance, this one is Co-Simulation"
+                                              : "it was saved by a Co-Simulation instance, this one is Model Exchange";
     if (head.mode < 0 || head.mode >= MODE_COUNT || head.jac_age < 0 || !isfinite(head.t) ||
-        !(head.rtol > 0.0 && head.rtol < 1.0) || !(head.max_step >= 0.0) || !(head.h >= 0.0) || !isfinite(head.h))
+        !(head.rtol > 0.0 && head.rtol < 1.0) || !(head.max_step >= 0.0) || !(head.h >= 0.0) || !isfinite(head.h) ||
+        !isfinite(head.t_step) || head.steps < 0 || head.rejected < 0 || head.jacobians < 0 || head.rhs_calls < 0)
         return "its values are out of range";
     return NULL;
 }
@@ -734,8 +776,9 @@ static void state_read(Instance *c, const unsigned char *payload) {
     const double *v = (const double *)(payload + sizeof head);
     memcpy(c->x, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->u, v, sizeof(double) * model_info.nu); v += model_info.nu;
-    for (int i = 0; i < model_info.nu; i++) c->u_der[i] = 0.0; /* derivatives belong to one step */
-    c->interpolating = 0;
+    memcpy(c->u_der, v, sizeof(double) * model_info.nu); v += model_info.nu;
+    c->interpolating = head.interpolating != 0;
+    c->t_step = head.t_step;
     memcpy(c->p, v, sizeof(double) * model_info.np); v += model_info.np;
     memcpy(c->x_set, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->solver.F0, v, sizeof(double) * model_info.nx); v += model_info.nx;
@@ -752,6 +795,9 @@ static void state_read(Instance *c, const unsigned char *payload) {
     c->solver.jac_current = head.jac_current != 0;
     c->solver.jac_age = head.jac_age;
     c->solver.h = head.h;
+    c->solver.steps = head.steps; c->solver.rejected = head.rejected;
+    c->solver.jacobians = head.jacobians; c->solver.rhs_calls = head.rhs_calls;
+    c->eval.evaluations = head.evaluations; c->eval.reused = head.reused;
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component component, fmi2FMUstate *state) {
@@ -775,7 +821,7 @@ fmi2Status fmi2SetFMUstate(fmi2Component component, fmi2FMUstate state) {
     size_t size;
     memcpy(&size, state, sizeof size);
     const unsigned char *payload = (const unsigned char *)state + sizeof(size_t);
-    const char *refusal = state_refusal(payload, size);
+    const char *refusal = state_refusal(payload, size, c->type);
     if (refusal) return fail(c, F_SetFMUstate, REJECTED, "not an FMU state of %s: %s", model_info.identifier, refusal);
     state_read(c, payload);
     return fmi2OK;
@@ -812,7 +858,7 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component component, const fmi2Byte seria
     ENTER(F_DeSerializeFMUstate);
     NOT_NULL(F_DeSerializeFMUstate, serialized, size);
     NOT_NULL(F_DeSerializeFMUstate, state, 1);
-    const char *refusal = state_refusal((const unsigned char *)serialized, size);
+    const char *refusal = state_refusal((const unsigned char *)serialized, size, c->type);
     if (refusal)
         return fail(c, F_DeSerializeFMUstate, REJECTED, "%zu bytes are not an FMU state of %s: %s", size,
                     model_info.identifier, refusal);
@@ -997,6 +1043,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component component, const fmi2ValueR
             return fail(c, F, REJECTED, "%s: derivative %g: expected a finite value", real_name(vr[i]), value[i]);
     }
     for (size_t i = 0; i < nvr; i++) c->u_der[real_index(vr[i]) - off_u()] = value[i];
+    c->t_step = c->t;  /* the inputs' values hold at the current time (the start time before the first step) */
     c->interpolating = 0;
     for (int i = 0; i < model_info.nu; i++) c->interpolating |= c->u_der[i] != 0.0;
     invalidate(c);
@@ -1023,6 +1070,9 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real currentCommunicationPoin
         return fail(c, F, REJECTED, "current communication point %.17g differs from the FMU's time %.17g",
                     currentCommunicationPoint, c->t);
     double t_end = currentCommunicationPoint + communicationStepSize;
+    if (!(t_end > currentCommunicationPoint))
+        return fail(c, F, REJECTED, "communication step size %g does not advance the time %.17g (t + h == t)",
+                    communicationStepSize, currentCommunicationPoint);
     if (c->has_stop && t_end > c->t_stop * (1.0 + 1e-12) + 1e-12)
         return fail(c, F, REJECTED, "step to t = %.17g goes past the stop time %.17g", t_end, c->t_stop);
     c->solver.rtol = c->rtol;
