@@ -1,9 +1,12 @@
-"""Build FMUs: Modelica class → (built-in backend) rumoca → CasADi → C → FMI 2.0 FMU in ``fmus/``.
+"""Build FMUs: Modelica class → (built-in backend) rumoca → CasADi → C → FMI 2.0 FMU in ``fmus/``,
+with the binaries of the host (its C compiler) or of the platforms asked for (zig, see
+:mod:`fmubuild.platforms`), compiled in parallel from the same sources.
 
 The FMU is assembled in a temporary folder and moved into place with one rename, so a failed
 build (an unsupported construct, a compiler error) leaves the output folder as it was. A build is
-skipped when the FMU already there was made from the same inputs (the digest of the Modelica
-package, this builder and the pinned tool versions is stored in ``documentation/build.json``).
+skipped when the FMU already there was made from the same inputs for the same platforms (the
+digest of the Modelica package, this builder, the pinned tool versions and each platform's
+compiler and flags is stored in ``documentation/build.json``).
 """
 
 from __future__ import annotations
