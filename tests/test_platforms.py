@@ -30,6 +30,7 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
+from fmpy.validation import validate_fmu
 
 from rover_cosim.fmubuild import build, platforms, prefix
 
@@ -147,6 +148,7 @@ def test_every_platform_is_in_the_fmu_and_its_build_record(wheel_all: Path):
         assert entry["target"] == platforms.PLATFORMS[name].target
         assert entry["compiler"].startswith("zig cc ") and "-ffp-contract=off" in entry["cflags"]
     assert set(fmpy.supported_platforms(str(wheel_all))) >= {"linux64", "win64", "darwin64", "c-code"}
+    assert validate_fmu(str(wheel_all.parent / "Wheel.fmu")) == []
 
 
 def test_the_up_to_date_check_accounts_for_the_platforms(wheel_all: Path, tmp_path: Path):
