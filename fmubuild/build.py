@@ -31,6 +31,7 @@ from . import codegen, description, ode, prefix, source
 from .artifact import BUILD_RECORD, CFLAGS, RUNTIME, RUNTIME_FILES, BuildResult, input_digest, stored_digest
 from .omc import build_fmu_omc
 from .platforms import HOST, PLATFORMS, ZIG_FLAGS, host_compiler, host_folder, host_suffix, zig_command, zig_version
+from .platforms import parse as parse_platforms
 
 #: The FMUs ``make fmus`` builds (classes of the Modelica package).
 FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel", "SteerableRover", "SteerableRoverBody")
@@ -145,9 +146,10 @@ class Target:
 
 
 def targets(platforms: Sequence[str]) -> list[Target]:
-    """The targets of ``platforms`` (names as :func:`platforms.parse` returns them)."""
+    """The targets of ``platforms`` (names as :func:`platforms.parse` takes them; ValueError names
+    an unknown one)."""
     result = []
-    for name in platforms:
+    for name in parse_platforms(",".join(platforms)):
         if name == HOST:
             cc = compiler()
             version = subprocess.run([cc, "--version"], capture_output=True, text=True, check=False).stdout

@@ -17,7 +17,6 @@ from __future__ import annotations
 import os
 import platform as host_platform
 import shutil
-import subprocess
 import sys
 from dataclasses import dataclass
 from importlib import metadata
@@ -106,9 +105,3 @@ def host_compiler() -> str:
     if shutil.which(cc) is None:
         raise RuntimeError(f"C compiler {cc!r} not found on PATH (set CC, or install gcc)")
     return cc
-
-
-def compiler_version(command: list[str]) -> str:
-    """First line of ``command --version`` (for the build record)."""
-    result = subprocess.run([*command, "--version"], capture_output=True, text=True, check=False)
-    return (result.stdout or result.stderr).strip().splitlines()[0] if (result.stdout or result.stderr) else "?"

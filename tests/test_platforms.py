@@ -168,6 +168,9 @@ def test_an_unknown_platform_is_named_with_the_allowed_ones():
     assert platforms.parse("host") == ("host",)
     with pytest.raises(ValueError, match="the same folder"):
         platforms.parse(f"host,{platforms.host_folder()}")
+    with pytest.raises(ValueError, match="unknown platform 'x86_64-linux'"):
+        build.build_fmu("Wheel", Path("never-written"), platforms=("x86_64-linux",))
+    assert not Path("never-written").exists()
 
 
 def test_cli_refuses_an_unknown_platform_in_one_line(tmp_path: Path):
