@@ -416,3 +416,21 @@ def test_fmu_is_one_zip_with_every_platform(wheel_all: Path):
     for name in platforms.ALL:
         assert f"binaries/{name}/Wheel{platforms.PLATFORMS[name].suffix}" in members
     assert not [m for m in members if m.endswith((".pdb", ".lib"))]
+
+
+def test_a_failing_target_leaves_the_previous_fmu_as_it_was(wheel_all: Path, tmp_path: Path,
+                                                           monkeypatch: pytest.MonkeyPatch):
+    """All or nothing: the host compiler fails while win64 builds; the FMU already there stays."""
+    zig_or_skip()
+    failing = tmp_path / "failing-cc"
+    failing.write_text("#!/bin/sh\n[ \"$1\" = --version ] && echo 'failing-cc 1.0' && exit 0\n"
+                       "echo 'no way' >&2\nexit 1\n")
+    failing.chmod(0o755)
+    monkeypatch.setenv("CC", str(failing))
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "Wheel.fmu").write_bytes(b"the previous FMU")
+    with pytest.raises(RuntimeError, match=r"the C compiler failed for linux64 \(failing-cc 1.0, exit 1\)"):
+        build.build_fmu("Wheel", out, platforms=(platforms.HOST, "win64"))
+    assert (out / "Wheel.fmu").read_bytes() == b"the previous FMU"
+    assert sorted(p.name for p in out.iterdir()) == ["Wheel.fmu"]
