@@ -230,6 +230,11 @@ def build_parser() -> argparse.ArgumentParser:
                        help="auto: omc where OpenModelica is on PATH, else the built-in rumoca/CasADi exporter")
     build.add_argument("--force", action="store_true", help="rebuild even when the FMU is up to date")
     build.add_argument("--jobs", type=int, default=None, help="parallel builds (default: number of CPUs)")
+    build.add_argument("--platforms", default="host", metavar="LIST",
+                       help="binaries/ folders to build: host (default: this machine's, by $CC or cc), all "
+                       "(linux64, win64, darwin64, aarch64-linux, aarch64-darwin) or a comma-separated list of "
+                       "those; other than host, cross-compiled by zig (pip install -e '.[platforms]'); "
+                       "linux ones for glibc >= 2.17")
     for name, sub in commands.choices.items():
         summary, *examples = USAGE[name]
         sub.description = summary
@@ -262,7 +267,8 @@ USAGE = {
     "report": ("One self-contained HTML page of the results: figures, tables, provenance.",
                "rover-cosim report --results results"),
     "build-fmus": ("Build the FMI 2.0 FMUs (Model Exchange + Co-Simulation) from the Modelica library.",
-                   "rover-cosim build-fmus --out fmus", "rover-cosim build-fmus Wheel --force"),
+                   "rover-cosim build-fmus --out fmus", "rover-cosim build-fmus Wheel --force",
+                   "rover-cosim build-fmus Wheel --platforms all", "rover-cosim build-fmus --platforms host,win64"),
 }
 
 
@@ -611,6 +617,7 @@ def _print_straight(outcome) -> None:  # noqa: ANN001 - SimulationResult, import
 def _build_fmus(args: argparse.Namespace) -> int:
     from rover_cosim.fmubuild.build import FMU_MODELS, BuildResult, build_all
     from rover_cosim.fmubuild.expressions import UnsupportedConstruct
+    from rover_cosim.fmubuild.platforms import parse as parse_platforms
 
     def report(result: BuildResult) -> None:
         if result.rebuilt:
@@ -623,8 +630,13 @@ def _build_fmus(args: argparse.Namespace) -> int:
         print(f"rover-cosim build-fmus: --jobs {args.jobs}: expected >= 1", file=sys.stderr)
         return 2
     try:
+        platforms = parse_platforms(args.platforms)
+    except ValueError as error:
+        print(f"rover-cosim build-fmus: {error}", file=sys.stderr)
+        return 2
+    try:
         build_all(tuple(args.models) or FMU_MODELS, args.out, force=args.force, jobs=args.jobs,
-                  backend=args.backend, report=report)
+                  backend=args.backend, platforms=platforms, report=report)
     except (UnsupportedConstruct, ValueError, RuntimeError) as error:
         print(f"rover-cosim build-fmus: {error}", file=sys.stderr)
         return 1

@@ -11,6 +11,12 @@
 #ifndef ROVER_COSIM_MODEL_H
 #define ROVER_COSIM_MODEL_H
 
+/* FMI2_FUNCTION_PREFIX (several source FMUs in one program): the FMU's other external names get
+ * the same prefix (fmu_prefix.h, written with the sources by fmubuild). */
+#ifdef FMI2_FUNCTION_PREFIX
+#include "fmu_prefix.h"
+#endif
+
 typedef long long int casadi_int;
 
 typedef struct {
