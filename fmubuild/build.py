@@ -19,13 +19,16 @@ import os
 import shutil
 import subprocess
 import tempfile
+import threading
 import time
 import zipfile
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from contextlib import ExitStack
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
+from typing import Any
 
 from . import codegen, description, ode, prefix, source
 from .artifact import BUILD_RECORD, CFLAGS, RUNTIME, RUNTIME_FILES, BuildResult, input_digest, stored_digest
@@ -184,15 +187,32 @@ def _compile(name: str, target: Target, sources: Path, c_files: list[str], work:
     return library, time.perf_counter() - started
 
 
+#: A build's progress: called with the FMU's name and the stage just finished ("translate",
+#: "generate", "compile <folder>", "package"); see :func:`steps_of`.
+StepReport = Callable[[str, str], None]
+
+
+def steps_of(platforms: Sequence[str]) -> int:
+    """Stages one FMU's build reports: translate, generate, one compile per platform, package."""
+    return 3 + len(targets(platforms))
+
+
 def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries: Path, work: Path,
-                    jobs: int | None = None) -> dict[str, float]:
+                    jobs: int | None = None, step: StepReport | None = None) -> dict[str, float]:
     """Compile the sources for every target, ``jobs`` compilers at a time (default: one per CPU),
     into ``binaries``/<folder>/; returns the seconds per folder. The first failure is raised after
-    the other compilers finished."""
+    the other compilers finished. ``step`` hears of each compiler that finished."""
     c_files = sorted(str(sources / f.name) for f in sources.iterdir() if f.suffix == ".c")
     workers = max(1, min(jobs or os.cpu_count() or 1, len(chosen)))
+
+    def compile_one(target: Target) -> tuple[Path, float]:
+        done = _compile(name, target, sources, c_files, work)
+        if step:
+            step(name, f"compile {target.folder}")
+        return done
+
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        futures = {t.folder: pool.submit(_compile, name, t, sources, c_files, work) for t in chosen}
+        futures = {t.folder: pool.submit(compile_one, t) for t in chosen}
     seconds: dict[str, float] = {}
     for folder, future in futures.items():
         library, took = future.result()
@@ -203,10 +223,11 @@ def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries
 
 
 def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Sequence[str] = (HOST,),
-              compile_jobs: int | None = None) -> BuildResult:
+              compile_jobs: int | None = None, step: StepReport | None = None) -> BuildResult:
     """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date) with binaries
     for ``platforms`` (``host``: this machine's, by its C compiler; other names: cross-compiled by
-    zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time."""
+    zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time; ``step`` hears of
+    each stage as it ends."""
     started = time.perf_counter()
     out_dir = Path(out_dir)
     target = out_dir / f"{name}.fmu"
@@ -221,6 +242,8 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
         model = ode.translate(source.load(f"{source.PACKAGE}.{name}"), name)
         model_layout = codegen.layout(model)
         stages["translate"] = time.perf_counter() - t0
+        if step:
+            step(name, "translate")
 
         t0 = time.perf_counter()
         root = tmp / "fmu"
@@ -240,9 +263,11 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
             description.model_description(model_layout, guid, source_files, _class_description(name), version,
                                           _default_experiment(name)))
         stages["generate"] = time.perf_counter() - t0
+        if step:
+            step(name, "generate")
 
         t0 = time.perf_counter()
-        seconds = compile_targets(name, chosen, sources, root / "binaries", tmp / "compile", compile_jobs)
+        seconds = compile_targets(name, chosen, sources, root / "binaries", tmp / "compile", compile_jobs, step)
         stages["compile"] = time.perf_counter() - t0
         stages.update({f"compile {folder}": s for folder, s in seconds.items()})
 
@@ -271,14 +296,45 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
                     archive.write(path, path.relative_to(root).as_posix())
         os.replace(partial, target)
         stages["package"] = time.perf_counter() - t0
+    if step:
+        step(name, "package")
     return BuildResult(name, target, True, time.perf_counter() - started, stages)
 
 
-def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int]) -> BuildResult:
-    name, out_dir, force, backend, platforms, compile_jobs = args
+def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int, Any]) -> BuildResult:
+    """One FMU (in a pool's worker): its stages go to ``steps`` (a queue of the parent's, or None)."""
+    name, out_dir, force, backend, platforms, compile_jobs, steps = args
     if backend == "omc":
         return build_fmu_omc(name, out_dir, force=force)
-    return build_fmu(name, out_dir, force=force, platforms=platforms, compile_jobs=compile_jobs)
+    step = (lambda fmu, stage: steps.put((fmu, stage))) if steps is not None else None
+    return build_fmu(name, out_dir, force=force, platforms=platforms, compile_jobs=compile_jobs, step=step)
+
+
+class _LocalSteps:
+    """A queue's ``put`` for builds in this process: the stage goes straight to ``step``."""
+
+    def __init__(self, step: StepReport):
+        self.step = step
+
+    def put(self, item: tuple[str, str]) -> None:
+        self.step(*item)
+
+
+def _forward_steps(stack: ExitStack, context: Any, step: StepReport) -> Any:
+    """A queue the pool's workers put their stages on, and a thread here that hands them to
+    ``step`` until the stack closes."""
+    manager = stack.enter_context(context.Manager())
+    queue = manager.Queue()
+
+    def forward() -> None:
+        while (item := queue.get()) is not None:
+            step(*item)
+
+    thread = threading.Thread(target=forward, daemon=True)
+    thread.start()
+    stack.callback(thread.join)
+    stack.callback(queue.put, None)
+    return queue
 
 
 def resolve_backend(backend: str) -> str:
@@ -303,10 +359,13 @@ def _check_platforms(backend: str, platforms: tuple[str, ...]) -> tuple[str, ...
 
 def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *, force: bool = False,
               jobs: int | None = None, backend: str = "builtin", platforms: Sequence[str] = (HOST,),
-              report: Callable[[BuildResult], None] | None = None) -> list[BuildResult]:
+              report: Callable[[BuildResult], None] | None = None,
+              step: StepReport | None = None) -> list[BuildResult]:
     """Build several FMUs, ``jobs`` at a time (default: the number of CPUs), each with binaries for
     ``platforms`` (see :func:`build_fmu`; the CPUs left to each build compile its platforms in
-    parallel). The first failure is raised after the other builds finished; FMUs already built stay."""
+    parallel). The first failure is raised after the other builds finished; FMUs already built stay.
+    ``report`` hears of each FMU built or up to date, ``step`` of each stage of a build as it ends
+    (from the workers, through a queue)."""
     unknown = [n for n in names if n not in FMU_MODELS]
     if unknown:
         raise ValueError(f"model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}")
@@ -315,10 +374,11 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
     cpus = os.cpu_count() or 1
     jobs = max(1, min(jobs or cpus, len(names)))
     compile_jobs = max(1, cpus // jobs)
-    tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs) for n in names]
     results: list[BuildResult] = []
     errors: list[BaseException] = []
     if jobs == 1:
+        local = _LocalSteps(step) if step else None
+        tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, local) for n in names]
         for task in tasks:
             try:
                 results.append(_build_one(task))
@@ -328,7 +388,11 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
                 errors.append(error)
     else:
         # "spawn": a forked worker can deadlock on the locks of threads (rumoca's) in the parent.
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
+        context = multiprocessing.get_context("spawn")
+        with ExitStack() as stack:
+            steps = _forward_steps(stack, context, step) if step else None
+            pool = stack.enter_context(ProcessPoolExecutor(max_workers=jobs, mp_context=context))
+            tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, steps) for n in names]
             futures = [pool.submit(_build_one, task) for task in tasks]
             for future in futures:
                 try:

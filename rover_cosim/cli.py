@@ -230,6 +230,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="auto: omc where OpenModelica is on PATH, else the built-in rumoca/CasADi exporter")
     build.add_argument("--force", action="store_true", help="rebuild even when the FMU is up to date")
     build.add_argument("--jobs", type=int, default=None, help="parallel builds (default: number of CPUs)")
+    build.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     build.add_argument("--platforms", default="host", metavar="LIST",
                        help="binaries/ folders to build: host (default: this machine's, by $CC or cc), all "
                        "(linux64, win64, darwin64, aarch64-linux, aarch64-darwin) or a comma-separated list of "
@@ -615,16 +616,26 @@ def _print_straight(outcome) -> None:  # noqa: ANN001 - SimulationResult, import
 
 
 def _build_fmus(args: argparse.Namespace) -> int:
-    from rover_cosim.fmubuild.build import FMU_MODELS, BuildResult, build_all
+    from rover_cosim.fmubuild.build import FMU_MODELS, BuildResult, build_all, steps_of
     from rover_cosim.fmubuild.expressions import UnsupportedConstruct
     from rover_cosim.fmubuild.platforms import parse as parse_platforms
+    from rover_cosim.progress import ProgressBar
+
+    bar = ProgressBar("build-fmus", enabled=not args.quiet)
+    done = {"steps": 0, "total": 1}
+
+    def step(_model: str, _stage: str) -> None:  # translate, generate, compile <folder>, package
+        done["steps"] += 1
+        bar(min(1.0, done["steps"] / max(1, done["total"])))
 
     def report(result: BuildResult) -> None:
+        bar.clear()
         if result.rebuilt:
             stages = ", ".join(f"{k} {v:.1f} s" for k, v in result.stages.items())
             print(f"built {result.path} in {result.seconds:.1f} s ({stages})", flush=True)
         else:
             print(f"{result.path} is up to date", flush=True)
+            done["total"] -= done["per_fmu"]  # nothing to wait for there
 
     if args.jobs is not None and args.jobs < 1:
         print(f"rover-cosim build-fmus: --jobs {args.jobs}: expected >= 1", file=sys.stderr)
@@ -634,12 +645,17 @@ def _build_fmus(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"rover-cosim build-fmus: {error}", file=sys.stderr)
         return 2
+    models = tuple(args.models) or FMU_MODELS
+    done["per_fmu"] = steps_of(platforms)
+    done["total"] = len(models) * done["per_fmu"]
     try:
-        build_all(tuple(args.models) or FMU_MODELS, args.out, force=args.force, jobs=args.jobs,
-                  backend=args.backend, platforms=platforms, report=report)
+        build_all(models, args.out, force=args.force, jobs=args.jobs, backend=args.backend, platforms=platforms,
+                  report=report, step=step)
     except (UnsupportedConstruct, ValueError, RuntimeError) as error:
+        bar.close()
         print(f"rover-cosim build-fmus: {error}", file=sys.stderr)
         return 1
+    bar.close()
     return 0
 
 

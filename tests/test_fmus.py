@@ -570,6 +570,46 @@ def test_build_cli_reports_up_to_date_fmus(fmu_dir, fmus, capsys):
     assert "NoSuchModel" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_build_reports_each_stage_as_it_ends(tmp_path, jobs):
+    """build-fmus shows progress per compile step (issue 29): every FMU's stages reach the step
+    callback, in order per FMU, from this process (--jobs 1) and from the pool's workers (--jobs 2),
+    before its BuildResult; the CLI draws them as a bar on a terminal."""
+    seen: list[tuple[str, str]] = []
+    results = build.build_all(["RoverBody", "SteerableRoverBody"], tmp_path, jobs=jobs, backend="builtin",
+                              step=lambda model, stage: seen.append((model, stage)))
+    folder = build.host_folder()
+    for model in ("RoverBody", "SteerableRoverBody"):
+        assert [s for m, s in seen if m == model] == ["translate", "generate", f"compile {folder}", "package"]
+    assert len(seen) == 2 * build.steps_of(["host"]) and all(r.rebuilt for r in results)
+    again: list[tuple[str, str]] = []
+    build.build_all(["RoverBody"], tmp_path, jobs=jobs, backend="builtin", step=lambda m, s: again.append((m, s)))
+    assert again == []  # up to date: nothing to wait for
+
+
+def test_build_cli_draws_a_progress_bar_on_a_terminal(tmp_path, monkeypatch, capsys):
+    import io
+
+    from rover_cosim.cli import main
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    from rover_cosim.progress import ProgressBar
+
+    monkeypatch.setattr(ProgressBar.__init__, "__kwdefaults__", {**ProgressBar.__init__.__kwdefaults__, "delay": 0.0})
+    assert main(["build-fmus", "--out", str(tmp_path), "--backend", "builtin", "--jobs", "1", "RoverBody"]) == 0
+    assert "build-fmus [" in terminal.getvalue() and "100.0%" in terminal.getvalue()
+    assert "built " in capsys.readouterr().out
+    quiet = Terminal()
+    monkeypatch.setattr("sys.stderr", quiet)
+    assert main(["build-fmus", "--out", str(tmp_path), "--force", "-q", "--jobs", "1", "RoverBody"]) == 0
+    assert quiet.getvalue() == ""
+
+
 def test_backend_choice_and_the_omc_script(monkeypatch):
     from rover_cosim.fmubuild.omc import script
 
