@@ -600,7 +600,8 @@ def test_build_cli_draws_a_progress_bar_on_a_terminal(tmp_path, monkeypatch, cap
     monkeypatch.setattr("sys.stderr", terminal)
     from rover_cosim.progress import ProgressBar
 
-    monkeypatch.setattr(ProgressBar.__init__, "__kwdefaults__", {**(ProgressBar.__init__.__kwdefaults__ or {}), "delay": 0.0})
+    defaults = {**(ProgressBar.__init__.__kwdefaults__ or {}), "delay": 0.0}  # drawn at once
+    monkeypatch.setattr(ProgressBar.__init__, "__kwdefaults__", defaults)
     assert main(["build-fmus", "--out", str(tmp_path), "--backend", "builtin", "--jobs", "1", "RoverBody"]) == 0
     assert "build-fmus [" in terminal.getvalue() and "100.0%" in terminal.getvalue()
     assert "built " in capsys.readouterr().out
