@@ -28,7 +28,8 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
-from fmpy.fmi2 import FMU2Model, FMU2Slave
+from fmpy.fmi2 import FMU2Model, FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.fmi2 import defaultCallbacks as default_callbacks
 
 STEP = 1e-3
 STEPS = 500
@@ -89,7 +90,15 @@ class Instance:
         self.fmu = cls(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
                        instanceName=name)
         self.kind = kind
-        self.fmu.instantiate()
+        # A logger of its own, alive as long as the instance: FMPy's default callbacks go through one
+        # process-wide proxy that another FMPy user may have pointed at a logger since freed (a crash).
+        self.messages: list[str] = []
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = fmi2CallbackLoggerTYPE(lambda env, name, status, category, text:
+                                                       self.messages.append(text.decode()))
+        self.callbacks.allocateMemory = default_callbacks.allocateMemory
+        self.callbacks.freeMemory = default_callbacks.freeMemory
+        self.fmu.instantiate(callbacks=self.callbacks)
         self.fmu.setupExperiment(startTime=0.0)
         self.set(starts)
         self.fmu.enterInitializationMode()
@@ -197,6 +206,8 @@ def test_directional_derivatives_refuse_unknowns_that_are_no_output_state_or_der
         assert unknown in instance.refs
         with pytest.raises(fmpy.fmi1.FMICallException):
             instance.fmu.getDirectionalDerivative([instance.refs[unknown]], [instance.refs["tau"]], [1.0])
+        message = instance.messages[-1]
+        assert unknown in message and "expected a state, a derivative or an output" in message
     fine = instance.fmu.getDirectionalDerivative([instance.refs["Fx"]], [instance.refs["tau"]], [1.0])
     assert math.isfinite(fine[0])
     instance.fmu.terminate()
