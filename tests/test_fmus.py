@@ -61,8 +61,9 @@ def test_fmu_is_me_and_cs_with_sources_units_and_solver_parameters(fmus, name: s
         root = ET.fromstring(archive.read("modelDescription.xml"))
     for kind in ("ModelExchange", "CoSimulation"):
         listed = [f.get("name") for f in root.findall(f"{kind}/SourceFiles/File")]
-        assert "fmi2_runtime.c" in listed and all(f"sources/{f}" in members for f in listed)
-    assert {"sources/fmi2_runtime.c", "sources/model_casadi.c", "sources/model.h"} <= members
+        assert "fmi2_api.c" in listed and all(f"sources/{f}" in members for f in listed)
+    assert {"sources/fmi2_api.c", "sources/core.h", "sources/instance.c", "sources/model_casadi.c",
+            "sources/model.h"} <= members
     assert f"binaries/{build.platform_folder()}/{name}{build.shared_library_suffix()}" in members
     reals = [v for v in md.modelVariables if v.type == "Real"]
     assert all(v.unit is not None for v in reals), [v.name for v in reals if v.unit is None]

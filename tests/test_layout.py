@@ -162,7 +162,7 @@ def test_the_sdist_carries_the_release_files_and_the_sources_the_wheel_is_built_
         names = {name.split("/", 1)[1] for name in archive.getnames() if "/" in name}
     for expected in ("LICENSE", "CHANGELOG.md", "CITATION.cff", "README.md", "pyproject.toml",
                      "rover_cosim/modelica/RoverTerramechanics/package.mo",
-                     "rover_cosim/fmubuild/runtime/fmi2_runtime.c", "rover_cosim/terramechanics/library/soils.toml",
+                     "rover_cosim/fmubuild/runtime/fmi2_api.c", "rover_cosim/terramechanics/library/soils.toml",
                      "rover_cosim/py.typed"):
         assert expected in names, expected
 
@@ -177,7 +177,7 @@ def test_the_wheel_has_only_rover_cosim_at_the_top_level(wheel):
         names = archive.namelist()
     top = {name.split("/")[0] for name in names}
     assert top == {"rover_cosim", wheel.name.split("-")[0] + "-" + wheel.name.split("-")[1] + ".dist-info"}, top
-    for expected in ("rover_cosim/orchestrator/systems/rover_cosim.toml", "rover_cosim/fmubuild/runtime/fmi2_runtime.c",
+    for expected in ("rover_cosim/orchestrator/systems/rover_cosim.toml", "rover_cosim/fmubuild/runtime/fmi2_api.c",
                      "rover_cosim/modelica/RoverTerramechanics/package.mo",
                      "rover_cosim/modelica/RoverTerramechanics/package.order", "rover_cosim/terramechanics/forces.py"):
         assert expected in names, expected

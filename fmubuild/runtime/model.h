@@ -2,7 +2,7 @@
  *
  * fmubuild generates, per model, model_casadi.c (CasADi's C code of the functions below) and
  * model_data.c (sizes, value-reference layout, defaults: the ModelInfo below). The runtime
- * (fmi2_runtime.c, ode23s.c) is the same for every model.
+ * (core.h: instance.c, state.c, cosim.c, ode23s.c, and the API layer fmi2_api.c) is the same for every model.
  *
  * Real value references are indices into one array laid out as
  *   [parameters | states | derivatives | inputs | observed | memories | tolerance, maxStep | statistics]
