@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test lint fig3 fmus identify simulate montecarlo report cosim-study bench venv clean
+.PHONY: run test lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -47,6 +47,10 @@ fig3: $(STAMP)
 ## PLATFORMS=all adds the binaries of every host (see PLATFORMS above)
 fmus: $(STAMP)
 	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) --platforms $(PLATFORMS) $(FMU_NAMES)
+
+## fmus3: the same models as FMI 3.0 FMUs (ME + CS) -> fmus/fmi3/*.fmu (PLATFORMS as for fmus)
+fmus3: $(STAMP)
+	$(VENV)/bin/rover-cosim build-fmus --out fmus/fmi3 --backend builtin --fmi-version 3 --platforms $(PLATFORMS) $(FMU_NAMES)
 
 ## identify: paper Sec. 3 (sweep on SingleWheel.fmu, LUT, Fx fits, Table 1) -> results/identification/
 identify: fmus

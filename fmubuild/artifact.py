@@ -14,7 +14,11 @@ from pathlib import Path
 from . import source
 
 RUNTIME = Path(__file__).parent / "runtime"
-RUNTIME_FILES = ("model.h", "core.h", "ode23s.h", "ode23s.c", "instance.c", "state.c", "cosim.c", "fmi2_api.c")
+#: The runtime's files in an FMU: the core (core.h, instance.c, state.c, cosim.c, ode23s) and the API
+#: layer of its FMI version.
+RUNTIME_CORE = ("model.h", "core.h", "ode23s.h", "ode23s.c", "instance.c", "state.c", "cosim.c")
+RUNTIME_FILES = (*RUNTIME_CORE, "fmi2_api.c")
+RUNTIME_FILES_3 = (*RUNTIME_CORE, "fmi3_api.c")
 #: -fno-math-errno: libm calls are pure functions to the optimiser (the runtime never reads
 #: errno), so it may drop or move them like any other operation.
 CFLAGS = ("-O2", "-fno-math-errno", "-fPIC", "-shared", "-fvisibility=hidden", "-std=c99", "-D_POSIX_C_SOURCE=200809L")
@@ -34,7 +38,7 @@ def input_digest(name: str) -> str:
     """Digest of everything a built-in FMU of ``name`` is made from."""
     digest = hashlib.sha256(name.encode())
     files = sorted((source.MODELICA_ROOT / source.PACKAGE).rglob("*")) + sorted(Path(__file__).parent.glob("*.py"))
-    files += [RUNTIME / f for f in RUNTIME_FILES]
+    files += [RUNTIME / f for f in sorted({*RUNTIME_FILES, *RUNTIME_FILES_3})]
     for path in files:
         if path.is_file():
             digest.update(str(path.relative_to(path.parents[1])).encode())

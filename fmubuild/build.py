@@ -30,8 +30,17 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from . import codegen, description, ode, prefix, source
-from .artifact import BUILD_RECORD, CFLAGS, RUNTIME, RUNTIME_FILES, BuildResult, input_digest, stored_digest
+from . import codegen, description, description3, ode, prefix, source
+from .artifact import (
+    BUILD_RECORD,
+    CFLAGS,
+    RUNTIME,
+    RUNTIME_FILES,
+    RUNTIME_FILES_3,
+    BuildResult,
+    input_digest,
+    stored_digest,
+)
 from .omc import build_fmu_omc
 from .platforms import HOST, PLATFORMS, ZIG_FLAGS, host_compiler, host_folder, host_suffix, zig_command, zig_version
 from .platforms import parse as parse_platforms
@@ -40,27 +49,33 @@ from .platforms import parse as parse_platforms
 FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel", "SteerableRover", "SteerableRoverBody")
 
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
+FMI3_HEADERS = ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")
+
+#: The FMI versions build_fmu writes: their runtime API layer and standard headers.
+FMI_VERSIONS = {2: (RUNTIME_FILES, FMI_HEADERS), 3: (RUNTIME_FILES_3, FMI3_HEADERS)}
 
 #: sources/buildDescription.xml (FMI 3.0 schema; FMI 2.0.4 section 2.3 lets an FMI 2.0 FMU carry
 #: it): the files to compile, the optional FMI2_FUNCTION_PREFIX, and the C math library to link.
 BUILD_DESCRIPTION = "buildDescription.xml"
 
 
-def build_description(name: str, c_files: Sequence[str]) -> str:
-    """The text of sources/buildDescription.xml for the FMU ``name`` compiled from ``c_files``."""
+def build_description(name: str, c_files: Sequence[str], fmi_version: int = 2) -> str:
+    """The text of sources/buildDescription.xml for the FMU ``name`` compiled from ``c_files``
+    (the optional FMI2_FUNCTION_PREFIX for an FMI 2.0 FMU)."""
     from xml.sax.saxutils import quoteattr
 
     files = "\n".join(f"      <SourceFile name={quoteattr(f)}/>" for f in c_files)
     how = "Compile the C99 files into one shared library, linking the C math library: cc -shared -fPIC sources/*.c -lm"
     prefix_use = "Prefix of every external name of the FMU, to compile several source FMUs into one program"
     libm = "The C math library (exp, log, pow, sin, cos, ...): -lm where the C library lacks it (Linux)"
+    prefix_line = (f'      <PreprocessorDefinition name="FMI2_FUNCTION_PREFIX" optional="true" '
+                   f'description={quoteattr(prefix_use)}/>\n') if fmi_version == 2 else ""
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <fmiBuildDescription fmiVersion="3.0">
   <BuildConfiguration modelIdentifier={quoteattr(name)} description={quoteattr(how)}>
     <SourceFileSet language="C99">
 {files}
-      <PreprocessorDefinition name="FMI2_FUNCTION_PREFIX" optional="true" description={quoteattr(prefix_use)}/>
-    </SourceFileSet>
+{prefix_line}    </SourceFileSet>
     <Library name="m" external="true" description={quoteattr(libm)}/>
   </BuildConfiguration>
 </fmiBuildDescription>
@@ -223,16 +238,18 @@ def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries
 
 
 def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Sequence[str] = (HOST,),
-              compile_jobs: int | None = None, step: StepReport | None = None) -> BuildResult:
+              compile_jobs: int | None = None, step: StepReport | None = None, fmi_version: int = 2) -> BuildResult:
     """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date) with binaries
     for ``platforms`` (``host``: this machine's, by its C compiler; other names: cross-compiled by
     zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time; ``step`` hears of
-    each stage as it ends."""
+    each stage as it ends. ``fmi_version`` 3: an FMI 3.0 FMU of the same model code (the runtime's
+    FMI 3.0 layer, the FMI 3.0 model description and platform folders)."""
+    _check_version(fmi_version)
     started = time.perf_counter()
     out_dir = Path(out_dir)
     target = out_dir / f"{name}.fmu"
     chosen = targets(platforms)
-    digest = platforms_digest(name, chosen)
+    digest = platforms_digest(name, chosen) + ("" if fmi_version == 2 else f"-fmi{fmi_version}")
     if not force and target.exists() and stored_digest(target) == digest:
         return BuildResult(name, target, False, time.perf_counter() - started)
     stages: dict[str, float] = {}
@@ -248,26 +265,17 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
         t0 = time.perf_counter()
         root = tmp / "fmu"
         sources = root / "sources"
-        guid = codegen.write_sources(model, model_layout, sources)
-        for file in RUNTIME_FILES:
-            shutil.copy2(RUNTIME / file, sources / file)
-        headers = fmi_headers()
-        for file in FMI_HEADERS:
-            shutil.copy2(headers / file, sources / file)
-        c_texts = [p.read_text() for p in sorted(sources.glob("*.c"))]
-        (sources / prefix.HEADER).write_text(prefix.prefix_header(prefix.external_names(c_texts)))
-        (sources / BUILD_DESCRIPTION).write_text(build_description(name, sorted(p.name for p in sources.glob("*.c"))))
-        source_files = sorted(p.name for p in sources.iterdir() if p.name != BUILD_DESCRIPTION)
         version = metadata.version("rover-cosim")
-        (root / "modelDescription.xml").write_text(
-            description.model_description(model_layout, guid, source_files, _class_description(name), version,
-                                          _default_experiment(name)))
+        guid = _generate(name, model, model_layout, root, fmi_version, version)
         stages["generate"] = time.perf_counter() - t0
         if step:
             step(name, "generate")
 
         t0 = time.perf_counter()
         seconds = compile_targets(name, chosen, sources, root / "binaries", tmp / "compile", compile_jobs, step)
+        if fmi_version == 3:  # the FMI 3.0 platform tuples (x86_64-linux, ...) name the folders
+            for folder in seconds:
+                (root / "binaries" / folder).rename(root / "binaries" / fmi3_folder(folder))
         stages["compile"] = time.perf_counter() - t0
         stages.update({f"compile {folder}": s for folder, s in seconds.items()})
 
@@ -280,14 +288,17 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
                   "guid": guid, "rover_cosim": version,
                   "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")},
                   "cflags": list(host[0].flags if host else CFLAGS),
-                  "platforms": {t.folder: {**t.record(), "library": f"binaries/{t.folder}/{name}{t.suffix}"}
-                                for t in chosen},
+                  "fmi_version": fmi_version,
+                  "platforms": {folder: {**t.record(), "library": f"binaries/{folder}/{name}{t.suffix}"}
+                                for t in chosen
+                                for folder in [t.folder if fmi_version == 2 else fmi3_folder(t.folder)]},
                   "states": model_layout.n_states, "inputs": model_layout.n_inputs,
                   "parameters": model_layout.n_parameters, "observed": model_layout.n_observed}
         (root / "documentation").mkdir()
         (root / BUILD_RECORD).write_text(json.dumps(record, indent=2) + "\n")
         (root / "documentation" / "index.html").write_text(
-            description.documentation_html(model_layout, _class_description(name), _class_documentation(name)))
+            description.documentation_html(model_layout, _class_description(name), _class_documentation(name),
+                                           fmi_version))
         out_dir.mkdir(parents=True, exist_ok=True)
         partial = out_dir / f".{name}.fmu.partial"
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as archive:
@@ -301,13 +312,54 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
     return BuildResult(name, target, True, time.perf_counter() - started, stages)
 
 
-def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int, Any]) -> BuildResult:
+def _check_version(fmi_version: int, backend: str = "builtin") -> None:
+    if fmi_version not in FMI_VERSIONS:
+        raise ValueError(f"FMI version {fmi_version!r}: expected one of {', '.join(map(str, FMI_VERSIONS))}")
+    if fmi_version != 2 and backend == "omc":
+        raise ValueError("FMI 3.0: the built-in backend only (--backend builtin)")
+
+
+def _generate(name: str, model: ode.OdeModel, model_layout: codegen.ModelLayout, root: Path, fmi_version: int,
+              version: str) -> str:
+    """The FMU's sources (generated C, the runtime, the standard headers, the prefix header and the
+    build description) and its modelDescription.xml in ``root``; returns the GUID (FMI 3.0: the
+    instantiation token)."""
+    runtime_files, headers_wanted = FMI_VERSIONS[fmi_version]
+    sources = root / "sources"
+    guid = codegen.write_sources(model, model_layout, sources)
+    for file in runtime_files:
+        shutil.copy2(RUNTIME / file, sources / file)
+    headers = fmi_headers()
+    for file in headers_wanted:
+        shutil.copy2(headers / file, sources / file)
+    c_texts = [p.read_text() for p in sorted(sources.glob("*.c"))]
+    (sources / prefix.HEADER).write_text(prefix.prefix_header(prefix.external_names(c_texts)))
+    (sources / BUILD_DESCRIPTION).write_text(build_description(name, sorted(p.name for p in sources.glob("*.c")),
+                                                               fmi_version))
+    source_files = sorted(p.name for p in sources.iterdir() if p.name != BUILD_DESCRIPTION)
+    if fmi_version == 2:
+        text = description.model_description(model_layout, guid, source_files, _class_description(name), version,
+                                             _default_experiment(name))
+    else:
+        text = description3.model_description(model_layout, guid, _class_description(name), version,
+                                              _default_experiment(name))
+    (root / "modelDescription.xml").write_text(text)
+    return guid
+
+
+def fmi3_folder(folder: str) -> str:
+    """The FMI 3.0 binaries folder of an FMI 2.0 one (``linux64`` -> ``x86_64-linux``)."""
+    return PLATFORMS[folder].fmi3 if folder in PLATFORMS else folder
+
+
+def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int, Any, int]) -> BuildResult:
     """One FMU (in a pool's worker): its stages go to ``steps`` (a queue of the parent's, or None)."""
-    name, out_dir, force, backend, platforms, compile_jobs, steps = args
+    name, out_dir, force, backend, platforms, compile_jobs, steps, fmi_version = args
     if backend == "omc":
         return build_fmu_omc(name, out_dir, force=force)
     step = (lambda fmu, stage: steps.put((fmu, stage))) if steps is not None else None
-    return build_fmu(name, out_dir, force=force, platforms=platforms, compile_jobs=compile_jobs, step=step)
+    return build_fmu(name, out_dir, force=force, platforms=platforms, compile_jobs=compile_jobs, step=step,
+                     fmi_version=fmi_version)
 
 
 class _LocalSteps:
@@ -360,7 +412,7 @@ def _check_platforms(backend: str, platforms: tuple[str, ...]) -> tuple[str, ...
 def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *, force: bool = False,
               jobs: int | None = None, backend: str = "builtin", platforms: Sequence[str] = (HOST,),
               report: Callable[[BuildResult], None] | None = None,
-              step: StepReport | None = None) -> list[BuildResult]:
+              step: StepReport | None = None, fmi_version: int = 2) -> list[BuildResult]:
     """Build several FMUs, ``jobs`` at a time (default: the number of CPUs), each with binaries for
     ``platforms`` (see :func:`build_fmu`; the CPUs left to each build compile its platforms in
     parallel). The first failure is raised after the other builds finished; FMUs already built stay.
@@ -370,6 +422,7 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
     if unknown:
         raise ValueError(f"model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}")
     backend = resolve_backend(backend)
+    _check_version(fmi_version, backend)
     platforms = _check_platforms(backend, tuple(platforms))
     cpus = os.cpu_count() or 1
     jobs = max(1, min(jobs or cpus, len(names)))
@@ -378,7 +431,7 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
     errors: list[BaseException] = []
     if jobs == 1:
         local = _LocalSteps(step) if step else None
-        tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, local) for n in names]
+        tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, local, fmi_version) for n in names]
         for task in tasks:
             try:
                 results.append(_build_one(task))
@@ -392,7 +445,7 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
         with ExitStack() as stack:
             steps = _forward_steps(stack, context, step) if step else None
             pool = stack.enter_context(ProcessPoolExecutor(max_workers=jobs, mp_context=context))
-            tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, steps) for n in names]
+            tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, steps, fmi_version) for n in names]
             futures = [pool.submit(_build_one, task) for task in tasks]
             for future in futures:
                 try:

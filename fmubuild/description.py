@@ -160,7 +160,8 @@ def _dependencies(v: FmuVariable, model_layout: ModelLayout, index: dict[int, in
     return " ".join(str(index[r]) for r in refs)
 
 
-def documentation_html(model_layout: ModelLayout, description: str, documentation: str = "") -> str:
+def documentation_html(model_layout: ModelLayout, description: str, documentation: str = "",
+                       fmi_version: int = 2) -> str:
     """documentation/index.html of an FMU: what it is, every variable a user sets or reads (name,
     causality, unit and display unit, start, min, max, description), and ``documentation`` (the
     Modelica class's own Documentation: equations and sources; our own text, inserted as HTML)."""
@@ -181,7 +182,8 @@ def documentation_html(model_layout: ModelLayout, description: str, documentatio
     return ("<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
             f"<title>{html.escape(model_layout.name)}</title><style>{style}</style></head><body>"
             f"<h1>{html.escape(model_layout.name)}</h1><p>{html.escape(description)}</p>"
-            "<p>FMI 2.0, Model Exchange and Co-Simulation. Units are SI; min and max are the closed range a "
+            f"<p>FMI {fmi_version}.0, Model Exchange and Co-Simulation. Units are SI; min and max are the closed "
+            "range a "
             "value must lie in (where the model needs a strict bound, e.g. 0 &lt; phi, the FMU also refuses the "
             "end itself at initialization, naming the variable)."
             + (" A load W of 0 N is taken as 1e-3 N (the contact needs a load to be defined)." if any(

@@ -230,6 +230,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="auto: omc where OpenModelica is on PATH, else the built-in rumoca/CasADi exporter")
     build.add_argument("--force", action="store_true", help="rebuild even when the FMU is up to date")
     build.add_argument("--jobs", type=int, default=None, help="parallel builds (default: number of CPUs)")
+    build.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
+                       help="2 (default): FMI 2.0 FMUs; 3: FMI 3.0 FMUs of the same model code (use another --out)")
     build.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     build.add_argument("--platforms", default="host", metavar="LIST",
                        help="binaries/ folders to build: host (default: this machine's, by $CC or cc), all "
@@ -650,7 +652,7 @@ def _build_fmus(args: argparse.Namespace) -> int:
     done["total"] = len(models) * done["per_fmu"]
     try:
         build_all(models, args.out, force=args.force, jobs=args.jobs, backend=args.backend, platforms=platforms,
-                  report=report, step=step)
+                  report=report, step=step, fmi_version=args.fmi_version)
     except (UnsupportedConstruct, ValueError, RuntimeError) as error:
         bar.close()
         print(f"rover-cosim build-fmus: {error}", file=sys.stderr)
