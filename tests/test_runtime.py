@@ -94,6 +94,12 @@ def test_runtime_compiles_without_warnings(single_wheel_folder):
                *[str(sources / f) for f in ("fmi2_api.c", "instance.c", "state.c", "cosim.c", "ode23s.c")]]
     result = subprocess.run(command, capture_output=True, text=True, check=False)
     assert result.returncode == 0, result.stderr
+    from rover_cosim.fmubuild.build import RUNTIME, fmi_headers
+
+    fmi3 = ["gcc", "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fsyntax-only",
+            "-I", str(sources), "-I", str(fmi_headers()), str(RUNTIME / "fmi3_api.c")]  # the FMI 3.0 layer too
+    result = subprocess.run(fmi3, capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr
 
 
 def test_generated_code_compiles_without_warnings(fmus, tmp_path):
