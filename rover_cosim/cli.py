@@ -390,7 +390,7 @@ def _run_system(args: argparse.Namespace, system, path: Path,  # noqa: ANN001 - 
     except ValueError as error:
         print(f"rover-cosim run: {error}", file=sys.stderr)
         return 2
-    problem = _unwritable(output) or (None if args.overwrite else _foreign(output, "run"))
+    problem = _unwritable(output, _run_bytes(system)) or (None if args.overwrite else _foreign(output, "run"))
     if problem:  # said before the run, not after it
         print(f"rover-cosim run: output {output}: {problem}", file=sys.stderr)
         return 2
@@ -412,6 +412,12 @@ def _run_system(args: argparse.Namespace, system, path: Path,  # noqa: ANN001 - 
         print(f"stopped: {result.stopped}")
     print(f"{result.steps} steps of {system.step:g} s ({system.algorithm}) in {result.wall_seconds:.2f} s")
     return 0
+
+
+def _run_bytes(system) -> float:  # noqa: ANN001 - System, imported lazily
+    """About the bytes of a run's CSV: its rows and recorded columns at ~25 characters a value."""
+    rows = (system.stop_time - system.start_time) / system.step / system.record_every + 2
+    return rows * (len(system.record) + 1) * 25
 
 
 def _cosim_study(args: argparse.Namespace) -> int:
@@ -517,8 +523,6 @@ def _montecarlo(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
     from rover_cosim.progress import ProgressBar
 
-    if not _output_folder(args.out, "montecarlo"):
-        return 2
     for option, value, least in (("--workers", args.workers, 1), ("--runs", args.runs, 1), ("--seed", args.seed, 0)):
         if value is not None and value < least:
             print(f"rover-cosim montecarlo: {option} {value}: expected >= {least}", file=sys.stderr)
@@ -527,6 +531,8 @@ def _montecarlo(args: argparse.Namespace) -> int:
         study = load_study(args.study, runs=args.runs, seed=args.seed)
     except StudyError as error:
         print(f"rover-cosim montecarlo: {error}", file=sys.stderr)
+        return 2
+    if not _output_folder(args.out, "montecarlo", NEEDS["montecarlo"] + MONTECARLO_RUN_BYTES * study.runs):
         return 2
     if not args.model.is_file():
         print(f"rover-cosim montecarlo: identified model {args.model} not found (make it with `rover-cosim identify`)",
@@ -638,7 +644,7 @@ def _report(args: argparse.Namespace) -> int:
         print(f"rover-cosim report: nothing to report in {args.results} (no results of fig3, identify or "
               "simulate; make them with `rover-cosim fig3`, `identify`, `simulate`)", file=sys.stderr)
         return 1
-    problem = _unwritable(target) or (None if args.overwrite else _foreign(target, "report"))
+    problem = _unwritable(target, NEEDS["report"]) or (None if args.overwrite else _foreign(target, "report"))
     if problem:
         print(f"rover-cosim report: --out {target}: {problem}", file=sys.stderr)
         return 2
@@ -685,27 +691,28 @@ def _foreign(target: Path, command: str) -> str | None:
     return (f"{target} exists and is not a result of rover-cosim {command}: pass --overwrite to replace it")
 
 
-def _unwritable(target: Path) -> str | None:
-    """Why ``target`` (a file to write) cannot be written, or None: a folder in its place, a file
-    where its folder should be, a folder we may not write."""
-    import os
-
-    if target.is_dir():
-        return "is a folder: expected a file name"
-    folder = target.parent
-    while not folder.exists() and folder != folder.parent:
-        folder = folder.parent
-    if not folder.is_dir():
-        return f"{folder} is a file, not a folder"
-    if not os.access(folder, os.W_OK | os.X_OK):
-        return f"the folder {folder} cannot be written"
-    return None
+#: Bytes a command's results take, about (with its run cache; checked against the free space before
+#: the work starts). The Monte Carlo adds MONTECARLO_RUN_BYTES per run, `run` its rows.
+NEEDS = {"fig3": 5e6, "identify": 80e6, "simulate": 60e6, "montecarlo": 10e6, "cosim-study": 5e6, "report": 20e6,
+         "export-ssp": 0.0}
+MONTECARLO_RUN_BYTES = 5e3
 
 
-def _output_folder(out: Path, command: str) -> bool:
-    """Whether ``out`` can be an output folder (absent or a folder); else says why (on stderr)."""
-    if out.exists() and not out.is_dir():
-        print(f"rover-cosim {command}: --out {out} is a file: expected a folder (absent or existing)", file=sys.stderr)
+def _unwritable(target: Path, need_bytes: float = 0) -> str | None:
+    """Why ``target`` (a file to write) cannot be written, or None (common.outputs.output_problem)."""
+    from rover_cosim.common.outputs import output_problem
+
+    return output_problem(target, folder=False, need_bytes=need_bytes)
+
+
+def _output_folder(out: Path, command: str, need_bytes: float | None = None) -> bool:
+    """Whether ``out`` can be an output folder (absent or a writable folder, with room for about
+    the command's results); else says why (on stderr)."""
+    from rover_cosim.common.outputs import output_problem
+
+    problem = output_problem(out, folder=True, need_bytes=NEEDS[command] if need_bytes is None else need_bytes)
+    if problem:
+        print(f"rover-cosim {command}: --out {out}: {problem}", file=sys.stderr)
         return False
     return True
 
@@ -792,10 +799,28 @@ def _terminate(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+def _result_sets(args: argparse.Namespace) -> int | None:
+    """How many result sets (common.outputs.write_all calls) make the command's results whole;
+    None: a command without results to write this way."""
+    if args.command == "simulate":
+        return 1 if args.only else 2
+    return None if args.command in ("soils", "blocks", "build-fmus", "export-ssp") else 1
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    """The command of ``argv`` (default: the process's arguments); its exit code. Run as the
+    process itself (argv None), a signal that comes once the code is known no longer changes it."""
+    code = _main(argv)
+    if argv is None and threading.current_thread() is threading.main_thread():
+        for number in (signal.SIGINT, signal.SIGTERM):  # the process only exits from here on
+            signal.signal(number, signal.SIG_IGN)
+    return code
+
+
+def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     from rover_cosim.common import figures
-    from rover_cosim.common.outputs import set_command_line
+    from rover_cosim.common.outputs import Busy, OutputError, committed, set_command_line, writing
 
     try:
         figures.configure(args.figures, args.dpi)
@@ -806,16 +831,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
-    from rover_cosim.common.outputs import Busy, writing
-
     target = getattr(args, "out", None) or getattr(args, "output", None)
+    before, needed = committed(), _result_sets(args)
     try:
         with writing(target, f"rover-cosim {args.command}") if target is not None else nullcontext():
             return COMMANDS[args.command](args)
     except Busy as busy:
         print(f"rover-cosim {args.command}: {busy}", file=sys.stderr)
         return 2
+    except OutputError as error:
+        print(f"rover-cosim {args.command}: {error}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
+        if needed is not None and committed() - before >= needed:  # the signal came after the results
+            print(f"rover-cosim {args.command}: interrupted after its results were written; they are whole",
+                  file=sys.stderr)
+            return 0
         print(f"rover-cosim {args.command}: interrupted; nothing more written", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader went away (`rover-cosim soils | head`)

@@ -83,7 +83,7 @@ def test_papercuts_are_messages_naming_the_value(tmp_path, capsys):
     existing.write_text("x")
     for command in (["fig3"], ["simulate"], ["identify"], ["cosim-study"]):
         assert main([*command, "--out", str(existing)]) == 2
-        assert f"--out {existing} is a file: expected a folder" in capsys.readouterr().err
+        assert f"--out {existing}: is a file: expected a folder" in capsys.readouterr().err
     assert existing.read_text() == "x"
     assert main(["fig3", "--soil", str(tmp_path / "nofile.toml"), "--out", str(tmp_path / "f")]) == 2
     assert "nofile.toml not found" in capsys.readouterr().err

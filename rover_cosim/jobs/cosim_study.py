@@ -117,5 +117,5 @@ def write_cosim_study(fmu_dir: Path, out_dir: Path,
     files = {out_dir / "coupling_error.csv": table.to_csv(index=False, float_format="%.6g").encode(),
              out_dir / "coupling_error.png": figure_png(table),
              out_dir / "coupling_error.json": json_bytes(record)}
-    write_all(files)
+    write_all(files, folder=out_dir, stale=("coupling_error.*",))
     return CosimStudyResult(table, list(files))
