@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import tempfile
@@ -17,6 +18,26 @@ from rover_cosim.orchestrator.examples import examples
 
 #: Example systems shipped with the package (FMU paths relative to --fmu-dir, default fmus/).
 EXAMPLES = examples()
+
+
+#: Bytes of one file name and of a whole path the file systems take (Linux: NAME_MAX, PATH_MAX).
+NAME_MAX, PATH_MAX = 255, 4096
+
+
+def _path_text(text: str) -> str:
+    """A path (or a name standing for one) as given, refused when the system could not open it
+    for its length: a name of more than NAME_MAX bytes, a path of more than PATH_MAX."""
+    longest = max((len(os.fsencode(part)) for part in Path(text).parts), default=0)
+    if longest > NAME_MAX or len(os.fsencode(text)) >= PATH_MAX:
+        shown = repr(text) if len(text) <= 60 else f"{text[:40]!r}...{text[-12:]!r} ({len(text)} characters)"
+        raise argparse.ArgumentTypeError(f"{shown}: too long for a file name (expected at most {NAME_MAX} bytes a "
+                                         f"name, {PATH_MAX - 1} a path)")
+    return text
+
+
+def _path(text: str) -> Path:
+    """A path option (checked as _path_text)."""
+    return Path(_path_text(text))
 
 
 def _positive_loads(text: str) -> tuple[float, ...]:
@@ -62,10 +83,10 @@ def _slip_range(text: str) -> tuple[float, float]:
 
 
 def _add_soil_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--soil", default=None, help="soil: a name of the shipped library "
+    parser.add_argument("--soil", type=_path_text, default=None, help="soil: a name of the shipped library "
                         "(rover-cosim soils lists them), a TOML file, or FILE:NAME (default: paper)")
-    parser.add_argument("--wheel", default=None, help="wheel: a name of the shipped library, a TOML file, or "
-                        "FILE:NAME (default: paper)")
+    parser.add_argument("--wheel", type=_path_text, default=None,
+                        help="wheel: a name of the shipped library, a TOML file, or FILE:NAME (default: paper)")
     parser.add_argument("--set", dest="assignments", action="append", default=[], metavar="KIND.NAME=VALUE",
                         help="change one value, SI units or *_deg for angles: --set soil.c=500 "
                         "--set soil.phi_deg=30 --set wheel.b=0.2 (repeatable)")
@@ -106,7 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     original = commands.add_parser
     commands.add_parser = lambda *a, **k: original(*a, formatter_class=_Help, **k)  # type: ignore[method-assign]
     fig3 = commands.add_parser("fig3", help="paper Fig. 3: Fx against slip for loads 100..800 N (numpy reference)")
-    fig3.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
+    fig3.add_argument("--out", type=_path, default=Path("results"), help="output folder (default: results)")
     fig3.add_argument("--loads", type=_positive_loads, default=None,
                       help="comma-separated wheel loads [N] (default: 100,200,...,800)")
     fig3.add_argument("--slip-step", type=_slip_step, default=0.01,
@@ -115,13 +136,14 @@ def build_parser() -> argparse.ArgumentParser:
                       help="slip ratios from FIRST to LAST in [-1, 1] (negative: braking; default: 0,0.9)")
     _add_soil_options(fig3)
     run = commands.add_parser("run", help="co-simulate a system file (TOML or SSP) -> CSV + JSON sidecar")
-    run.add_argument("system", help="system file (.toml, or an .ssp archive), one FMU (.fmu: run alone, with its "
+    run.add_argument("system", type=_path_text,
+                     help="system file (.toml, or an .ssp archive), one FMU (.fmu: run alone, with its "
                      "DefaultExperiment unless --stop-time/--step say otherwise), or the name of a shipped example: "
                      + ", ".join(EXAMPLES))
-    run.add_argument("-o", "--output", type=Path, default=None,
+    run.add_argument("-o", "--output", type=_path, default=None,
                      help="CSV (full precision) or .parquet to write (default: results/<system name>.csv); a .json "
                      "sidecar goes beside it")
-    run.add_argument("--fmu-dir", type=Path, default=None,
+    run.add_argument("--fmu-dir", type=_path, default=None,
                      help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
     run.add_argument("--algorithm", choices=("jacobi", "gauss-seidel", "iterative"), default=None,
                      help="override the system file's master algorithm")
@@ -138,7 +160,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--start", type=_assignment, action="append", metavar="NAME=VALUE",
                      help="one FMU run alone: a parameter or start value (repeatable; TOML values: 2.5, 3, true, "
                      "\"text\")")
-    run.add_argument("--input", type=Path, default=None, metavar="CSV",
+    run.add_argument("--input", type=_path, default=None, metavar="CSV",
                      help="one FMU run alone: input signals, first column time [s], one column per input "
                      "(continuous Real inputs interpolated, the others held; a repeated time is a step)")
     run.add_argument("--overwrite", action="store_true",
@@ -148,35 +170,36 @@ def build_parser() -> argparse.ArgumentParser:
 
     ssp = commands.add_parser("export-ssp", help="write a system file (TOML) as an SSP 1.0 archive (.ssp) that "
                               "FMPy, libcosim and OMSimulator read")
-    ssp.add_argument("system", help="system file, or the name of a shipped example: " + ", ".join(EXAMPLES))
-    ssp.add_argument("-o", "--output", type=Path, required=True, help="the .ssp archive to write")
+    ssp.add_argument("system", type=_path_text,
+                     help="system file, or the name of a shipped example: " + ", ".join(EXAMPLES))
+    ssp.add_argument("-o", "--output", type=_path, required=True, help="the .ssp archive to write")
     ssp.add_argument("--overwrite", action="store_true",
                      help="replace --output even if it is not an archive this command wrote")
-    ssp.add_argument("--fmu-dir", type=Path, default=None,
+    ssp.add_argument("--fmu-dir", type=_path, default=None,
                      help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
 
     study = commands.add_parser("cosim-study", help="coupling error of the co-simulated rover against the "
                                 "monolithic one, Jacobi, Gauss-Seidel and iterative, steps 1-10 ms -> CSV + PNG")
-    study.add_argument("--out", type=Path, default=Path("results/cosim_study"), help="output folder")
-    study.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
+    study.add_argument("--out", type=_path, default=Path("results/cosim_study"), help="output folder")
+    study.add_argument("--fmu-dir", type=_path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
     study.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
     ident = commands.add_parser("identify", help="paper Sec. 3: step-torque sweep on SingleWheel.fmu, LUT and "
                                 "Fx(W, slip) fits, validation at 275/575/875 N -> results/identification/")
-    ident.add_argument("--out", type=Path, default=Path("results/identification"), help="output folder")
-    ident.add_argument("--fmu", type=Path, default=Path("fmus/SingleWheel.fmu"), help="the test-bed FMU")
+    ident.add_argument("--out", type=_path, default=Path("results/identification"), help="output folder")
+    ident.add_argument("--fmu", type=_path, default=Path("fmus/SingleWheel.fmu"), help="the test-bed FMU")
     ident.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
     ident.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
-    ident.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    ident.add_argument("--cache", type=_path, default=None, help="run cache (default: <out>/cache)")
     _add_soil_options(ident)
     ident.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
     simulate = commands.add_parser("simulate", help="paper Sec. 4: closed-loop rover, 20 s, on Rover.fmu and on "
                                    "RoverBody + 6 Wheel; then the steerable rover following a turn and a lane "
                                    "change -> results/simulation/")
-    simulate.add_argument("--out", type=Path, default=Path("results/simulation"), help="output folder")
-    simulate.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are")
-    simulate.add_argument("--model", type=Path, default=Path("results/identification/model.json"),
+    simulate.add_argument("--out", type=_path, default=Path("results/simulation"), help="output folder")
+    simulate.add_argument("--fmu-dir", type=_path, default=Path("fmus"), help="where the FMUs are")
+    simulate.add_argument("--model", type=_path, default=Path("results/identification/model.json"),
                           help="identified model (from `rover-cosim identify`)")
     simulate.add_argument("--only", choices=("straight", "path"), default=None,
                           help="only the paper's straight run, or only the path following (default: both)")
@@ -191,18 +214,18 @@ def build_parser() -> argparse.ArgumentParser:
     monte = commands.add_parser("montecarlo", help="Monte Carlo over soil uncertainty: the paper's closed loop with "
                                 "the identified model on every sampled soil, local processes or a Dask cluster -> "
                                 "results/montecarlo/")
-    monte.add_argument("--study", default="lunar_regolith",
+    monte.add_argument("--study", type=_path_text, default="lunar_regolith",
                        help="study file (TOML), or a shipped study: lunar_regolith (default)")
-    monte.add_argument("--model", type=Path, default=Path("results/identification/model.json"),
+    monte.add_argument("--model", type=_path, default=Path("results/identification/model.json"),
                        help="identified model (from `rover-cosim identify` on the study's nominal soil)")
-    monte.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are")
-    monte.add_argument("--out", type=Path, default=Path("results/montecarlo"), help="output folder")
+    monte.add_argument("--fmu-dir", type=_path, default=Path("fmus"), help="where the FMUs are")
+    monte.add_argument("--out", type=_path, default=Path("results/montecarlo"), help="output folder")
     monte.add_argument("--runs", type=int, default=None, help="number of samples, the nominal included "
                        "(default: the study's)")
     monte.add_argument("--seed", type=int, default=None, help="random seed (default: the study's)")
     monte.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
     monte.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
-    monte.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    monte.add_argument("--cache", type=_path, default=None, help="run cache (default: <out>/cache)")
     monte.add_argument("--allow-model-mismatch", action="store_true",
                        help="use a model identified on another soil or wheel than the study's nominal ones "
                        "(refused otherwise; recorded)")
@@ -210,19 +233,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     soils = commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources; "
                                 "`soils NAME` shows one with every value and its unit")
-    soils.add_argument("name", nargs="?", default=None, help="a soil or wheel (shipped name, TOML file or FILE:NAME)")
+    soils.add_argument("name", nargs="?", type=_path_text, default=None,
+                       help="a soil or wheel (shipped name, TOML file or FILE:NAME)")
     commands.add_parser("blocks", help="the block types of system files, with their keys, units and defaults")
 
     report = commands.add_parser("report", help="results/report.html: figures and tables beside the paper's")
-    report.add_argument("--results", type=Path, default=Path("results"), help="the results folder")
-    report.add_argument("--out", type=Path, default=None, help="HTML file (default: <results>/report.html)")
+    report.add_argument("--results", type=_path, default=Path("results"), help="the results folder")
+    report.add_argument("--out", type=_path, default=None, help="HTML file (default: <results>/report.html)")
     report.add_argument("--overwrite", action="store_true",
                         help="replace --out even if it is not a report this command wrote")
 
     build = commands.add_parser("build-fmus", help="build the FMI 2.0 FMUs (ME + CS) from modelica/ into fmus/")
     build.add_argument("models", nargs="*", help="models to build (default: SingleWheel Rover RoverBody Wheel "
                        "SteerableRover SteerableRoverBody)")
-    build.add_argument("--out", type=Path, default=Path("fmus"), help="output folder (default: fmus)")
+    build.add_argument("--out", type=_path, default=Path("fmus"), help="output folder (default: fmus)")
     build.add_argument("--backend", default="auto", choices=("auto", "builtin", "omc"),
                        help="auto: omc where OpenModelica is on PATH, else the built-in rumoca/CasADi exporter")
     build.add_argument("--force", action="store_true", help="rebuild even when the FMU is up to date")

@@ -191,3 +191,18 @@ def test_a_scheduler_that_does_not_answer_is_named(monkeypatch):
     monkeypatch.setenv("ROVER_COSIM_SCHEDULER_TIMEOUT", "2")
     with pytest.raises(RuntimeError, match=r"Dask scheduler tcp://127.0.0.1:1: no Dask scheduler answered within 2 s"):
         list(parallel_map(time.sleep, [(0,)], scheduler="tcp://127.0.0.1:1"))
+
+
+@pytest.mark.parametrize(("command", "option"), [
+    (["montecarlo", "--study"], "--study"), (["montecarlo", "--model"], "--model"), (["identify", "--fmu"], "--fmu"),
+    (["simulate", "--fmu-dir"], "--fmu-dir"), (["report", "--results"], "--results"), (["run"], "system"),
+    (["soils"], "name"), (["fig3", "--soil"], "--soil"), (["fig3", "--out"], "--out"),
+    (["run", "x.toml", "-o"], "-o/--output")])
+@pytest.mark.parametrize("value", ["a" * 300, "/" + "b/" * 2100])
+def test_paths_too_long_for_the_file_system_are_named(command, option, value, capsys):
+    """Before: OSError (File name too long) tracebacks from the first look at the path."""
+    with pytest.raises(SystemExit) as ended:
+        main([*command, value])
+    assert ended.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert f"error: argument {option}: " in err and "too long for a file name (expected at most 255 bytes a name" in err
