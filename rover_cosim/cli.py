@@ -470,7 +470,8 @@ def _identify(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.identify import run_identification
     from rover_cosim.progress import ProgressBar
 
-    if not _output_folder(args.out, "identify"):
+    if not _output_folder(args.out, "identify") or (args.cache and not _output_folder(args.cache, "identify", 0,
+                                                                                       "--cache")):
         return 2
     if args.workers is not None and args.workers < 1:
         print(f"rover-cosim identify: --workers {args.workers}: expected >= 1", file=sys.stderr)
@@ -556,7 +557,8 @@ def _montecarlo(args: argparse.Namespace) -> int:
     except StudyError as error:
         print(f"rover-cosim montecarlo: {error}", file=sys.stderr)
         return 2
-    if not _output_folder(args.out, "montecarlo", NEEDS["montecarlo"] + MONTECARLO_RUN_BYTES * study.runs):
+    if not _output_folder(args.out, "montecarlo", NEEDS["montecarlo"] + MONTECARLO_RUN_BYTES * study.runs) or (
+            args.cache and not _output_folder(args.cache, "montecarlo", 0, "--cache")):
         return 2
     if not args.model.is_file():
         print(f"rover-cosim montecarlo: identified model {args.model} not found (make it with `rover-cosim identify`)",
@@ -729,14 +731,14 @@ def _unwritable(target: Path, need_bytes: float = 0) -> str | None:
     return output_problem(target, folder=False, need_bytes=need_bytes)
 
 
-def _output_folder(out: Path, command: str, need_bytes: float | None = None) -> bool:
+def _output_folder(out: Path, command: str, need_bytes: float | None = None, option: str = "--out") -> bool:
     """Whether ``out`` can be an output folder (absent or a writable folder, with room for about
     the command's results); else says why (on stderr)."""
     from rover_cosim.common.outputs import output_problem
 
     problem = output_problem(out, folder=True, need_bytes=NEEDS[command] if need_bytes is None else need_bytes)
     if problem:
-        print(f"rover-cosim {command}: --out {out}: {problem}", file=sys.stderr)
+        print(f"rover-cosim {command}: {option} {out}: {problem}", file=sys.stderr)
         return False
     return True
 

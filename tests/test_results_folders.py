@@ -214,3 +214,24 @@ def test_a_signal_before_the_results_are_written_exits_130_and_writes_nothing(tm
     assert done.returncode == 130, done.stderr
     assert "rover-cosim fig3: interrupted; nothing more written" in done.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_folder_whose_parent_cannot_be_written_is_written_file_by_file(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    write_all(_result(out, "A"), folder=out)
+
+    def refused(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202 - mkdtemp's arguments
+        raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(tmp_path))
+
+    monkeypatch.setattr(folders.tempfile, "mkdtemp", refused)
+    before = os.stat(out).st_ino
+    write_all(_result(out, "B"), folder=out)
+    assert os.stat(out).st_ino == before and _tree(out) == {"r.csv": b"B", "r.json": b"B", "fig_a.png": b"B"}
+
+
+def test_a_cache_folder_that_is_a_file_is_named_before_the_work(tmp_path, capsys):
+    cache = tmp_path / "cache"
+    cache.write_text("x")
+    assert cli.main(["identify", "--out", str(tmp_path / "ident"), "--cache", str(cache)]) == 2
+    assert capsys.readouterr().err.strip() == f"rover-cosim identify: --cache {cache}: is a file: expected a folder " \
+                                              "(absent or existing)"

@@ -54,8 +54,8 @@ def exchange(first: Path, second: Path) -> bool:
     if function(_AT_FDCWD, os.fsencode(first), _AT_FDCWD, os.fsencode(second), _RENAME_EXCHANGE) == 0:
         return True
     code = ctypes.get_errno()
-    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP):
-        return False
+    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP, errno.EXDEV, errno.EBUSY, errno.EPERM, errno.EACCES):
+        return False  # not here: no such call or file system support, a mount point, a sticky folder
     raise OSError(code, os.strerror(code), str(first), None, str(second))
 
 
@@ -82,7 +82,10 @@ def exchange_folder(folder: Path, write: Callable[[Path], Collection[Path]], sta
         return False
     folder.parent.mkdir(parents=True, exist_ok=True)
     remove_stale_folders(folder.parent, prefix=f".{folder.name}.")
-    staging = Path(tempfile.mkdtemp(prefix=f".{folder.name}.{scratch_prefix('swap')}", dir=folder.parent))
+    try:
+        staging = Path(tempfile.mkdtemp(prefix=f".{folder.name}.{scratch_prefix('swap')}", dir=folder.parent))
+    except PermissionError:  # the folder's parent is not ours to write: the folder itself may be
+        return False
     try:
         written = {Path(p) for p in write(staging)}
         if not folder.exists():
