@@ -25,8 +25,11 @@ NAME_MAX, PATH_MAX = 255, 4096
 
 
 def _path_text(text: str) -> str:
-    """A path (or a name standing for one) as given, refused when the system could not open it
-    for its length: a name of more than NAME_MAX bytes, a path of more than PATH_MAX."""
+    """A path (or a name standing for one) as given, refused when empty (an empty --out would be
+    the current folder, an empty --soil the paper's) or when the system could not open it for its
+    length: a name of more than NAME_MAX bytes, a path of more than PATH_MAX."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a path or a name (empty)")
     longest = max((len(os.fsencode(part)) for part in Path(text).parts), default=0)
     if longest > NAME_MAX or len(os.fsencode(text)) >= PATH_MAX:
         shown = repr(text) if len(text) <= 60 else f"{text[:40]!r}...{text[-12:]!r} ({len(text)} characters)"

@@ -206,3 +206,14 @@ def test_paths_too_long_for_the_file_system_are_named(command, option, value, ca
     assert ended.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert f"error: argument {option}: " in err and "too long for a file name (expected at most 255 bytes a name" in err
+
+
+@pytest.mark.parametrize(("command", "option"), [(["fig3", "--out"], "--out"), (["fig3", "--soil"], "--soil"),
+                                                 (["fig3", "--wheel"], "--wheel"), (["run"], "system"),
+                                                 (["identify", "--cache"], "--cache")])
+def test_an_empty_path_is_refused_not_taken_as_the_current_folder_or_the_default(command, option, capsys):
+    """Before: fig3 --out '' wrote into the current folder, --soil '' and --wheel '' ran the paper's."""
+    with pytest.raises(SystemExit) as ended:
+        main([*command, ""])
+    assert ended.value.code == 2
+    assert f"error: argument {option}: '': expected a path or a name (empty)" in capsys.readouterr().err

@@ -52,7 +52,7 @@ def test_system_files_with_odd_values_end_in_a_message(fmu_dir, fmus):
     for case in range(300):
         data = copy.deepcopy(base)
         for _ in range(rng.randint(1, 3)):
-            _set(data, rng.choice(_paths(data) or paths), rng.choice(ODD))
+            _set(data, rng.choice(_paths(data) or paths), copy.deepcopy(rng.choice(ODD)))  # not ODD's own list
         try:
             system_from_dict(data, name=f"fuzz case {case}", base=fmu_dir)
         except SystemFileError:
