@@ -235,3 +235,13 @@ def test_a_cache_folder_that_is_a_file_is_named_before_the_work(tmp_path, capsys
     assert cli.main(["identify", "--out", str(tmp_path / "ident"), "--cache", str(cache)]) == 2
     assert capsys.readouterr().err.strip() == f"rover-cosim identify: --cache {cache}: is a file: expected a folder " \
                                               "(absent or existing)"
+
+
+def test_only_complete_results_count_as_written(tmp_path):
+    """The rows kept of a failed run (complete=False) do not make a later signal exit 0."""
+    before = outputs.committed()
+    write_all({tmp_path / "run.partial.csv": b"t\n0\n"}, complete=False)
+    assert outputs.committed() == before
+    write_all(_result(tmp_path / "out", "A"), folder=tmp_path / "out")
+    write_all({tmp_path / "run.csv": b"t\n0\n"})
+    assert outputs.committed() == before + 2

@@ -29,7 +29,8 @@ class OutputError(Exception):
     where they were saved instead."""
 
 
-def write_all(files: Mapping[Path, bytes], folder: Path | None = None, stale: Collection[str] = ()) -> None:
+def write_all(files: Mapping[Path, bytes], folder: Path | None = None, stale: Collection[str] = (),
+              complete: bool = True) -> None:
     """Write every file or none of them.
 
     ``folder`` given (a results folder of one command, holding every file of ``files``): the
@@ -44,17 +45,19 @@ def write_all(files: Mapping[Path, bytes], folder: Path | None = None, stale: Co
 
     A failure leaves the previous results and no stray temporary, and raises OutputError naming
     a folder (in the temporary folder, else the home folder) where the new files were saved.
+    ``complete``: the files are a command's result set (counted by :func:`committed`), not what
+    is kept of a failed run.
     """
     files = _with_other_renderings(files)
     try:
-        if folder is None or not _exchange(Path(folder), files, stale):
-            _rename_each(files)
+        if folder is None or not _exchange(Path(folder), files, stale, complete):
+            _rename_each(files, complete)
     except OSError as error:
         raise OutputError(_saved(files, folder, error)) from None
 
 
 def committed() -> int:
-    """How many result sets this process has written (write_all calls that completed)."""
+    """How many result sets this process has written (write_all calls of complete results)."""
     return _COMMITTED
 
 
@@ -86,7 +89,7 @@ def _signals_held() -> Iterator[None]:
                 os.kill(os.getpid(), number)
 
 
-def _exchange(folder: Path, files: Mapping[Path, bytes], stale: Collection[str]) -> bool:
+def _exchange(folder: Path, files: Mapping[Path, bytes], stale: Collection[str], complete: bool) -> bool:
     """``files`` written by replacing ``folder`` as one unit; False where it cannot be."""
     global _COMMITTED
     relative = {target: Path(target).relative_to(folder) for target in files}
@@ -103,11 +106,11 @@ def _exchange(folder: Path, files: Mapping[Path, bytes], stale: Collection[str])
         return False
     with _folder_locks([folder]), _signals_held():
         done = exchange_folder(folder, write, stale)
-        _COMMITTED += done
+        _COMMITTED += done and complete
     return done
 
 
-def _rename_each(files: Mapping[Path, bytes]) -> None:
+def _rename_each(files: Mapping[Path, bytes], complete: bool) -> None:
     """Temporaries beside the targets, renamed into place under the folders' locks."""
     global _COMMITTED
     staged: list[tuple[Path, Path]] = []
@@ -122,7 +125,7 @@ def _rename_each(files: Mapping[Path, bytes]) -> None:
         with _folder_locks(sorted({target.parent for _, target in staged})), _signals_held():
             for temporary, target in staged:
                 os.replace(temporary, target)
-            _COMMITTED += 1
+            _COMMITTED += complete
     finally:
         for temporary, _ in staged:
             temporary.unlink(missing_ok=True)
