@@ -43,6 +43,15 @@ def _path(text: str) -> Path:
     return Path(_path_text(text))
 
 
+def _scheduler(text: str) -> str:
+    """A Dask scheduler's address: [PROTOCOL://]HOST:PORT (tcp://10.0.0.5:8786, tls://[::1]:8786)."""
+    import re
+
+    if not re.fullmatch(r"([a-z][a-z0-9+.-]*://)?(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+):\d{1,5}", text):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a Dask scheduler's address, e.g. tcp://host:8786")
+    return text
+
+
 def _positive_loads(text: str) -> tuple[float, ...]:
     try:
         loads = tuple(float(part) for part in text.split(","))
@@ -192,7 +201,7 @@ def build_parser() -> argparse.ArgumentParser:
     ident.add_argument("--out", type=_path, default=Path("results/identification"), help="output folder")
     ident.add_argument("--fmu", type=_path, default=Path("fmus/SingleWheel.fmu"), help="the test-bed FMU")
     ident.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
-    ident.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
+    ident.add_argument("--scheduler", type=_scheduler, default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
     ident.add_argument("--cache", type=_path, default=None, help="run cache (default: <out>/cache)")
     _add_soil_options(ident)
     ident.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -227,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "(default: the study's)")
     monte.add_argument("--seed", type=int, default=None, help="random seed (default: the study's)")
     monte.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
-    monte.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
+    monte.add_argument("--scheduler", type=_scheduler, default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
     monte.add_argument("--cache", type=_path, default=None, help="run cache (default: <out>/cache)")
     monte.add_argument("--allow-model-mismatch", action="store_true",
                        help="use a model identified on another soil or wheel than the study's nominal ones "
@@ -455,6 +464,10 @@ def _cosim_study(args: argparse.Namespace) -> int:
 
     if not _output_folder(args.out, "cosim-study"):
         return 2
+    if not args.fmu_dir.is_dir():
+        print(f"rover-cosim cosim-study: --fmu-dir {args.fmu_dir}: no such folder (build the FMUs with "
+              "`rover-cosim build-fmus`)", file=sys.stderr)
+        return 2
     bar = ProgressBar("cosim-study", enabled=not args.quiet)
     try:
         outcome = write_cosim_study(args.fmu_dir, args.out, progress=bar)
@@ -509,7 +522,7 @@ def _identify(args: argparse.Namespace) -> int:
 
 def _simulate(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.path_following import run_path_following
-    from rover_cosim.jobs.simulate import run_simulation
+    from rover_cosim.jobs.simulate import run_simulation, steps_between_rows
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
     from rover_cosim.progress import ProgressBar
@@ -523,6 +536,11 @@ def _simulate(args: argparse.Namespace) -> int:
     if not args.model.is_file():
         print(f"rover-cosim simulate: identified model {args.model} not found (make it with `rover-cosim identify`)",
               file=sys.stderr)
+        return 2
+    try:
+        steps_between_rows(args.record_interval)
+    except ValueError as error:
+        print(f"rover-cosim simulate: --record-interval: {error}", file=sys.stderr)
         return 2
     choice = _choice(args, "simulate")
     if choice is None:
@@ -652,6 +670,10 @@ def _build_fmus(args: argparse.Namespace) -> int:
 
     if args.jobs is not None and args.jobs < 1:
         print(f"rover-cosim build-fmus: --jobs {args.jobs}: expected >= 1", file=sys.stderr)
+        return 2
+    unknown = [name for name in args.models if name not in FMU_MODELS]
+    if unknown:
+        print(f"rover-cosim build-fmus: model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}", file=sys.stderr)
         return 2
     try:
         build_all(tuple(args.models) or FMU_MODELS, args.out, force=args.force, jobs=args.jobs,

@@ -217,3 +217,32 @@ def test_an_empty_path_is_refused_not_taken_as_the_current_folder_or_the_default
         main([*command, ""])
     assert ended.value.code == 2
     assert f"error: argument {option}: '': expected a path or a name (empty)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("arguments", "message"), [
+    (["simulate", "--record-interval", "inf"], "rover-cosim simulate: --record-interval: record interval inf s: "
+                                                "expected a whole number of steps of 0.001 s"),
+    (["simulate", "--record-interval", "-1"], "rover-cosim simulate: --record-interval: record interval -1.0 s: "
+                                               "expected a whole number of steps of 0.001 s"),
+    (["build-fmus", "Nope"], "rover-cosim build-fmus: model 'Nope': expected one of SingleWheel, Rover"),
+    (["cosim-study", "--fmu-dir", "/nonexistent"], "rover-cosim cosim-study: --fmu-dir /nonexistent: no such folder"),
+])
+def test_bad_input_found_by_the_fuzz_is_refused_before_the_work(arguments, message, tmp_path, capsys):
+    """Before: simulate --record-interval inf an OverflowError traceback; -1, an unknown model of
+    build-fmus and a missing --fmu-dir of cosim-study exit 1 (the work failed) after starting it."""
+    (tmp_path / "model.json").write_text("{}")
+    extra = {"simulate": ["--fmu-dir", str(tmp_path), "--model", str(tmp_path / "model.json")]}.get(arguments[0], [])
+    assert main([*arguments, *extra, "--out", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err.startswith(message)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("address", ["5000", "/etc/passwd", "soil.c=800", "tcp://host", "host:port"])
+def test_a_scheduler_that_is_not_an_address_is_refused_at_once(address, capsys):
+    """Before: "no Dask scheduler answered within 30 s (ValueError: missing port number ...)", exit 1."""
+    for command in ("identify", "montecarlo"):
+        with pytest.raises(SystemExit) as ended:
+            main([command, "--scheduler", address])
+        assert ended.value.code == 2
+        assert f"argument --scheduler: {address!r}: expected a Dask scheduler's address, e.g. tcp://host:8786" in \
+            capsys.readouterr().err
