@@ -246,3 +246,10 @@ def test_a_scheduler_that_is_not_an_address_is_refused_at_once(address, capsys):
         assert ended.value.code == 2
         assert f"argument --scheduler: {address!r}: expected a Dask scheduler's address, e.g. tcp://host:8786" in \
             capsys.readouterr().err
+
+
+def test_a_monte_carlo_of_absurdly_many_runs_is_refused_naming_the_limit(tmp_path, capsys):
+    """Before: --runs 10**30 reached the free-space check ("needs about 5e27 MB")."""
+    assert main(["montecarlo", "--runs", str(10**30), "--out", str(tmp_path / "mc")]) == 2
+    assert f"runs = {10**30}: expected a whole number from 1 (the nominal included) to 1,000,000" in \
+        capsys.readouterr().err
