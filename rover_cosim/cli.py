@@ -870,21 +870,31 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
-    from rover_cosim.common import figures
-    from rover_cosim.common.outputs import Busy, OutputError, committed, set_command_line, writing
-
-    try:
-        figures.configure(args.figures, args.dpi)
-    except ValueError as error:
-        print(f"rover-cosim: {error}", file=sys.stderr)
-        return 2
-
-    set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
-    target = getattr(args, "out", None) or getattr(args, "output", None)
+    try:
+        return _command(args, argv)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _command(args: argparse.Namespace, argv: Sequence[str] | None) -> int:
+    """The command of ``args`` with its output held (a second writer refused), and the exit code
+    of how it ended."""
+    from rover_cosim.common.outputs import Busy, OutputError, committed, set_command_line, writing
+
     before, needed = committed(), _result_sets(args)
     try:
+        from rover_cosim.common import figures  # matplotlib: a while to import, a signal may come meanwhile
+
+        try:
+            figures.configure(args.figures, args.dpi)
+        except ValueError as error:
+            print(f"rover-cosim: {error}", file=sys.stderr)
+            return 2
+        set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
+        target = getattr(args, "out", None) or getattr(args, "output", None)
         with writing(target, f"rover-cosim {args.command}") if target is not None else nullcontext():
             return COMMANDS[args.command](args)
     except Busy as busy:
@@ -893,7 +903,9 @@ def _main(argv: Sequence[str] | None) -> int:
     except OutputError as error:
         print(f"rover-cosim {args.command}: {error}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, ImportError) as error:
+        if isinstance(error, ImportError) and not _cut_short(error):
+            raise
         if needed is not None and committed() - before >= needed:  # the signal came after the results
             print(f"rover-cosim {args.command}: interrupted after its results were written; they are whole",
                   file=sys.stderr)
@@ -903,9 +915,17 @@ def _main(argv: Sequence[str] | None) -> int:
     except BrokenPipeError:  # the reader went away (`rover-cosim soils | head`)
         sys.stderr.close()
         return 0
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+
+
+def _cut_short(error: BaseException) -> bool:
+    """Whether ``error`` (an ImportError) comes of a KeyboardInterrupt: a C extension whose
+    initialisation a signal interrupted reports "initialization failed" instead."""
+    seen: BaseException | None = error
+    while seen is not None:
+        if isinstance(seen, KeyboardInterrupt):
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return False
 
 
 if __name__ == "__main__":

@@ -245,3 +245,24 @@ def test_only_complete_results_count_as_written(tmp_path):
     write_all(_result(tmp_path / "out", "A"), folder=tmp_path / "out")
     write_all({tmp_path / "run.csv": b"t\n0\n"})
     assert outputs.committed() == before + 2
+
+
+def test_an_import_cut_short_by_a_signal_is_an_interruption_not_a_traceback(monkeypatch, capsys):
+    """A signal during the import of a C extension (matplotlib's ft2font, a pybind11 module)
+    arrives as ImportError("initialization failed") raised from the KeyboardInterrupt."""
+    def import_cut_short(args):  # noqa: ANN001, ANN202 - a command's signature
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as interrupt:
+            raise ImportError("initialization failed") from interrupt
+
+    monkeypatch.setitem(cli.COMMANDS, "blocks", import_cut_short)
+    assert cli.main(["blocks"]) == 130
+    assert capsys.readouterr().err == "rover-cosim blocks: interrupted; nothing more written\n"
+
+    def import_broken(args):  # noqa: ANN001, ANN202
+        raise ImportError("no module named nowhere")
+
+    monkeypatch.setitem(cli.COMMANDS, "blocks", import_broken)
+    with pytest.raises(ImportError, match="nowhere"):  # a real import error is not hidden as an interruption
+        cli.main(["blocks"])
