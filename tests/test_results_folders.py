@@ -266,3 +266,36 @@ def test_an_import_cut_short_by_a_signal_is_an_interruption_not_a_traceback(monk
     monkeypatch.setitem(cli.COMMANDS, "blocks", import_broken)
     with pytest.raises(ImportError, match="nowhere"):  # a real import error is not hidden as an interruption
         cli.main(["blocks"])
+
+
+def test_lock_files_are_removed_and_still_exclude(tmp_path, monkeypatch, capsys):
+    """Before: every output path ever written left a lock file or two in the temporary folder
+    (2,053 after a fuzz). Removing them must not let two holders in at once: a lock file's holder
+    removes it, a waiter that locked the removed file takes the new one."""
+    import threading
+    import time
+
+    from rover_cosim.common import locks
+
+    (tmp_path / "tmp").mkdir()
+    monkeypatch.setenv("TMPDIR", str(tmp_path / "tmp"))
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    assert cli.main([*FIG3, "--out", str(tmp_path / "out")]) == 0
+    assert not [p.name for p in (tmp_path / "tmp").iterdir()]
+    counter = tmp_path / "counter"
+    counter.write_text("0")
+
+    def add_one() -> None:
+        for _ in range(20):
+            with locks.folder_locks([tmp_path / "shared"]):
+                value = int(counter.read_text())
+                time.sleep(0.001)  # another holder would read the same value meanwhile
+                counter.write_text(str(value + 1))
+
+    threads = [threading.Thread(target=add_one) for _ in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert counter.read_text() == "80"
+    assert not [p.name for p in (tmp_path / "tmp").iterdir()]

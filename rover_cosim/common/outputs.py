@@ -13,12 +13,15 @@ import sys
 import tempfile
 import threading
 from collections.abc import Collection, Iterator, Mapping, Sequence
-from contextlib import ExitStack, contextmanager
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 
 from .folders import exchange_folder
+from .locks import Busy as Busy  # noqa: F401 - re-exported: the CLI takes them from here
+from .locks import folder_locks
+from .locks import writing as writing  # noqa: F401
 from .scratch import UMASK
 
 PACKAGES = ("rover-cosim", "numpy", "scipy", "pandas", "matplotlib", "fmpy", "casadi", "rumoca")
@@ -104,7 +107,7 @@ def _exchange(folder: Path, files: Mapping[Path, bytes], stale: Collection[str],
 
     if any(".." in path.parts or path.is_absolute() for path in relative.values()):
         return False
-    with _folder_locks([folder]), _signals_held():
+    with folder_locks([folder]), _signals_held():
         done = exchange_folder(folder, write, stale)
         _COMMITTED += done and complete
     return done
@@ -122,7 +125,7 @@ def _rename_each(files: Mapping[Path, bytes], complete: bool) -> None:
             with os.fdopen(handle, "wb") as stream:
                 stream.write(payload)
             os.chmod(name, result_mode())  # mkstemp makes 0600; results are ordinary files
-        with _folder_locks(sorted({target.parent for _, target in staged})), _signals_held():
+        with folder_locks(sorted({target.parent for _, target in staged})), _signals_held():
             for temporary, target in staged:
                 os.replace(temporary, target)
             _COMMITTED += complete
@@ -176,34 +179,6 @@ def output_problem(path: Path, folder: bool, need_bytes: float = 0) -> str | Non
         return (f"{free / 1e6:.1f} MB free on the file system of {existing}; the results need about "
                 f"{need_bytes / 1e6:.1f} MB")
     return None
-
-
-def _lock_file(target: Path, kind: str) -> Path:
-    """The lock file of ``target`` (kind: lock, for the renames; busy, for a whole command), in the
-    temporary folder, named by the digest of the target's path."""
-    name = hashlib.sha256(str(target.resolve()).encode()).hexdigest()[:24]
-    return Path(tempfile.gettempdir()) / f"rover-cosim-{kind}-{name}"
-
-
-@contextmanager
-def _folder_locks(folders: list[Path]) -> Iterator[None]:
-    """Exclusive locks (flock) on ``folders`` (taken in order, so two writers cannot deadlock);
-    where there is no flock (Windows) or the lock file cannot be opened (another user's), the
-    renames go on without it."""
-    try:
-        import fcntl
-    except ImportError:  # not POSIX
-        yield
-        return
-    with ExitStack() as stack:
-        for folder in folders:
-            try:
-                handle = stack.enter_context(open(_lock_file(folder, "lock"), "a"))  # noqa: SIM115 - held open while locked
-            except OSError:
-                continue
-            fcntl.flock(handle, fcntl.LOCK_EX)
-            stack.callback(fcntl.flock, handle, fcntl.LOCK_UN)
-        yield
 
 
 def result_mode() -> int:
@@ -285,41 +260,3 @@ def summary_repr(kind: str, files: Sequence[Path] | None = None, **facts: object
         parts.append(f"{len(files)} files in {', '.join(folders)}")
     parts += [f"{key}={value}" for key, value in facts.items()]
     return f"{kind}({'; '.join(parts)})"
-
-
-class Busy(RuntimeError):
-    """Another command is writing the same results; the message names it and its PID."""
-
-
-@contextmanager
-def writing(target: Path, command: str) -> Iterator[None]:
-    """Hold ``target`` (a results folder or file) for ``command`` while it computes and writes:
-    a second command on the same target is refused (Busy, naming the first and its PID) instead
-    of the two mixing their files. Best effort where there is no flock (Windows)."""
-    try:
-        import fcntl
-    except ImportError:
-        yield
-        return
-    try:
-        handle = open(_lock_file(Path(target), "busy"), "a+")  # noqa: SIM115 - held for the whole command
-    except OSError:
-        yield
-        return
-    with handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            handle.seek(0)
-            holder = handle.read().strip() or "another process"
-            raise Busy(f"{target} is being written by {holder}; wait for it to end, or write elsewhere") from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(f"PID {os.getpid()} ({command})")
-        handle.flush()
-        try:
-            yield
-        finally:
-            handle.seek(0)
-            handle.truncate()
-            fcntl.flock(handle, fcntl.LOCK_UN)
