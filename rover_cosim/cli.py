@@ -533,14 +533,12 @@ def _simulate(args: argparse.Namespace) -> int:
         print(f"rover-cosim simulate: --fmu-dir {args.fmu_dir}: no such folder (build the FMUs with "
               "`rover-cosim build-fmus`)", file=sys.stderr)
         return 2
-    if not args.model.is_file():
-        print(f"rover-cosim simulate: identified model {args.model} not found (make it with `rover-cosim identify`)",
-              file=sys.stderr)
-        return 2
     try:
         steps_between_rows(args.record_interval)
     except ValueError as error:
         print(f"rover-cosim simulate: --record-interval: {error}", file=sys.stderr)
+        return 2
+    if not _model_readable(args.model, "simulate"):
         return 2
     choice = _choice(args, "simulate")
     if choice is None:
@@ -565,6 +563,18 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _model_readable(path: Path, command: str) -> bool:
+    """Whether ``path`` is an identified model (read whole, as the command will); else says why."""
+    from rover_cosim.identification.model_set import ModelFileError, ModelSet
+
+    try:
+        ModelSet.read(path)
+    except ModelFileError as error:
+        print(f"rover-cosim {command}: {error}", file=sys.stderr)
+        return False
+    return True
+
+
 def _montecarlo(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
     from rover_cosim.progress import ProgressBar
@@ -581,9 +591,7 @@ def _montecarlo(args: argparse.Namespace) -> int:
     if not _output_folder(args.out, "montecarlo", NEEDS["montecarlo"] + MONTECARLO_RUN_BYTES * study.runs) or (
             args.cache and not _output_folder(args.cache, "montecarlo", 0, "--cache")):
         return 2
-    if not args.model.is_file():
-        print(f"rover-cosim montecarlo: identified model {args.model} not found (make it with `rover-cosim identify`)",
-              file=sys.stderr)
+    if not _model_readable(args.model, "montecarlo"):
         return 2
     bar = ProgressBar("montecarlo", enabled=not args.quiet)
     try:

@@ -226,14 +226,20 @@ def test_an_empty_path_is_refused_not_taken_as_the_current_folder_or_the_default
                                                "expected a whole number of steps of 0.001 s"),
     (["build-fmus", "Nope"], "rover-cosim build-fmus: model 'Nope': expected one of SingleWheel, Rover"),
     (["cosim-study", "--fmu-dir", "/nonexistent"], "rover-cosim cosim-study: --fmu-dir /nonexistent: no such folder"),
+    (["simulate", "--model", "TEXT"], "rover-cosim simulate: TEXT: not a JSON file"),
+    (["montecarlo", "--model", "TEXT"], "rover-cosim montecarlo: TEXT: not a JSON file"),
 ])
 def test_bad_input_found_by_the_fuzz_is_refused_before_the_work(arguments, message, tmp_path, capsys):
     """Before: simulate --record-interval inf an OverflowError traceback; -1, an unknown model of
-    build-fmus and a missing --fmu-dir of cosim-study exit 1 (the work failed) after starting it."""
+    build-fmus, a missing --fmu-dir of cosim-study and an identified model that is not one exit 1
+    (the work failed) after starting it."""
     (tmp_path / "model.json").write_text("{}")
     extra = {"simulate": ["--fmu-dir", str(tmp_path), "--model", str(tmp_path / "model.json")]}.get(arguments[0], [])
+    extra = extra if "--model" not in arguments else extra[:2]
+    (tmp_path / "text.json").write_text("not JSON\n")
+    arguments = [str(tmp_path / "text.json") if a == "TEXT" else a for a in arguments]
     assert main([*arguments, *extra, "--out", str(tmp_path / "out")]) == 2
-    assert capsys.readouterr().err.startswith(message)
+    assert capsys.readouterr().err.startswith(message.replace("TEXT", str(tmp_path / "text.json")))
     assert not (tmp_path / "out").exists()
 
 
