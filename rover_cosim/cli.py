@@ -496,6 +496,10 @@ def _identify(args: argparse.Namespace) -> int:
         print(f"rover-cosim identify: FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)",
               file=sys.stderr)
         return 2
+    if not _is_fmu(args.fmu):
+        print(f"rover-cosim identify: --fmu {args.fmu}: not an FMU (expected a zip archive holding a "
+              "modelDescription.xml, e.g. fmus/SingleWheel.fmu)", file=sys.stderr)
+        return 2
     choice = _choice(args, "identify")
     if choice is None:
         return 2
@@ -518,6 +522,17 @@ def _identify(args: argparse.Namespace) -> int:
     for path in outcome.files:
         print(f"wrote {path}")
     return 0
+
+
+def _is_fmu(path: Path) -> bool:
+    """Whether ``path`` is an FMU: a zip archive with a modelDescription.xml."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as archive:
+            return "modelDescription.xml" in archive.namelist()
+    except (OSError, zipfile.BadZipFile):
+        return False
 
 
 def _simulate(args: argparse.Namespace) -> int:

@@ -226,13 +226,15 @@ def test_an_empty_path_is_refused_not_taken_as_the_current_folder_or_the_default
                                                "expected a whole number of steps of 0.001 s"),
     (["build-fmus", "Nope"], "rover-cosim build-fmus: model 'Nope': expected one of SingleWheel, Rover"),
     (["cosim-study", "--fmu-dir", "/nonexistent"], "rover-cosim cosim-study: --fmu-dir /nonexistent: no such folder"),
+    (["identify", "--fmu", "TEXT"], "rover-cosim identify: --fmu TEXT: not an FMU (expected a zip archive holding a "
+                                    "modelDescription.xml"),
     (["simulate", "--model", "TEXT"], "rover-cosim simulate: TEXT: not a JSON file"),
     (["montecarlo", "--model", "TEXT"], "rover-cosim montecarlo: TEXT: not a JSON file"),
 ])
 def test_bad_input_found_by_the_fuzz_is_refused_before_the_work(arguments, message, tmp_path, capsys):
     """Before: simulate --record-interval inf an OverflowError traceback; -1, an unknown model of
-    build-fmus, a missing --fmu-dir of cosim-study and an identified model that is not one exit 1
-    (the work failed) after starting it."""
+    build-fmus, a missing --fmu-dir of cosim-study, an identified model that is not one and an
+    FMU that is not one (identify's every run failing) exit 1 (the work failed) after starting it."""
     (tmp_path / "model.json").write_text("{}")
     extra = {"simulate": ["--fmu-dir", str(tmp_path), "--model", str(tmp_path / "model.json")]}.get(arguments[0], [])
     extra = extra if "--model" not in arguments else extra[:2]
