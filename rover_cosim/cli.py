@@ -457,7 +457,7 @@ def _run_bytes(system) -> float:  # noqa: ANN001 - System, imported lazily
 
 
 def _cosim_study(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.cosim_study import write_cosim_study
+    from rover_cosim.jobs.cosim_study import systems, write_cosim_study
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
     from rover_cosim.progress import ProgressBar
@@ -467,6 +467,11 @@ def _cosim_study(args: argparse.Namespace) -> int:
     if not args.fmu_dir.is_dir():
         print(f"rover-cosim cosim-study: --fmu-dir {args.fmu_dir}: no such folder (build the FMUs with "
               "`rover-cosim build-fmus`)", file=sys.stderr)
+        return 2
+    try:
+        systems(args.fmu_dir)  # its FMUs there
+    except SystemFileError as error:
+        print(f"rover-cosim cosim-study: --fmu-dir {args.fmu_dir}: {error}", file=sys.stderr)
         return 2
     bar = ProgressBar("cosim-study", enabled=not args.quiet)
     try:

@@ -226,6 +226,7 @@ def test_an_empty_path_is_refused_not_taken_as_the_current_folder_or_the_default
                                                "expected a whole number of steps of 0.001 s"),
     (["build-fmus", "Nope"], "rover-cosim build-fmus: model 'Nope': expected one of SingleWheel, Rover"),
     (["cosim-study", "--fmu-dir", "/nonexistent"], "rover-cosim cosim-study: --fmu-dir /nonexistent: no such folder"),
+    (["cosim-study", "--fmu-dir", "TMP"], "rover-cosim cosim-study: --fmu-dir TMP: /"),  # a folder without the FMUs
     (["identify", "--fmu", "TEXT"], "rover-cosim identify: --fmu TEXT: not an FMU (expected a zip archive holding a "
                                     "modelDescription.xml"),
     (["simulate", "--model", "TEXT"], "rover-cosim simulate: TEXT: not a JSON file"),
@@ -239,9 +240,12 @@ def test_bad_input_found_by_the_fuzz_is_refused_before_the_work(arguments, messa
     extra = {"simulate": ["--fmu-dir", str(tmp_path), "--model", str(tmp_path / "model.json")]}.get(arguments[0], [])
     extra = extra if "--model" not in arguments else extra[:2]
     (tmp_path / "text.json").write_text("not JSON\n")
-    arguments = [str(tmp_path / "text.json") if a == "TEXT" else a for a in arguments]
+    named = {"TEXT": str(tmp_path / "text.json"), "TMP": str(tmp_path)}
+    arguments = [named.get(a, a) for a in arguments]
     assert main([*arguments, *extra, "--out", str(tmp_path / "out")]) == 2
-    assert capsys.readouterr().err.startswith(message.replace("TEXT", str(tmp_path / "text.json")))
+    err = capsys.readouterr().err
+    assert err.startswith(message.replace("TEXT", named["TEXT"]).replace("TMP", named["TMP"])), err
+    assert "Rover.fmu not found" in err or "TMP" not in message
     assert not (tmp_path / "out").exists()
 
 
