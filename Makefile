@@ -21,13 +21,16 @@ SOIL ?= paper
 WHEEL ?= paper
 SOIL_OPTIONS := --soil $(SOIL) --wheel $(WHEEL)
 FMU_NAMES := SingleWheel Rover RoverBody Wheel SteerableRover SteerableRoverBody
+# binaries/ folders of the FMUs: host (this machine's, by cc), all (linux64 for glibc 2.17, win64,
+# darwin64, aarch64-linux, aarch64-darwin; cross-compiled by zig from PyPI) or a comma-separated list.
+PLATFORMS ?= host
 
 # The virtualenv is (re)installed when pyproject.toml changes; the stamp records success.
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "rover-cosim needs Python >= 3.11, found " + sys.version.split()[0])'
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,lint]'
+	$(PY) -m pip install --quiet -e '.[test,lint,platforms]'
 	@touch $@
 
 venv: $(STAMP)
@@ -40,9 +43,10 @@ run: fmus fig3 identify simulate
 fig3: $(STAMP)
 	$(VENV)/bin/rover-cosim fig3 --out $(RESULTS) $(SOIL_OPTIONS)
 
-## fmus: FMI 2.0 FMUs (ME + CS) of the Modelica models -> fmus/*.fmu (skipped when up to date)
+## fmus: FMI 2.0 FMUs (ME + CS) of the Modelica models -> fmus/*.fmu (skipped when up to date);
+## PLATFORMS=all adds the binaries of every host (see PLATFORMS above)
 fmus: $(STAMP)
-	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) $(FMU_NAMES)
+	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) --platforms $(PLATFORMS) $(FMU_NAMES)
 
 ## identify: paper Sec. 3 (sweep on SingleWheel.fmu, LUT, Fx fits, Table 1) -> results/identification/
 identify: fmus

@@ -14,7 +14,7 @@ from pathlib import Path
 from . import source
 
 RUNTIME = Path(__file__).parent / "runtime"
-RUNTIME_FILES = ("model.h", "ode23s.h", "ode23s.c", "fmi2_runtime.c")
+RUNTIME_FILES = ("model.h", "core.h", "ode23s.h", "ode23s.c", "instance.c", "state.c", "cosim.c", "fmi2_api.c")
 #: -fno-math-errno: libm calls are pure functions to the optimiser (the runtime never reads
 #: errno), so it may drop or move them like any other operation.
 CFLAGS = ("-O2", "-fno-math-errno", "-fPIC", "-shared", "-fvisibility=hidden", "-std=c99", "-D_POSIX_C_SOURCE=200809L")

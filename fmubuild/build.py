@@ -1,63 +1,96 @@
-"""Build FMUs: Modelica class → (built-in backend) rumoca → CasADi → C → FMI 2.0 FMU in ``fmus/``.
+"""Build FMUs: Modelica class → (built-in backend) rumoca → CasADi → C → FMI 2.0 FMU in ``fmus/``,
+with the binaries of the host (its C compiler) or of the platforms asked for (zig, see
+:mod:`fmubuild.platforms`), compiled in parallel from the same sources.
 
 The FMU is assembled in a temporary folder and moved into place with one rename, so a failed
 build (an unsupported construct, a compiler error) leaves the output folder as it was. A build is
-skipped when the FMU already there was made from the same inputs (the digest of the Modelica
-package, this builder and the pinned tool versions is stored in ``documentation/build.json``).
+skipped when the FMU already there was made from the same inputs for the same platforms (the
+digest of the Modelica package, this builder, the pinned tool versions and each platform's
+compiler and flags is stored in ``documentation/build.json``).
 """
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import json
 import multiprocessing
 import os
-import platform
 import shutil
 import subprocess
-import sys
 import tempfile
+import threading
 import time
 import zipfile
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from contextlib import ExitStack
+from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
+from typing import Any
 
-from . import codegen, description, ode, source
+from . import codegen, description, ode, prefix, source
 from .artifact import BUILD_RECORD, CFLAGS, RUNTIME, RUNTIME_FILES, BuildResult, input_digest, stored_digest
 from .omc import build_fmu_omc
+from .platforms import HOST, PLATFORMS, ZIG_FLAGS, host_compiler, host_folder, host_suffix, zig_command, zig_version
+from .platforms import parse as parse_platforms
 
 #: The FMUs ``make fmus`` builds (classes of the Modelica package).
 FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel", "SteerableRover", "SteerableRoverBody")
 
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 
+#: sources/buildDescription.xml (FMI 3.0 schema; FMI 2.0.4 section 2.3 lets an FMI 2.0 FMU carry
+#: it): the files to compile, the optional FMI2_FUNCTION_PREFIX, and the C math library to link.
+BUILD_DESCRIPTION = "buildDescription.xml"
+
+
+def build_description(name: str, c_files: Sequence[str]) -> str:
+    """The text of sources/buildDescription.xml for the FMU ``name`` compiled from ``c_files``."""
+    from xml.sax.saxutils import quoteattr
+
+    files = "\n".join(f"      <SourceFile name={quoteattr(f)}/>" for f in c_files)
+    how = "Compile the C99 files into one shared library, linking the C math library: cc -shared -fPIC sources/*.c -lm"
+    prefix_use = "Prefix of every external name of the FMU, to compile several source FMUs into one program"
+    libm = "The C math library (exp, log, pow, sin, cos, ...): -lm where the C library lacks it (Linux)"
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<fmiBuildDescription fmiVersion="3.0">
+  <BuildConfiguration modelIdentifier={quoteattr(name)} description={quoteattr(how)}>
+    <SourceFileSet language="C99">
+{files}
+      <PreprocessorDefinition name="FMI2_FUNCTION_PREFIX" optional="true" description={quoteattr(prefix_use)}/>
+    </SourceFileSet>
+    <Library name="m" external="true" description={quoteattr(libm)}/>
+  </BuildConfiguration>
+</fmiBuildDescription>
+"""
+
+
 
 def platform_folder() -> str:
     """The ``binaries/`` folder name of this platform (FMI 2.0 convention)."""
-    bits = "64" if sys.maxsize > 2**32 else "32"
-    system = platform.system()
-    if system == "Linux":
-        return "linux" + bits
-    if system == "Darwin":
-        return "darwin" + bits
-    if system == "Windows":
-        return "win" + bits
-    raise RuntimeError(f"platform {system!r}: no FMI 2.0 binaries folder name for it")
+    return host_folder()
 
 
 def shared_library_suffix() -> str:
-    return {"Darwin": ".dylib", "Windows": ".dll"}.get(platform.system(), ".so")
+    return host_suffix()
 
 
 def fmi_headers() -> Path:
-    """The FMI 2.0 standard headers, as shipped with FMPy (not copied into this repository)."""
-    import fmpy  # its c-code folder holds the FMI standard headers
-
-    folder = Path(fmpy.__file__).parent / "c-code"
+    """The FMI 2.0 standard headers, unmodified (BSD-2-Clause, meant to travel with FMUs), as PyPI's
+    fmu-manipulation-toolbox ships them (the FMI 2.0.1 release). Not FMPy's copy: FMPy changed its
+    fmi2Functions.h to ignore FMI2_FUNCTION_PREFIX. Not copied into this repository."""
+    spec = importlib.util.find_spec("fmu_manipulation_toolbox")
+    if spec is None or spec.origin is None:
+        raise RuntimeError("the FMI 2.0 standard headers come from fmu-manipulation-toolbox: pip install "
+                           "fmu-manipulation-toolbox (a dependency of rover-cosim)")
+    folder = Path(spec.origin).parent / "resources" / "fmi"
     missing = [h for h in FMI_HEADERS if not (folder / h).exists()]
     if missing:
-        raise RuntimeError(f"FMI 2.0 headers {missing} not found in {folder} (is FMPy installed?)")
+        raise RuntimeError(f"FMI 2.0 headers {missing} not found in {folder}")
+    if "fmi2PasteB(FMI2_FUNCTION_PREFIX, name)" not in (folder / "fmi2Functions.h").read_text():
+        raise RuntimeError(f"{folder / 'fmi2Functions.h'} is not the standard header (no FMI2_FUNCTION_PREFIX)")
     return folder
 
 
@@ -95,18 +128,111 @@ def _class_description(name: str) -> str:
 
 
 def compiler() -> str:
-    cc = os.environ.get("CC", "cc")
-    if shutil.which(cc) is None:
-        raise RuntimeError(f"C compiler {cc!r} not found on PATH (set CC, or install gcc)")
-    return cc
+    return host_compiler()
 
 
-def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
-    """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date)."""
+@dataclass(frozen=True)
+class Target:
+    """How one ``binaries/`` folder is compiled."""
+
+    folder: str
+    command: tuple[str, ...]   # the compiler (with its -target)
+    flags: tuple[str, ...]
+    libraries: tuple[str, ...]
+    suffix: str
+    compiler: str              # name and version, for the record and the digest
+
+    def record(self) -> dict[str, object]:
+        target = self.command[-1] if "-target" in self.command else "host"
+        return {"compiler": self.compiler, "target": target, "cflags": list(self.flags),
+                "libraries": list(self.libraries)}
+
+
+def targets(platforms: Sequence[str]) -> list[Target]:
+    """The targets of ``platforms`` (names as :func:`platforms.parse` takes them; ValueError names
+    an unknown one)."""
+    result = []
+    for name in parse_platforms(",".join(platforms)):
+        if name == HOST:
+            cc = compiler()
+            version = subprocess.run([cc, "--version"], capture_output=True, text=True, check=False).stdout
+            result.append(Target(platform_folder(), (cc,), CFLAGS, ("-lm",), shared_library_suffix(),
+                                 (version.splitlines() or [cc])[0]))
+            continue
+        spec = PLATFORMS[name]
+        libraries = ("-lm",) if spec.system == "linux" else ()
+        result.append(Target(name, (*zig_command(), "-target", spec.target), (*CFLAGS, *ZIG_FLAGS), libraries,
+                             spec.suffix, f"zig cc {zig_version()} (PyPI ziglang)"))
+    return result
+
+
+def platforms_digest(name: str, chosen: Sequence[Target]) -> str:
+    """What decides whether an FMU is up to date: its inputs and, per binaries folder, the compiler
+    and its flags."""
+    key = [(t.folder, t.command[-1], t.flags, t.libraries, t.compiler) for t in chosen]
+    return hashlib.sha256((input_digest(name) + json.dumps(key)).encode()).hexdigest()
+
+
+def _compile(name: str, target: Target, sources: Path, c_files: list[str], work: Path) -> tuple[Path, float]:
+    """Compile ``c_files`` into ``work``/<folder>/<name><suffix>; returns the library and the seconds."""
+    started = time.perf_counter()
+    out = work / target.folder
+    out.mkdir(parents=True)
+    library = out / f"{name}{target.suffix}"
+    command = [*target.command, *target.flags, "-I", str(sources), *c_files, "-o", str(library), *target.libraries]
+    result = subprocess.run(command, capture_output=True, text=True, check=False, cwd=out)
+    if result.returncode != 0 or not library.is_file():
+        raise RuntimeError(f"{name}: the C compiler failed for {target.folder} ({target.compiler}, exit "
+                           f"{result.returncode}):\n" + result.stderr[-4000:])
+    return library, time.perf_counter() - started
+
+
+#: A build's progress: called with the FMU's name and the stage just finished ("translate",
+#: "generate", "compile <folder>", "package"); see :func:`steps_of`.
+StepReport = Callable[[str, str], None]
+
+
+def steps_of(platforms: Sequence[str]) -> int:
+    """Stages one FMU's build reports: translate, generate, one compile per platform, package."""
+    return 3 + len(targets(platforms))
+
+
+def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries: Path, work: Path,
+                    jobs: int | None = None, step: StepReport | None = None) -> dict[str, float]:
+    """Compile the sources for every target, ``jobs`` compilers at a time (default: one per CPU),
+    into ``binaries``/<folder>/; returns the seconds per folder. The first failure is raised after
+    the other compilers finished. ``step`` hears of each compiler that finished."""
+    c_files = sorted(str(sources / f.name) for f in sources.iterdir() if f.suffix == ".c")
+    workers = max(1, min(jobs or os.cpu_count() or 1, len(chosen)))
+
+    def compile_one(target: Target) -> tuple[Path, float]:
+        done = _compile(name, target, sources, c_files, work)
+        if step:
+            step(name, f"compile {target.folder}")
+        return done
+
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        futures = {t.folder: pool.submit(compile_one, t) for t in chosen}
+    seconds: dict[str, float] = {}
+    for folder, future in futures.items():
+        library, took = future.result()
+        (binaries / folder).mkdir(parents=True)
+        shutil.copy2(library, binaries / folder / library.name)
+        seconds[folder] = took
+    return seconds
+
+
+def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Sequence[str] = (HOST,),
+              compile_jobs: int | None = None, step: StepReport | None = None) -> BuildResult:
+    """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date) with binaries
+    for ``platforms`` (``host``: this machine's, by its C compiler; other names: cross-compiled by
+    zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time; ``step`` hears of
+    each stage as it ends."""
     started = time.perf_counter()
     out_dir = Path(out_dir)
     target = out_dir / f"{name}.fmu"
-    digest = input_digest(name)
+    chosen = targets(platforms)
+    digest = platforms_digest(name, chosen)
     if not force and target.exists() and stored_digest(target) == digest:
         return BuildResult(name, target, False, time.perf_counter() - started)
     stages: dict[str, float] = {}
@@ -116,6 +242,8 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
         model = ode.translate(source.load(f"{source.PACKAGE}.{name}"), name)
         model_layout = codegen.layout(model)
         stages["translate"] = time.perf_counter() - t0
+        if step:
+            step(name, "translate")
 
         t0 = time.perf_counter()
         root = tmp / "fmu"
@@ -126,33 +254,34 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
         headers = fmi_headers()
         for file in FMI_HEADERS:
             shutil.copy2(headers / file, sources / file)
-        source_files = sorted(p.name for p in sources.iterdir())
+        c_texts = [p.read_text() for p in sorted(sources.glob("*.c"))]
+        (sources / prefix.HEADER).write_text(prefix.prefix_header(prefix.external_names(c_texts)))
+        (sources / BUILD_DESCRIPTION).write_text(build_description(name, sorted(p.name for p in sources.glob("*.c"))))
+        source_files = sorted(p.name for p in sources.iterdir() if p.name != BUILD_DESCRIPTION)
         version = metadata.version("rover-cosim")
         (root / "modelDescription.xml").write_text(
             description.model_description(model_layout, guid, source_files, _class_description(name), version,
                                           _default_experiment(name)))
         stages["generate"] = time.perf_counter() - t0
+        if step:
+            step(name, "generate")
 
         t0 = time.perf_counter()
-        binaries = root / "binaries" / platform_folder()
-        binaries.mkdir(parents=True)
-        library = binaries / f"{name}{shared_library_suffix()}"
-        c_files = [str(sources / f) for f in source_files if f.endswith(".c")]
-        command = [compiler(), *CFLAGS, "-I", str(sources), *c_files,
-                   "-o", str(library), "-lm"]
-        result = subprocess.run(command, capture_output=True, text=True, check=False)
-        if result.returncode != 0:
-            raise RuntimeError(f"{name}: the C compiler failed ({' '.join(command[:1])}, exit {result.returncode}):\n"
-                               + result.stderr[-4000:])
+        seconds = compile_targets(name, chosen, sources, root / "binaries", tmp / "compile", compile_jobs, step)
         stages["compile"] = time.perf_counter() - t0
+        stages.update({f"compile {folder}": s for folder, s in seconds.items()})
 
         t0 = time.perf_counter()
         # Inputs the Modelica source gives a start value: a system may leave them unconnected.
         optional = [v for v in model.inputs if model.variables[v].start is not None]
+        host = [t for t in chosen if "-target" not in t.command]
         record = {"input_sha256": digest, "backend": "builtin", "model": f"{source.PACKAGE}.{name}",
                   "optional_inputs": optional,
                   "guid": guid, "rover_cosim": version,
-                  "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")}, "cflags": list(CFLAGS),
+                  "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")},
+                  "cflags": list(host[0].flags if host else CFLAGS),
+                  "platforms": {t.folder: {**t.record(), "library": f"binaries/{t.folder}/{name}{t.suffix}"}
+                                for t in chosen},
                   "states": model_layout.n_states, "inputs": model_layout.n_inputs,
                   "parameters": model_layout.n_parameters, "observed": model_layout.n_observed}
         (root / "documentation").mkdir()
@@ -167,14 +296,45 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False) -> BuildResult:
                     archive.write(path, path.relative_to(root).as_posix())
         os.replace(partial, target)
         stages["package"] = time.perf_counter() - t0
+    if step:
+        step(name, "package")
     return BuildResult(name, target, True, time.perf_counter() - started, stages)
 
 
-def _build_one(args: tuple[str, Path, bool, str]) -> BuildResult:
-    name, out_dir, force, backend = args
+def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int, Any]) -> BuildResult:
+    """One FMU (in a pool's worker): its stages go to ``steps`` (a queue of the parent's, or None)."""
+    name, out_dir, force, backend, platforms, compile_jobs, steps = args
     if backend == "omc":
         return build_fmu_omc(name, out_dir, force=force)
-    return build_fmu(name, out_dir, force=force)
+    step = (lambda fmu, stage: steps.put((fmu, stage))) if steps is not None else None
+    return build_fmu(name, out_dir, force=force, platforms=platforms, compile_jobs=compile_jobs, step=step)
+
+
+class _LocalSteps:
+    """A queue's ``put`` for builds in this process: the stage goes straight to ``step``."""
+
+    def __init__(self, step: StepReport):
+        self.step = step
+
+    def put(self, item: tuple[str, str]) -> None:
+        self.step(*item)
+
+
+def _forward_steps(stack: ExitStack, context: Any, step: StepReport) -> Any:
+    """A queue the pool's workers put their stages on, and a thread here that hands them to
+    ``step`` until the stack closes."""
+    manager = stack.enter_context(context.Manager())
+    queue = manager.Queue()
+
+    def forward() -> None:
+        while (item := queue.get()) is not None:
+            step(*item)
+
+    thread = threading.Thread(target=forward, daemon=True)
+    thread.start()
+    stack.callback(thread.join)
+    stack.callback(queue.put, None)
+    return queue
 
 
 def resolve_backend(backend: str) -> str:
@@ -188,20 +348,37 @@ def resolve_backend(backend: str) -> str:
     return backend
 
 
+def _check_platforms(backend: str, platforms: tuple[str, ...]) -> tuple[str, ...]:
+    """``platforms`` if ``backend`` can build them and their compilers are there (said before any work)."""
+    if backend == "omc" and platforms != (HOST,):
+        raise ValueError(f"--platforms {','.join(platforms)}: the omc backend builds the host platform only "
+                         "(use --backend builtin)")
+    targets(platforms)
+    return platforms
+
+
 def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *, force: bool = False,
-              jobs: int | None = None, backend: str = "builtin",
-              report: Callable[[BuildResult], None] | None = None) -> list[BuildResult]:
-    """Build several FMUs, ``jobs`` at a time (default: the number of CPUs). The first failure
-    is raised after the other builds finished; FMUs already built stay."""
+              jobs: int | None = None, backend: str = "builtin", platforms: Sequence[str] = (HOST,),
+              report: Callable[[BuildResult], None] | None = None,
+              step: StepReport | None = None) -> list[BuildResult]:
+    """Build several FMUs, ``jobs`` at a time (default: the number of CPUs), each with binaries for
+    ``platforms`` (see :func:`build_fmu`; the CPUs left to each build compile its platforms in
+    parallel). The first failure is raised after the other builds finished; FMUs already built stay.
+    ``report`` hears of each FMU built or up to date, ``step`` of each stage of a build as it ends
+    (from the workers, through a queue)."""
     unknown = [n for n in names if n not in FMU_MODELS]
     if unknown:
         raise ValueError(f"model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}")
     backend = resolve_backend(backend)
-    jobs = max(1, min(jobs or os.cpu_count() or 1, len(names)))
-    tasks = [(n, Path(out_dir), force, backend) for n in names]
+    platforms = _check_platforms(backend, tuple(platforms))
+    cpus = os.cpu_count() or 1
+    jobs = max(1, min(jobs or cpus, len(names)))
+    compile_jobs = max(1, cpus // jobs)
     results: list[BuildResult] = []
     errors: list[BaseException] = []
     if jobs == 1:
+        local = _LocalSteps(step) if step else None
+        tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, local) for n in names]
         for task in tasks:
             try:
                 results.append(_build_one(task))
@@ -211,7 +388,11 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
                 errors.append(error)
     else:
         # "spawn": a forked worker can deadlock on the locks of threads (rumoca's) in the parent.
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
+        context = multiprocessing.get_context("spawn")
+        with ExitStack() as stack:
+            steps = _forward_steps(stack, context, step) if step else None
+            pool = stack.enter_context(ProcessPoolExecutor(max_workers=jobs, mp_context=context))
+            tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, steps) for n in names]
             futures = [pool.submit(_build_one, task) for task in tasks]
             for future in futures:
                 try:

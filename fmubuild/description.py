@@ -136,9 +136,11 @@ def model_description(model_layout: ModelLayout, guid: str, sources: list[str], 
     categories = ET.SubElement(root, "LogCategories")
     ET.SubElement(categories, "Category", {"name": "logStatusError", "description": "errors, always reported"})
     ET.SubElement(categories, "Category", {"name": "logStatusWarning",
-                                           "description": "warnings (assert level warning), always reported"})
+                                           "description": "warnings (assert level warning); reported unless "
+                                           "fmi2SetDebugLogging switches them off"})
     ET.SubElement(categories, "Category", {"name": "logStatistics",
-                                           "description": "Co-Simulation integrator counts, at fmi2Terminate"})
+                                           "description": "Co-Simulation integrator counts, at fmi2Terminate, "
+                                           "with debug logging on"})
     default = {"startTime": "0.0", "tolerance": "1e-06"}
     if experiment is not None:
         default = {"startTime": repr(experiment.start), "stopTime": repr(experiment.stop),

@@ -104,8 +104,15 @@ def _compare(op: str, a: Value, b: Value) -> Value:
 
 
 def _logic(op: str, a: Value, b: Value) -> Value:
-    if is_symbolic(a) or is_symbolic(b):
+    """``and``/``or``; a constant side decides at translation time where it can (``flag or c``
+    with a true flag is true), so a structural flag can switch a run-time condition off."""
+    if is_symbolic(a) and is_symbolic(b):
         return ca.logic_and(a, b) if op == "And" else ca.logic_or(a, b)
+    if is_symbolic(a) or is_symbolic(b):
+        constant, other = (b, a) if is_symbolic(a) else (a, b)
+        if op == "And":
+            return other if constant else False
+        return True if constant else other
     return (a and b) if op == "And" else (a or b)
 
 

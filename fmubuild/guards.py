@@ -38,6 +38,8 @@ _DECLARATION = re.compile(r"^  casadi_real (a\d+(, a\d+)*);$")
 _ASSIGNMENT = re.compile(r"^  (a\d+)=(.*);$")
 _OUTPUT = re.compile(r"^  if \(res\[(\d+)\]!=0\) res\[\1\]\[(\d+)\]=(a\d+);$")
 _RETURN = "  return 0;"
+_PARAMETERS = ("arg", "res", "iw", "w", "mem")
+_EMPTY_RELEASE = re.compile(r"^(void \w+_release\(int mem\) \{\n)\}", re.M)
 _VARIABLE = re.compile(r"\ba\d+\b")
 _SELECT = re.compile(r"^\((a\d+)\?(a\d+):0\)$")
 
@@ -140,7 +142,10 @@ def _guard(need: Need, defined_before: int) -> str | None:
 
 def _emit(statements: list[_Statement], needs: dict[int, Need]) -> str:
     conditions = {c for need in needs.values() if need for term in need for c in term}
-    declared = [f"v{s.target}" + (" = 0" if s.target in conditions else "")
+    guards = {s.target: _guard(needs.get(s.target), s.target) for s in statements if s.target is not None}
+    # Conditions and every value computed under a guard start at 0: a guard never reads an unset
+    # value, and the compiler sees no path that reads one (no -Wmaybe-uninitialized).
+    declared = [f"v{s.target}" + (" = 0" if s.target in conditions or guards[s.target] is not None else "")
                 for s in statements if s.target is not None]
     lines = [f"  casadi_real {', '.join(declared[i:i + 8])};" for i in range(0, len(declared), 8)]
     open_guard: str | None = None
@@ -149,7 +154,7 @@ def _emit(statements: list[_Statement], needs: dict[int, Need]) -> str:
             guard = None
             code = statement.text
         else:
-            guard = _guard(needs.get(statement.target), statement.target)
+            guard = guards[statement.target]
             code = f"v{statement.target}={statement.text};"
         if guard != open_guard:
             if open_guard is not None:
@@ -183,6 +188,10 @@ def guard_generated_code(code: str) -> tuple[str, int]:
         original = match.group(2)
         body = guard_function_body(original)
         rewritten += body is not original
-        return match.group(1) + body + match.group(3)
+        # CasADi's one signature for every function: say which arguments this one does not use
+        # (no -Wunused-parameter).
+        unused = "".join(f"  (void){name};\n" for name in _PARAMETERS if not re.search(rf"\b{name}\b", body))
+        return match.group(1) + unused + body + match.group(3)
 
-    return _FUNCTION.sub(replace, code), rewritten
+    code = _FUNCTION.sub(replace, code)
+    return _EMPTY_RELEASE.sub(r"\1  (void)mem;\n}", code), rewritten

@@ -30,6 +30,7 @@ from .expressions import (
     scalar_name,
 )
 from .functions import FunctionLibrary
+from .implicit import implicit_solves
 from .memory import bound_variables
 
 
@@ -85,6 +86,10 @@ class OdeModel:
     parameter_values: dict[str, float] = field(default_factory=dict)
     calculated: dict[str, ca.MX] = field(default_factory=dict)  # dependent parameters, expressions of p
     asserts: list[Assertion] = field(default_factory=list)
+    # xdot and y as the FMU's derivatives are taken from: equal values, with the derivatives of
+    # implicit solves by the implicit-function theorem (fmubuild.implicit); None: xdot and y.
+    xdot_derivative: ca.MX | None = None
+    y_derivative: ca.MX | None = None
 
     def at_memory_defaults(self) -> tuple[ca.MX, ca.MX]:
         """xdot and y with every memory at its binding: what a Modelica tool without the runtime's
@@ -320,7 +325,7 @@ def translate(model: Any, name: str) -> OdeModel:
     flat = model.to_dict("flat")
     locate = _Locator(model.to_dict("dae"))
     _reject_unsupported_sections(flat, locate, name)
-    library = FunctionLibrary(flat["functions"])
+    library = FunctionLibrary(flat["functions"], implicit_solves(flat["functions"], locate.files))
     types = flat["variable_type_names"]
     infos = _scalar_infos(flat)
     parameters = _Parameters(infos, types, library, name)
@@ -339,13 +344,17 @@ def translate(model: Any, name: str) -> OdeModel:
                                **{s: u[i] for i, s in enumerate(inputs)}, **parameters.values,
                                **{memory.name: m[i] for i, memory in enumerate(memories)}}
     unknowns = [f"der({s})" for s in states] + [s for s in infos if s not in known and not _is_parameter(infos[s][0])]
-    env = _solve(_equations(flat, locate, name) + binding_equations, unknowns, known, library, name)
+    equations = _equations(flat, locate, name) + binding_equations
+    env = _solve(equations, unknowns, known, library, name)
+    derivative_env = _solve(equations, unknowns, known, library.for_derivatives(), name) if library.implicit else env
 
     xdot = ca.vertcat(*[_mx(env[f"der({s})"]) for s in states]) if states else ca.MX(0, 1)
+    xdot_derivative = ca.vertcat(*[_mx(derivative_env[f"der({s})"]) for s in states]) if states else ca.MX(0, 1)
     observed = [s for s in unknowns if not s.startswith("der(")]
     x0 = _start_values(states, infos, parameters, name)
     states, observed, renamed = _public_state_names(states, observed, env, x, infos)
     y = ca.vertcat(*[_mx(env[s]) for s in observed]) if observed else ca.MX(0, 1)
+    y_derivative = ca.vertcat(*[_mx(derivative_env[s]) for s in observed]) if observed else ca.MX(0, 1)
     variables = _variables(infos, types, parameters, inputs, states, locate)
     for public, inner in renamed.items():  # the public name keeps the inner state's start and description
         variables[public] = replace(variables[public], start=variables[inner].start,
@@ -357,7 +366,7 @@ def translate(model: Any, name: str) -> OdeModel:
     memory_defaults = [_constant_binding(memory.name, memory.binding, parameters, library, name) for memory in memories]
     return OdeModel(name, variables, states, inputs, parameters.free, observed, t, x, u, p, xdot, y, x0, m,
                     [memory.name for memory in memories], [memory.source for memory in memories], memory_defaults,
-                    parameters.defaults, parameters.calculated, asserts)
+                    parameters.defaults, parameters.calculated, asserts, xdot_derivative, y_derivative)
 
 
 def _constant_binding(variable: str, binding: Mapping[str, Any], parameters: _Parameters, library: FunctionLibrary,

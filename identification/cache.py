@@ -1,7 +1,7 @@
 """The sweep's cache of runs: each run is a CSV written with a checksum beside it, and is only
 used when it is whole.
 
-``W575_tau20.csv`` goes with ``W575_tau20.csv.sha256`` (JSON: the case the file was computed for,
+``W575_tau20.csv.gz`` goes with ``W575_tau20.csv.gz.sha256`` (JSON: the case the file was computed for,
 its key; SHA-256 of that key and the CSV's bytes together; its rows and columns), both written to
 temporary names and renamed, the checksum last. A run file is used only if its checksum file
 exists and matches, it was computed for the case it stands for (its key: the file's place in the
@@ -9,10 +9,14 @@ cache, whose folders are the digests of the FMU, soil and plan, so a file copied
 another case, with its own checksum, is refused), and it has the expected rows and columns; any
 other file is reported (naming it and why) and computed again. Partial files of an
 interrupted sweep (``.*.part``) are removed when the next sweep starts.
+
+A file whose name ends in ``.gz`` holds its CSV gzip-compressed (a sweep's runs: a quarter of the
+plain CSV's size; written with a zero timestamp, so the same run gives the same bytes).
 """
 
 from __future__ import annotations
 
+import gzip
 import hashlib
 import io
 import json
@@ -60,6 +64,8 @@ def write_run(target: Path, data: pd.DataFrame, float_format: str | None = "%.12
     that reads back the same)."""
     target = Path(target)
     payload = data.to_csv(index=False, float_format=float_format).encode()
+    if target.name.endswith(".gz"):
+        payload = gzip.compress(payload, compresslevel=6, mtime=0)
     _atomic_write(target, payload)
     key = case_key(target)
     record = {"key": key, "sha256": _digest(key, payload), "rows": len(data), "columns": list(data.columns)}
@@ -91,8 +97,9 @@ def read_run(path: Path, rows: int, columns: list[str], exact: bool = False) -> 
     if _digest(key, payload) != record.get("sha256"):
         return None, "its content does not match its checksum (cut short or changed)"
     try:
-        data = pd.read_csv(io.BytesIO(payload), **_ROUND_TRIP if exact else {})
-    except (ValueError, pd.errors.ParserError) as error:
+        text = gzip.decompress(payload) if path.name.endswith(".gz") else payload
+        data = pd.read_csv(io.BytesIO(text), **_ROUND_TRIP if exact else {})
+    except (OSError, EOFError, ValueError, pd.errors.ParserError) as error:
         return None, f"not a readable CSV ({error})"
     if len(data) != rows or not set(columns) <= set(data.columns):
         return None, f"{len(data)} rows and columns {list(data.columns)}; expected {rows} rows with {columns}"

@@ -118,9 +118,10 @@ class SweepOutcome:
 
 
 def run_file(folder: Path, load: float, torque: float, slip_angle_deg: float = 0.0) -> Path:
-    """The cache file of one case (the paper's longitudinal runs keep their name without the angle)."""
+    """The cache file of one case, a gzip-compressed CSV (the paper's longitudinal runs keep their
+    name without the angle)."""
     angle = f"_beta{slip_angle_deg:g}" if slip_angle_deg else ""
-    return folder / f"W{load:g}_tau{torque:g}{angle}.csv"
+    return folder / f"W{load:g}_tau{torque:g}{angle}.csv.gz"
 
 
 def compute_run(fmu_path: str | None, case: Case, stop_time: float, sample_time: float,

@@ -203,6 +203,9 @@ def build_parser() -> argparse.ArgumentParser:
     ident.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
     ident.add_argument("--scheduler", type=_scheduler, default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
     ident.add_argument("--cache", type=_path, default=None, help="run cache (default: <out>/cache)")
+    ident.add_argument("--record-interval", type=float, default=0.001,
+                       help="rows kept in runs.csv [s] (a whole number of the sweep's 0.1 ms samples; default "
+                       "0.001; 0.0001: every sample); the fits use every sample")
     _add_soil_options(ident)
     ident.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
@@ -263,6 +266,12 @@ def build_parser() -> argparse.ArgumentParser:
                        help="auto: omc where OpenModelica is on PATH, else the built-in rumoca/CasADi exporter")
     build.add_argument("--force", action="store_true", help="rebuild even when the FMU is up to date")
     build.add_argument("--jobs", type=int, default=None, help="parallel builds (default: number of CPUs)")
+    build.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    build.add_argument("--platforms", default="host", metavar="LIST",
+                       help="binaries/ folders to build: host (default: this machine's, by $CC or cc), all "
+                       "(linux64, win64, darwin64, aarch64-linux, aarch64-darwin) or a comma-separated list of "
+                       "those; other than host, cross-compiled by zig (pip install -e '.[platforms]'); "
+                       "linux ones for glibc >= 2.17")
     for name, sub in commands.choices.items():
         summary, *examples = USAGE[name]
         sub.description = summary
@@ -295,7 +304,8 @@ USAGE = {
     "report": ("One self-contained HTML page of the results: figures, tables, provenance.",
                "rover-cosim report --results results"),
     "build-fmus": ("Build the FMI 2.0 FMUs (Model Exchange + Co-Simulation) from the Modelica library.",
-                   "rover-cosim build-fmus --out fmus", "rover-cosim build-fmus Wheel --force"),
+                   "rover-cosim build-fmus --out fmus", "rover-cosim build-fmus Wheel --force",
+                   "rover-cosim build-fmus Wheel --platforms all", "rover-cosim build-fmus --platforms host,win64"),
 }
 
 
@@ -488,6 +498,8 @@ def _cosim_study(args: argparse.Namespace) -> int:
 
 
 def _identify(args: argparse.Namespace) -> int:
+    from rover_cosim.common.rows import steps_between_rows
+    from rover_cosim.identification.sweep import SweepPlan
     from rover_cosim.jobs.identify import run_identification
     from rover_cosim.progress import ProgressBar
 
@@ -496,6 +508,11 @@ def _identify(args: argparse.Namespace) -> int:
         return 2
     if args.workers is not None and args.workers < 1:
         print(f"rover-cosim identify: --workers {args.workers}: expected >= 1", file=sys.stderr)
+        return 2
+    try:
+        steps_between_rows(args.record_interval, SweepPlan().sample_time)
+    except ValueError as error:
+        print(f"rover-cosim identify: --record-interval: {error}", file=sys.stderr)
         return 2
     if not args.fmu.is_file():
         print(f"rover-cosim identify: FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)",
@@ -511,7 +528,8 @@ def _identify(args: argparse.Namespace) -> int:
     bar = ProgressBar("sweep", enabled=not args.quiet)
     try:
         outcome = run_identification(args.fmu, args.out, workers=args.workers, scheduler=args.scheduler,
-                                     cache_dir=args.cache, progress=bar, choice=choice)
+                                     cache_dir=args.cache, progress=bar, choice=choice,
+                                     record_interval=args.record_interval)
     except (OSError, RuntimeError, ValueError) as error:
         bar.close()
         print(f"rover-cosim identify: {error} (nothing written)", file=sys.stderr)
@@ -541,8 +559,9 @@ def _is_fmu(path: Path) -> bool:
 
 
 def _simulate(args: argparse.Namespace) -> int:
+    from rover_cosim.common.rows import steps_between_rows
     from rover_cosim.jobs.path_following import run_path_following
-    from rover_cosim.jobs.simulate import run_simulation, steps_between_rows
+    from rover_cosim.jobs.simulate import STEP, run_simulation
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
     from rover_cosim.progress import ProgressBar
@@ -554,7 +573,7 @@ def _simulate(args: argparse.Namespace) -> int:
               "`rover-cosim build-fmus`)", file=sys.stderr)
         return 2
     try:
-        steps_between_rows(args.record_interval)
+        steps_between_rows(args.record_interval, STEP)
     except ValueError as error:
         print(f"rover-cosim simulate: --record-interval: {error}", file=sys.stderr)
         return 2
@@ -686,15 +705,26 @@ def _print_straight(outcome) -> None:  # noqa: ANN001 - SimulationResult, import
 
 
 def _build_fmus(args: argparse.Namespace) -> int:
-    from rover_cosim.fmubuild.build import FMU_MODELS, BuildResult, build_all
+    from rover_cosim.fmubuild.build import FMU_MODELS, BuildResult, build_all, steps_of
     from rover_cosim.fmubuild.expressions import UnsupportedConstruct
+    from rover_cosim.fmubuild.platforms import parse as parse_platforms
+    from rover_cosim.progress import ProgressBar
+
+    bar = ProgressBar("build-fmus", enabled=not args.quiet)
+    done = {"steps": 0, "total": 1}
+
+    def step(_model: str, _stage: str) -> None:  # translate, generate, compile <folder>, package
+        done["steps"] += 1
+        bar(min(1.0, done["steps"] / max(1, done["total"])))
 
     def report(result: BuildResult) -> None:
+        bar.clear()
         if result.rebuilt:
             stages = ", ".join(f"{k} {v:.1f} s" for k, v in result.stages.items())
             print(f"built {result.path} in {result.seconds:.1f} s ({stages})", flush=True)
         else:
             print(f"{result.path} is up to date", flush=True)
+            done["total"] -= done["per_fmu"]  # nothing to wait for there
 
     if args.jobs is not None and args.jobs < 1:
         print(f"rover-cosim build-fmus: --jobs {args.jobs}: expected >= 1", file=sys.stderr)
@@ -704,11 +734,21 @@ def _build_fmus(args: argparse.Namespace) -> int:
         print(f"rover-cosim build-fmus: model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}", file=sys.stderr)
         return 2
     try:
-        build_all(tuple(args.models) or FMU_MODELS, args.out, force=args.force, jobs=args.jobs,
-                  backend=args.backend, report=report)
+        platforms = parse_platforms(args.platforms)
+    except ValueError as error:
+        print(f"rover-cosim build-fmus: {error}", file=sys.stderr)
+        return 2
+    models = tuple(args.models) or FMU_MODELS
+    done["per_fmu"] = steps_of(platforms)
+    done["total"] = len(models) * done["per_fmu"]
+    try:
+        build_all(models, args.out, force=args.force, jobs=args.jobs, backend=args.backend, platforms=platforms,
+                  report=report, step=step)
     except (UnsupportedConstruct, ValueError, RuntimeError) as error:
+        bar.close()
         print(f"rover-cosim build-fmus: {error}", file=sys.stderr)
         return 1
+    bar.close()
     return 0
 
 

@@ -20,6 +20,7 @@ class ProgressBar:
         self.started = time.monotonic()
         self.last_drawn = 0.0
         self.drawn = False
+        self.length = 0
 
     def __call__(self, fraction: float) -> None:
         if not self.enabled:
@@ -31,10 +32,20 @@ class ProgressBar:
         self.last_drawn = now
         filled = int(self.width * fraction)
         remaining = elapsed * (1.0 - fraction) / fraction if fraction > 0 else float("nan")
-        self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f}% "
-                          f"{elapsed:6.1f} s, ~{remaining:5.1f} s left")
+        line = (f"{self.label} [{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f}% "
+                f"{elapsed:6.1f} s, ~{remaining:5.1f} s left")
+        self.stream.write("\r" + line)
         self.stream.flush()
         self.drawn = True
+        self.length = len(line)
+
+    def clear(self) -> None:
+        """Take the bar off its line (before another line is printed; the next call draws it again)."""
+        if self.drawn:
+            self.stream.write("\r" + " " * self.length + "\r")
+            self.stream.flush()
+            self.drawn = False
+            self.last_drawn = 0.0
 
     def close(self) -> None:
         if self.drawn:

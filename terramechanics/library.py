@@ -221,6 +221,8 @@ def from_fmu_parameters(values: dict[str, float]) -> tuple[Soil, Wheel]:
     """The inverse of fmu_parameters (the paper's values for what ``values`` leaves out)."""
     modelica = {v: k for k, v in MODELICA_NAMES.items()}
     soil = {modelica.get(k[5:], k[5:]): v for k, v in values.items() if k.startswith("soil.")}
+    if soil.get("xc") == 0:  # the FMUs' "from phi" (45 deg - phi/2), Soil's XC_FROM_PHI
+        del soil["xc"]
     wheel = {k[6:]: v for k, v in values.items() if k.startswith("wheel.")}
     return Soil(**soil), Wheel(**wheel)
 

@@ -224,6 +224,8 @@ def test_an_empty_path_is_refused_not_taken_as_the_current_folder_or_the_default
                                                 "expected a whole number of steps of 0.001 s"),
     (["simulate", "--record-interval", "-1"], "rover-cosim simulate: --record-interval: record interval -1.0 s: "
                                                "expected a whole number of steps of 0.001 s"),
+    (["identify", "--record-interval", "inf"], "rover-cosim identify: --record-interval: record interval inf s: "
+                                                "expected a whole number of steps of 0.0001 s"),
     (["build-fmus", "Nope"], "rover-cosim build-fmus: model 'Nope': expected one of SingleWheel, Rover"),
     (["cosim-study", "--fmu-dir", "/nonexistent"], "rover-cosim cosim-study: --fmu-dir /nonexistent: no such folder"),
     (["cosim-study", "--fmu-dir", "TMP"], "rover-cosim cosim-study: --fmu-dir TMP: /"),  # a folder without the FMUs

@@ -72,3 +72,24 @@ def test_wheel_fmu_takes_the_lateral_speed_and_gives_fy_and_the_slip_angle(fmus)
     expected = wheel_forces(424.0, result["omega"], 1.0, v_lateral=0.1)
     np.testing.assert_allclose(result["slipAngle"], math.atan(0.1), rtol=1e-12)
     np.testing.assert_allclose(result["Fy"], expected.Fy, rtol=1e-4)
+
+
+@pytest.mark.parametrize("phi_deg", [30.0, 37.2, 44.0])
+def test_the_fmus_destructive_angle_follows_phi_unless_given(fmus, phi_deg: float):
+    """soil.xc left at its default (0) is 45° - φ/2 of the φ the user sets, as in
+    terramechanics.Soil: a plain FMPy user changing soil.phi alone gets the sidewall force of
+    that soil (before, X_c stayed 26.4°); an explicit soil.xc is used as given."""
+    from rover_cosim.terramechanics import Soil
+
+    phi = math.radians(phi_deg)
+    derived = fmpy.simulate_fmu(fmus["Wheel"], stop_time=0.2, output=["Fy", "omega"],
+                                start_values={"W": 424.0, "v_hub": 1.0, "v_lat": 0.1, "soil.phi": phi,
+                                              "omega": 1.0 / 0.355})
+    expected = wheel_forces(424.0, derived["omega"], 1.0, v_lateral=0.1, soil=Soil(phi=phi))
+    np.testing.assert_allclose(derived["Fy"], expected.Fy, rtol=1e-6)  # measured 1e-8: the sinkage solve
+    given = fmpy.simulate_fmu(fmus["Wheel"], stop_time=0.2, output=["Fy", "omega"],
+                              start_values={"W": 424.0, "v_hub": 1.0, "v_lat": 0.1, "soil.phi": phi,
+                                            "soil.xc": math.radians(20.0), "omega": 1.0 / 0.355})
+    expected = wheel_forces(424.0, given["omega"], 1.0, v_lateral=0.1, soil=Soil(phi=phi, xc=math.radians(20.0)))
+    np.testing.assert_allclose(given["Fy"], expected.Fy, rtol=1e-6)
+    assert abs(given["Fy"][-1] - derived["Fy"][-1]) > 1e-3 * abs(derived["Fy"][-1])

@@ -61,8 +61,9 @@ def test_fmu_is_me_and_cs_with_sources_units_and_solver_parameters(fmus, name: s
         root = ET.fromstring(archive.read("modelDescription.xml"))
     for kind in ("ModelExchange", "CoSimulation"):
         listed = [f.get("name") for f in root.findall(f"{kind}/SourceFiles/File")]
-        assert "fmi2_runtime.c" in listed and all(f"sources/{f}" in members for f in listed)
-    assert {"sources/fmi2_runtime.c", "sources/model_casadi.c", "sources/model.h"} <= members
+        assert "fmi2_api.c" in listed and all(f"sources/{f}" in members for f in listed)
+    assert {"sources/fmi2_api.c", "sources/core.h", "sources/instance.c", "sources/model_casadi.c",
+            "sources/model.h"} <= members
     assert f"binaries/{build.platform_folder()}/{name}{build.shared_library_suffix()}" in members
     reals = [v for v in md.modelVariables if v.type == "Real"]
     assert all(v.unit is not None for v in reals), [v.name for v in reals if v.unit is None]
@@ -375,8 +376,9 @@ def test_outputs_after_a_step_reuse_its_last_evaluation_and_match_a_fresh_one(fm
     second = fmu.getReal(outputs)
     other, _ = started(fmus, "Wheel", tmp_path, {"W": 575.0, "tau": 40.0, "v_hub": 0.3}, instance="b")
     other.setFMUstate(state)
-    assert other.getReal([vr["statistics.reusedEvaluations"]]) == [0.0]
+    assert other.getReal(stats) == stepped  # the statistics come with the state
     assert other.getReal(outputs) == second  # bit for bit: a fresh evaluation at the same point
+    assert other.getReal([vr["statistics.evaluations"]])[0] == stepped[0] + 1  # (none to reuse there)
     assert first != second
     with pytest.raises(Exception, match="status 3"):
         fmu.setReal([vr["statistics.steps"]], [0.0])
@@ -567,6 +569,47 @@ def test_build_cli_reports_up_to_date_fmus(fmu_dir, fmus, capsys):
     assert "Wheel.fmu is up to date" in capsys.readouterr().out
     assert main(["build-fmus", "--out", str(fmu_dir), "NoSuchModel"]) == 2  # bad input: nothing built
     assert "NoSuchModel" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_build_reports_each_stage_as_it_ends(tmp_path, jobs):
+    """build-fmus shows progress per compile step (issue 29): every FMU's stages reach the step
+    callback, in order per FMU, from this process (--jobs 1) and from the pool's workers (--jobs 2),
+    before its BuildResult; the CLI draws them as a bar on a terminal."""
+    seen: list[tuple[str, str]] = []
+    results = build.build_all(["RoverBody", "SteerableRoverBody"], tmp_path, jobs=jobs, backend="builtin",
+                              step=lambda model, stage: seen.append((model, stage)))
+    folder = build.host_folder()
+    for model in ("RoverBody", "SteerableRoverBody"):
+        assert [s for m, s in seen if m == model] == ["translate", "generate", f"compile {folder}", "package"]
+    assert len(seen) == 2 * build.steps_of(["host"]) and all(r.rebuilt for r in results)
+    again: list[tuple[str, str]] = []
+    build.build_all(["RoverBody"], tmp_path, jobs=jobs, backend="builtin", step=lambda m, s: again.append((m, s)))
+    assert again == []  # up to date: nothing to wait for
+
+
+def test_build_cli_draws_a_progress_bar_on_a_terminal(tmp_path, monkeypatch, capsys):
+    import io
+
+    from rover_cosim.cli import main
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    from rover_cosim.progress import ProgressBar
+
+    defaults = {**(ProgressBar.__init__.__kwdefaults__ or {}), "delay": 0.0}  # drawn at once
+    monkeypatch.setattr(ProgressBar.__init__, "__kwdefaults__", defaults)
+    assert main(["build-fmus", "--out", str(tmp_path), "--backend", "builtin", "--jobs", "1", "RoverBody"]) == 0
+    assert "build-fmus [" in terminal.getvalue() and "100.0%" in terminal.getvalue()
+    assert "built " in capsys.readouterr().out
+    quiet = Terminal()
+    monkeypatch.setattr("sys.stderr", quiet)
+    assert main(["build-fmus", "--out", str(tmp_path), "--force", "-q", "--jobs", "1", "RoverBody"]) == 0
+    assert quiet.getvalue() == ""
 
 
 def test_backend_choice_and_the_omc_script(monkeypatch):

@@ -22,7 +22,7 @@ from rover_cosim.identification.fits import (
 )
 from rover_cosim.identification.sweep import Case, SweepPlan, compute_run, run_file, run_sweep
 from rover_cosim.identification.validate import PAPER_FIT
-from rover_cosim.jobs.identify import IdentificationResult
+from rover_cosim.jobs.identify import RECORD_INTERVAL, IdentificationResult
 
 SMALL = SweepPlan(loads=(300.0, 600.0), torques=(10.0, 30.0), stop_time=0.02, sample_time=1e-3)
 
@@ -76,7 +76,7 @@ def test_a_failing_run_is_recorded_and_the_sweep_goes_on(single_wheel, tmp_path,
     assert set(outcome.failures) == {(600.0, 10.0, 0.0), (600.0, 30.0, 0.0)}
     assert "the carriage fell off" in outcome.failures[Case(600.0, 10.0)]
     assert set(outcome.runs) == {(300.0, 10.0, 0.0), (300.0, 30.0, 0.0)}
-    assert sorted(p.name for p in outcome.cache_folder.glob("*.csv")) == ["W300_tau10.csv", "W300_tau30.csv"]
+    assert sorted(p.name for p in outcome.cache_folder.glob("*.csv.gz")) == ["W300_tau10.csv.gz", "W300_tau30.csv.gz"]
 
 
 def test_an_interrupted_write_leaves_no_file(single_wheel, tmp_path, monkeypatch):
@@ -133,7 +133,12 @@ def test_identify_writes_every_output(out, identified):
             "identification.json"} <= names
     runs = pd.read_csv(out / "runs.csv")
     plan = SweepPlan()
-    assert len(runs) == len(plan.loads) * len(plan.torques) * (round(plan.stop_time / plan.sample_time) + 1)
+    kept = round(RECORD_INTERVAL / plan.sample_time)  # a row every 1 ms of the 0.1 ms samples (and the last)
+    samples = round(plan.stop_time / plan.sample_time) + 1
+    assert kept == 10 and len(runs) == len(plan.loads) * len(plan.torques) * len(range(0, samples, kept))
+    one = runs[(runs["load_N"] == plan.loads[0]) & (runs["torque_N_m"] == plan.torques[0])]
+    np.testing.assert_allclose(np.diff(one["time"]), RECORD_INTERVAL, rtol=1e-9)
+    assert one["time"].iloc[-1] == pytest.approx(plan.stop_time)
     assert list(runs.columns[:4]) == ["load_N", "torque_N_m", "time", "tau"]
     table = pd.read_csv(out / "fit_table.csv")
     assert list(table.columns) == ["load_N", "fit_percent"] and list(table["load_N"]) == [275.0, 575.0, 875.0]

@@ -90,7 +90,7 @@ def test_slip_angle_sweep_caches_per_angle_and_shares_the_longitudinal_runs(fmus
     lateral = run_sweep(fmus["SingleWheel"], lateral_plan, tmp_path, workers=2)
     assert (lateral.computed, lateral.cached) == (2, 1)
     assert run_file(lateral.cache_folder, 300.0, 10.0).exists()
-    assert run_file(lateral.cache_folder, 300.0, 10.0, 20.0).name == "W300_tau10_beta20.csv"
+    assert run_file(lateral.cache_folder, 300.0, 10.0, 20.0).name == "W300_tau10_beta20.csv.gz"
     pd.testing.assert_frame_equal(longitudinal.runs[Case(300.0, 10.0)], lateral.runs[Case(300.0, 10.0)])
     table = lateral_table(lateral.runs).set_index("slip_angle_deg")
     assert table.loc[0.0, "Fy_N"] == 0.0 and table.loc[20.0, "Fy_N"] < table.loc[10.0, "Fy_N"] < 0.0

@@ -134,16 +134,37 @@ NOT_BUILT_FROM = shutil.ignore_patterns(".git", ".venv", "results", "build", "di
 
 
 @pytest.fixture(scope="module")
-def wheel(tmp_path_factory) -> Path:
-    """The project's wheel, built from a copy of the checkout in a scratch folder, so that the
-    build leaves nothing in the checkout (offline: setuptools from the test extra)."""
-    out = tmp_path_factory.mktemp("wheel")
+def release(tmp_path_factory) -> tuple[Path, Path]:
+    """The project's sdist and the wheel built from that sdist (``python -m build``, as a release is
+    made), from a copy of the checkout in a scratch folder, so that the build leaves nothing in the
+    checkout (offline: build and setuptools from the test extra)."""
+    out = tmp_path_factory.mktemp("dist")
     source = tmp_path_factory.mktemp("source") / "rover-cosim"
     shutil.copytree(REPOSITORY, source, symlinks=True, ignore=NOT_BUILT_FROM)
-    run([sys.executable, "-m", "pip", "wheel", "--quiet", "--no-deps", "--no-build-isolation", "-w", str(out),
-         str(source)], cwd=out)
+    run([sys.executable, "-m", "build", "--no-isolation", "--outdir", str(out), str(source)], cwd=out)
+    (sdist,) = out.glob("rover_cosim-*.tar.gz")
     (built,) = out.glob("rover_cosim-*.whl")
-    return built
+    return sdist, built
+
+
+@pytest.fixture(scope="module")
+def wheel(release) -> Path:
+    return release[1]
+
+
+def test_the_sdist_carries_the_release_files_and_the_sources_the_wheel_is_built_from(release):
+    """The source distribution holds the licence, changelog and citation, the Modelica library, the
+    C runtime and the shipped soils (the wheel above was built from it, not from the checkout)."""
+    import tarfile
+
+    sdist, _ = release
+    with tarfile.open(sdist) as archive:
+        names = {name.split("/", 1)[1] for name in archive.getnames() if "/" in name}
+    for expected in ("LICENSE", "CHANGELOG.md", "CITATION.cff", "README.md", "pyproject.toml",
+                     "rover_cosim/modelica/RoverTerramechanics/package.mo",
+                     "rover_cosim/fmubuild/runtime/fmi2_api.c", "rover_cosim/terramechanics/library/soils.toml",
+                     "rover_cosim/py.typed"):
+        assert expected in names, expected
 
 
 def test_building_the_wheel_leaves_nothing_in_the_checkout(wheel):
@@ -156,7 +177,7 @@ def test_the_wheel_has_only_rover_cosim_at_the_top_level(wheel):
         names = archive.namelist()
     top = {name.split("/")[0] for name in names}
     assert top == {"rover_cosim", wheel.name.split("-")[0] + "-" + wheel.name.split("-")[1] + ".dist-info"}, top
-    for expected in ("rover_cosim/orchestrator/systems/rover_cosim.toml", "rover_cosim/fmubuild/runtime/fmi2_runtime.c",
+    for expected in ("rover_cosim/orchestrator/systems/rover_cosim.toml", "rover_cosim/fmubuild/runtime/fmi2_api.c",
                      "rover_cosim/modelica/RoverTerramechanics/package.mo",
                      "rover_cosim/modelica/RoverTerramechanics/package.order", "rover_cosim/terramechanics/forces.py"):
         assert expected in names, expected

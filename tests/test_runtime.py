@@ -90,9 +90,25 @@ def test_runtime_compiles_without_warnings(single_wheel_folder):
     """The runtime (not CasADi's generated code) under -Wall -Wextra -pedantic -Werror."""
     sources = single_wheel_folder / "sources"
     command = ["gcc", "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-Wall", "-Wextra", "-pedantic", "-Werror",
-               "-fsyntax-only", "-I", str(sources), str(sources / "fmi2_runtime.c"), str(sources / "ode23s.c")]
+               "-fsyntax-only", "-I", str(sources),
+               *[str(sources / f) for f in ("fmi2_api.c", "instance.c", "state.c", "cosim.c", "ode23s.c")]]
     result = subprocess.run(command, capture_output=True, text=True, check=False)
     assert result.returncode == 0, result.stderr
+
+
+def test_generated_code_compiles_without_warnings(fmus, tmp_path):
+    """The generated C of a wheel (CasADi's code after fmubuild.guards, and the model's data) under
+    -Wall -Wextra -Werror, optimized so that gcc looks for values that may be read unset (the
+    guarded branches declared theirs without a value: 1340 such warnings in SingleWheel; CasADi's
+    fixed signature left 219 parameters unused)."""
+    with zipfile.ZipFile(fmus["Wheel"]) as archive:
+        archive.extractall(tmp_path)
+    sources = tmp_path / "sources"
+    for name in ("model_casadi.c", "model_data.c"):
+        command = ["gcc", "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-O1", "-Wall", "-Wextra", "-Werror", "-c",
+                   "-I", str(sources), str(sources / name), "-o", str(tmp_path / (name + ".o"))]
+        result = subprocess.run(command, capture_output=True, text=True, check=False)
+        assert result.returncode == 0, result.stderr[-3000:]
 
 
 def test_bad_calls_get_fmi2error_and_a_message_never_a_crash(single_wheel_folder):

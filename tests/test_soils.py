@@ -53,6 +53,8 @@ def test_choose_applies_set_in_si_and_degrees():
     values = library.fmu_parameters(choice.soil, choice.wheel)
     assert values["soil.kxBeta"] == choice.soil.kx_beta and values["wheel.r"] == 0.13
     assert library.from_fmu_parameters(values) == (choice.soil, choice.wheel)
+    values["soil.xc"] = 0.0   # the FMUs' default: 45 deg - phi/2 of the soil's own phi
+    assert library.from_fmu_parameters(values)[0].xc == pytest.approx(math.radians(30.0))
 
 
 @pytest.mark.parametrize(("soil", "assignments", "message"), [

@@ -28,12 +28,28 @@ def cached(fmus, tmp_path):
     return first
 
 
+def test_the_sweeps_cache_files_are_compressed_and_read_back_exactly(cached):
+    """A sweep's cache files are gzip-compressed CSV: smaller than the CSV they hold, and read back
+    equal to the runs the sweep returned."""
+    import gzip
+
+    from rover_cosim.identification.cache import read_run
+
+    path = run_file(cached.cache_folder, 600.0, 30.0)
+    assert path.name.endswith(".csv.gz") and path.read_bytes()[:2] == b"\x1f\x8b"
+    assert path.stat().st_size < len(gzip.decompress(path.read_bytes()))
+    run = cached.runs[Case(600.0, 30.0)]
+    data, problem = read_run(path, len(run), list(run.columns))
+    assert problem is None and data is not None
+    pd.testing.assert_frame_equal(data, run)
+
+
 @pytest.mark.parametrize("damage", ["cut mid-line", "empty", "garbage", "no checksum", "other rows"])
 def test_a_damaged_cache_file_is_named_and_computed_again(fmus, tmp_path, cached, damage):
     path = run_file(cached.cache_folder, 600.0, 30.0)
-    text = path.read_text()
+    payload = path.read_bytes()
     if damage == "cut mid-line":
-        path.write_text(text[: len(text) // 2])
+        path.write_bytes(payload[: len(payload) // 2])
     elif damage == "empty":
         path.write_bytes(b"")
     elif damage == "garbage":

@@ -2,7 +2,7 @@
  *
  * fmubuild generates, per model, model_casadi.c (CasADi's C code of the functions below) and
  * model_data.c (sizes, value-reference layout, defaults: the ModelInfo below). The runtime
- * (fmi2_runtime.c, ode23s.c) is the same for every model.
+ * (core.h: instance.c, state.c, cosim.c, ode23s.c, and the API layer fmi2_api.c) is the same for every model.
  *
  * Real value references are indices into one array laid out as
  *   [parameters | states | derivatives | inputs | observed | memories | tolerance, maxStep | statistics]
@@ -10,6 +10,12 @@
  */
 #ifndef ROVER_COSIM_MODEL_H
 #define ROVER_COSIM_MODEL_H
+
+/* FMI2_FUNCTION_PREFIX (several source FMUs in one program): the FMU's other external names get
+ * the same prefix (fmu_prefix.h, written with the sources by fmubuild). */
+#ifdef FMI2_FUNCTION_PREFIX
+#include "fmu_prefix.h"
+#endif
 
 typedef long long int casadi_int;
 
@@ -30,6 +36,7 @@ typedef struct {
     int nm;                           /* memories: values the runtime keeps from the previous step */
     const double *m_default;          /* [nm] their value before the first step */
     const int *m_source;              /* [nm] index into y of the variable each one remembers */
+    const int *y_is_output;           /* [ny] 1: an output (causality output), 0: a local variable */
 } ModelInfo;
 
 extern const ModelInfo model_info;

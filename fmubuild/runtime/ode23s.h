@@ -6,6 +6,12 @@
 #ifndef ROVER_COSIM_ODE23S_H
 #define ROVER_COSIM_ODE23S_H
 
+/* FMI2_FUNCTION_PREFIX (several source FMUs in one program): the FMU's other external names get
+ * the same prefix (fmu_prefix.h, written with the sources by fmubuild). */
+#ifdef FMI2_FUNCTION_PREFIX
+#include "fmu_prefix.h"
+#endif
+
 typedef struct {
     /* f(t, x) -> xdot; returns 0 on success. */
     int (*rhs)(void *ctx, double t, const double *x, double *xdot);

@@ -1,7 +1,8 @@
 """``make identify``: sweep, fits, validation and every output file, written all at once.
 
 results/identification/
-  runs.csv         every recorded run, long format (load_N, torque_N_m, time, tau, slip, Fx, ...)
+  runs.csv         every recorded run, long format (load_N, torque_N_m, time, tau, slip, Fx, ...),
+                   a row every record_interval (1 ms; the sweep samples every 0.1 ms)
   steps.csv        per run: settled slip and Fx, fitted K and T
   model.json       LUT grids, K and T tables, Fx coefficients of both models, the plan, FMU hash
   fit_table.csv    load_N, fit_percent (the recommended model) at 275, 575, 875 N
@@ -32,6 +33,7 @@ from typing import Any
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
+from rover_cosim.common.rows import every, steps_between_rows
 from rover_cosim.identification import figures, lateral_figures
 from rover_cosim.identification.fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
 from rover_cosim.identification.lateral import (
@@ -53,6 +55,8 @@ from rover_cosim.identification.validate import validate
 from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, describe, soil_label
 
+#: Rows kept in runs.csv [s]: 1 ms (the sweep samples every 0.1 ms; 10x smaller, as the lateral runs).
+RECORD_INTERVAL = 1e-3
 MODELS = {"quadratic": 2, "linear": 1}  # label -> degree in slip; the first is recommended
 RECOMMENDED = "quadratic"
 #: The lateral sweep: the longitudinal sweep's loads and torques at slip angles 0-30 deg.
@@ -85,10 +89,11 @@ def _sweep(fmu_path: Path, plan: SweepPlan, cache_dir: Path, workers: int | None
     return sweep
 
 
-def _long(runs: dict, columns: list[str]) -> pd.DataFrame:
-    """The runs one below the other, each row tagged with its case."""
-    frames = [run.assign(load_N=c.load, torque_N_m=c.torque, slip_angle_deg=c.slip_angle_deg)
-              for c, run in sorted(runs.items())]
+def _long(runs: dict, columns: list[str], interval: float | None = None, sample_time: float = 1.0) -> pd.DataFrame:
+    """The runs one below the other, each row tagged with its case; with ``interval`` [s], a row
+    every ``interval`` of each run (sampled every ``sample_time`` [s]) and its last one."""
+    frames = [(run if interval is None else every(run, interval, sample_time)).assign(
+        load_N=c.load, torque_N_m=c.torque, slip_angle_deg=c.slip_angle_deg) for c, run in sorted(runs.items())]
     return pd.concat(frames, ignore_index=True)[columns]
 
 
@@ -128,13 +133,16 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
                        lateral_plan: SweepPlan | None = None, workers: int | None = None,
                        scheduler: str | None = None, cache_dir: Path | None = None,
                        progress: Callable[[float], None] | None = None,
-                       choice: Choice | Soil | Wheel | None = None) -> IdentificationResult:
+                       choice: Choice | Soil | Wheel | None = None,
+                       record_interval: float = RECORD_INTERVAL) -> IdentificationResult:
     """Sweep, fit, validate and write every file of ``results/identification/`` (all or none):
     the paper's longitudinal model (``plan``) and the lateral model (``lateral_plan``), on the
-    soil and wheel of ``choice`` (default: the paper's)."""
+    soil and wheel of ``choice`` (default: the paper's). runs.csv keeps a row every
+    ``record_interval`` [s] of each run (a whole number of the plan's samples)."""
     started = time.perf_counter()
     choice = as_choice(choice)
     plan = replace(plan or SweepPlan(), soil=choice.soil, wheel=choice.wheel)
+    steps_between_rows(record_interval, plan.sample_time)  # a bad interval refused before anything runs
     lateral_plan = replace(lateral_plan or LATERAL_PLAN, soil=choice.soil, wheel=choice.wheel)
     cache_dir = cache_dir or out_dir / "cache"
     first, second = len(plan.cases()), len(lateral_plan.cases())
@@ -156,7 +164,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     lateral_models = {form.name: identify_lateral(lateral_table_, form) for form in FORMS}
     lateral_validation = validate_lateral(bed, lateral_models)
 
-    long = _long(sweep.runs, ["load_N", "torque_N_m", "time", "tau", *[c for c in RECORDED if c not in ("Fy", "beta")]])
+    long = _long(sweep.runs, ["load_N", "torque_N_m", "time", "tau", *[c for c in RECORDED if c not in ("Fy", "beta")]],
+                 record_interval, plan.sample_time)
     failed = sorted({**sweep.failures, **lateral_sweep.failures}.items())
     failures = pd.DataFrame([{"load_N": c.load, "torque_N_m": c.torque, "slip_angle_deg": c.slip_angle_deg,
                               "error": e} for c, e in failed],
@@ -176,7 +185,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     })
     fit_models = validation.fit.drop(columns=["fit_percent"])
     record = run_record("rover-cosim identify", {"plan": asdict(plan), "lateral_plan": asdict(lateral_plan),
-                                                 "workers": workers, "scheduler": scheduler})
+                                                 "workers": workers, "scheduler": scheduler,
+                                                 "record_interval_s": record_interval})
     record.update({**describe(choice), "fmu_sha256": fmu_sha, "runs_computed": sweep.computed + lateral_sweep.computed,
                    "runs_cached": sweep.cached + lateral_sweep.cached,
                    "runs_failed": len(failed), "sweep_wall_seconds": sweep.wall_seconds + lateral_sweep.wall_seconds,

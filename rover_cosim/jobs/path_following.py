@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
+from rover_cosim.common.rows import every, steps_between_rows
 from rover_cosim.control import path_figures
 from rover_cosim.control.path_controller import PATHS, PathFollowingController
 from rover_cosim.identification.model_set import ModelSet
@@ -47,7 +48,7 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover
-from .simulate import RECORD_INTERVAL, checked_models, every, models_of, steps_between_rows
+from .simulate import RECORD_INTERVAL, checked_models, models_of
 
 STEP = 1e-3  # s
 WHEELS = range(1, 7)

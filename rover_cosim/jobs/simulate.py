@@ -12,7 +12,6 @@ results/simulation/
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -24,6 +23,7 @@ import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
+from rover_cosim.common.rows import every, steps_between_rows
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
 from rover_cosim.identification.model_set import ModelMismatch, ModelSet
@@ -134,22 +134,6 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
             "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
 
 
-def steps_between_rows(interval: float, step: float = STEP) -> int:
-    """Steps of ``step`` [s] between two kept rows; ValueError unless ``interval`` [s] is a whole
-    number (>= 1) of them."""
-    count = interval / step if isinstance(interval, (int, float)) and 0 < interval < math.inf else 0.0
-    if round(count) < 1 or abs(count - round(count)) > 1e-9 * max(1.0, count):
-        raise ValueError(f"record interval {interval!r} s: expected a whole number of steps of {step} s")
-    return round(count)
-
-
-def every(table: pd.DataFrame, interval: float, step: float = STEP) -> pd.DataFrame:
-    """The rows of ``table`` (one per ``step`` [s]) every ``interval`` [s], and the last one."""
-    k = steps_between_rows(interval, step)
-    kept = sorted(set(range(0, len(table), k)) | {len(table) - 1})
-    return table.iloc[kept].reset_index(drop=True)
-
-
 def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> tuple[ModelSet, str | None]:
     """The models of ``model`` and why they do not belong to the soil and wheel of ``choice``
     (None: they do); ModelMismatch naming both unless ``allow_mismatch``."""
@@ -171,7 +155,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     [s] (the metrics and figures use every step)."""
     started = time.perf_counter()
     choice = as_choice(choice)
-    steps_between_rows(record_interval)  # a bad interval refused before anything runs
+    steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
     stages = Stages(progress, 3)
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
@@ -202,9 +186,9 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
                              "fixed_load_ablation": ablation["rms_N"].tolist()}})
     out = Path(out_dir)
     files = {
-        out / "trajectories.csv": every(tables["monolithic"], record_interval).to_csv(
+        out / "trajectories.csv": every(tables["monolithic"], record_interval, STEP).to_csv(
             index=False, float_format="%.8g").encode(),
-        out / "trajectories_cosim.csv": every(tables["cosim"], record_interval).to_csv(
+        out / "trajectories_cosim.csv": every(tables["cosim"], record_interval, STEP).to_csv(
             index=False, float_format="%.8g").encode(),
         out / "rms.csv": rms_mono.to_csv(index=False, float_format="%.4f").encode(),
         out / "rms_cosim.csv": rms_cosim.to_csv(index=False, float_format="%.4f").encode(),

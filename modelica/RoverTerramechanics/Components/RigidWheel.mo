@@ -44,7 +44,7 @@ equation
   assert(soil.kyBeta >= 0, "soil.kyBeta: must be >= 0 m/rad");
   assert(soil.rho >= 0, "soil.rho: the dry density must be >= 0 kg/m3");
   assert(soil.gravity >= 0, "soil.gravity: must be >= 0 m/s2");
-  assert(soil.xc > 0 and soil.xc < 1.5707963267948966, "soil.xc: the destructive angle must be in (0, pi/2) rad");
+  assert(soil.xc >= 0 and soil.xc < 1.5707963267948966, "soil.xc: the destructive angle must be in (0, pi/2) rad, or 0 for 45 deg - phi/2");
   assert(wheel.r > 0, "wheel.r: the radius must be > 0 m");
   assert(wheel.b > 0, "wheel.b: the width must be > 0 m");
   assert(wheel.J > 0, "wheel.J: the spin inertia must be > 0 kg.m2");

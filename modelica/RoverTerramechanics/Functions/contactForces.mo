@@ -6,6 +6,7 @@ function contactForces "Contact forces Fx, Fz and torque Tx of a rigid wheel at 
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
   input Integer nNodes = 16 "Gauss-Legendre nodes on each side of thetaM";
   input Real slipAngle(unit="rad") = 0 "Slip angle beta of the hub velocity (Ishigami et al. 2007), |beta| < pi/2";
+  input Boolean lateralAtZero = false "true: evaluate the lateral terms at beta = 0 too (they are 0 there, their derivative is not)";
   output Real Fx(unit="N") "Longitudinal force (drawbar pull), Eq. (12)";
   output Real Fz(unit="N") "Vertical force, Eq. (11)";
   output Real Tx(unit="N.m") "Resistance torque about the axle, Eq. (13)";
@@ -36,12 +37,14 @@ protected
   Real depth(unit="m") "Depth of the soil piled against the side at theta";
   Real d1(unit="1") "Hegedus D1";
   Real d2(unit="1") "Hegedus D2";
+  Real xc(unit="rad") "Destructive angle: soil.xc, or 45 deg - phi/2 where soil.xc is 0";
 algorithm
   kx := soil.kx + soil.kxBeta*noEvent(abs(slipAngle));
   ky := soil.ky + soil.kyBeta*noEvent(abs(slipAngle));
   tanBeta := tan(slipAngle);
-  d1 := 1/tan(soil.xc) + tan(soil.xc + soil.phi);
-  d2 := 1/tan(soil.xc) + tan(soil.phi)/tan(soil.xc)^2;
+  xc := if soil.xc > 0 then soil.xc else 0.7853981633974483 - soil.phi/2;
+  d1 := 1/tan(xc) + tan(xc + soil.phi);
+  d2 := 1/tan(xc) + tan(soil.phi)/tan(xc)^2;
   sumFy := 0;
   sumPile := 0;
   depth := 0;
@@ -67,7 +70,7 @@ algorithm
     Fz := Fz + ds*dFront*(sigma*cos(theta) + tau*sin(theta));
     Fx := Fx + ds*dFront*(tau*cos(theta) - sigma*sin(theta));
     Tx := Tx + ds*dFront*tau;
-    if noEvent(tanBeta <> 0) then
+    if lateralAtZero or noEvent(tanBeta <> 0) then
       // Lateral shear and sidewall: both vanish at beta = 0 (zero displacement), not computed then.
       sumFy := sumFy + ds*dFront*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
       depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
@@ -81,7 +84,7 @@ algorithm
     Fz := Fz + ds*dRear*(sigma*cos(theta) + tau*sin(theta));
     Fx := Fx + ds*dRear*(tau*cos(theta) - sigma*sin(theta));
     Tx := Tx + ds*dRear*tau;
-    if noEvent(tanBeta <> 0) then
+    if lateralAtZero or noEvent(tanBeta <> 0) then
       sumFy := sumFy + ds*dRear*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
       depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));
       sumPile := sumPile + ds*dRear*d1*(soil.c*depth + d2*soil.rho*soil.gravity*depth^2/2)*(wheel.r - depth*cos(theta));
@@ -126,6 +129,8 @@ D<sub>2</sub> &rho; g h<sup>2</sup>/2) with h = r(cos &theta; - cos &theta;<sub>
 1 - exp(-|j<sub>y</sub>(&theta;<sub>r</sub>)|/k<sub>y</sub>), so that it vanishes smoothly at
 &beta; = 0. F<sub>y</sub> = F<sub>y,sidewall</sub> - r b &int;&tau;<sub>y</sub> d&theta; opposes
 the sideways sliding. Same as <code>terramechanics.lateral</code>. At &beta; = 0 both lateral parts are
-zero (no lateral displacement) and are not computed: a third of the exponentials of an evaluation.</p>
+zero (no lateral displacement) and are not computed: a third of the exponentials of an evaluation;
+<code>lateralAtZero</code> = true computes them there too, for their derivative with respect to
+&beta; (the cornering stiffness), which is not zero (<code>contactResidual</code>).</p>
 </html>"));
 end contactForces;

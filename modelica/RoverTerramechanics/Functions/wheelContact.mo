@@ -62,12 +62,10 @@ algorithm
   first := true;
   for k in 1:nIterations loop
     if not done then
-      h := exp(x);
       logSinkage := x;
-      (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nNodes, slipAngle);
+      // A skidding wheel that has barely sunk can have Fz <= 0: f = -1e3, "too shallow".
+      (f, h, Fx, Fz, Tx, Fy, FySidewall) := contactResidual(x, W, slip, soil, wheel, nNodes, WMin, slipAngle, false);
       evaluations := evaluations + 1;
-      // A skidding wheel that has barely sunk can have Fz <= 0: treat it as "too shallow".
-      f := if noEvent(Fz > 0) then log(Fz/load) else -1e3;
       if noEvent(abs(f) <= tolerance) then
         done := true;
       else
@@ -100,7 +98,8 @@ algorithm
       end if;
     end if;
   end for;
-  annotation (Documentation(info="<html>
+  annotation (__RoverCosim(implicit(unknown="logSinkage", residual="RoverTerramechanics.Functions.contactResidual")),
+    Documentation(info="<html>
 <p>The paper decides the sinkage \"by the optimization\" so that the vertical force of Eq. (11)
 equals the load. Here the equation log F<sub>z</sub>(h, &kappa;) = log W is solved in log h inside
 the function, so that a model that calls it has no nonlinear algebraic loop: the first step is
@@ -116,6 +115,10 @@ log h of its last evaluation) the solve starts there instead; started at a conve
 repeats that evaluation bit for bit and stops after it; a start whose residual exceeds 1 (F<sub>z</sub> more than a factor e from W)
 falls back to the cold start. The result does not depend on the start beyond the tolerance; a
 wheel rolling steadily needs 1-2 evaluations instead of about 4.</p>
+<p>Derivatives: the annotation <code>__RoverCosim(implicit(...))</code> tells the rover-cosim FMU
+exporter that <code>logSinkage</code> solves <code>contactResidual</code> = 0, so that the FMUs'
+directional derivatives and their integrator's Jacobian follow the implicit-function theorem at
+the solution, whatever the warm start (other tools differentiate the iterations, or ignore it).</p>
 <p>Same method as the Python reference <code>terramechanics.wheel_state</code> (which also splits
 the patch where a skidding wheel's shear displacement changes sign).</p>
 </html>"));
