@@ -262,7 +262,8 @@ class SystemBuilder:
         if interval is not None:
             interval = self._number(interval, f"{where} output_interval")
             multiple = interval / step
-            if not interval > 0 or abs(multiple - round(multiple)) > 1e-9 * max(1.0, multiple) or round(multiple) < 1:
+            if not 0 < interval < math.inf or abs(multiple - round(multiple)) > 1e-9 * max(1.0, multiple) \
+                    or round(multiple) < 1:
                 raise self.error(f"{where} output_interval", f"{interval!r}: expected a whole number of communication "
                                  f"steps ({step!r} s) > 0")
 

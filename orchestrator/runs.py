@@ -106,7 +106,7 @@ def write_partial(system: System, data: Any, csv_path: Path, failure: str,
                    "last_time_s": float(data["time"].iloc[-1]) if len(data) else None,
                    "system_file": str(system.path) if system.path else None})
     json_path = sidecar_path(target)
-    write_all({target: table_bytes(data, target), json_path: json_bytes(record)})
+    write_all({target: table_bytes(data, target), json_path: json_bytes(record)}, complete=False)  # not the result
     return [target, json_path]
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import tempfile
@@ -17,6 +18,38 @@ from rover_cosim.orchestrator.examples import examples
 
 #: Example systems shipped with the package (FMU paths relative to --fmu-dir, default fmus/).
 EXAMPLES = examples()
+
+
+#: Bytes of one file name and of a whole path the file systems take (Linux: NAME_MAX, PATH_MAX).
+NAME_MAX, PATH_MAX = 255, 4096
+
+
+def _path_text(text: str) -> str:
+    """A path (or a name standing for one) as given, refused when empty (an empty --out would be
+    the current folder, an empty --soil the paper's) or when the system could not open it for its
+    length: a name of more than NAME_MAX bytes, a path of more than PATH_MAX."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a path or a name (empty)")
+    longest = max((len(os.fsencode(part)) for part in Path(text).parts), default=0)
+    if longest > NAME_MAX or len(os.fsencode(text)) >= PATH_MAX:
+        shown = repr(text) if len(text) <= 60 else f"{text[:40]!r}...{text[-12:]!r} ({len(text)} characters)"
+        raise argparse.ArgumentTypeError(f"{shown}: too long for a file name (expected at most {NAME_MAX} bytes a "
+                                         f"name, {PATH_MAX - 1} a path)")
+    return text
+
+
+def _path(text: str) -> Path:
+    """A path option (checked as _path_text)."""
+    return Path(_path_text(text))
+
+
+def _scheduler(text: str) -> str:
+    """A Dask scheduler's address: [PROTOCOL://]HOST:PORT (tcp://10.0.0.5:8786, tls://[::1]:8786)."""
+    import re
+
+    if not re.fullmatch(r"([a-z][a-z0-9+.-]*://)?(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+):\d{1,5}", text):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a Dask scheduler's address, e.g. tcp://host:8786")
+    return text
 
 
 def _positive_loads(text: str) -> tuple[float, ...]:
@@ -62,10 +95,10 @@ def _slip_range(text: str) -> tuple[float, float]:
 
 
 def _add_soil_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--soil", default=None, help="soil: a name of the shipped library "
+    parser.add_argument("--soil", type=_path_text, default=None, help="soil: a name of the shipped library "
                         "(rover-cosim soils lists them), a TOML file, or FILE:NAME (default: paper)")
-    parser.add_argument("--wheel", default=None, help="wheel: a name of the shipped library, a TOML file, or "
-                        "FILE:NAME (default: paper)")
+    parser.add_argument("--wheel", type=_path_text, default=None,
+                        help="wheel: a name of the shipped library, a TOML file, or FILE:NAME (default: paper)")
     parser.add_argument("--set", dest="assignments", action="append", default=[], metavar="KIND.NAME=VALUE",
                         help="change one value, SI units or *_deg for angles: --set soil.c=500 "
                         "--set soil.phi_deg=30 --set wheel.b=0.2 (repeatable)")
@@ -106,7 +139,7 @@ def build_parser() -> argparse.ArgumentParser:
     original = commands.add_parser
     commands.add_parser = lambda *a, **k: original(*a, formatter_class=_Help, **k)  # type: ignore[method-assign]
     fig3 = commands.add_parser("fig3", help="paper Fig. 3: Fx against slip for loads 100..800 N (numpy reference)")
-    fig3.add_argument("--out", type=Path, default=Path("results"), help="output folder (default: results)")
+    fig3.add_argument("--out", type=_path, default=Path("results"), help="output folder (default: results)")
     fig3.add_argument("--loads", type=_positive_loads, default=None,
                       help="comma-separated wheel loads [N] (default: 100,200,...,800)")
     fig3.add_argument("--slip-step", type=_slip_step, default=0.01,
@@ -115,13 +148,14 @@ def build_parser() -> argparse.ArgumentParser:
                       help="slip ratios from FIRST to LAST in [-1, 1] (negative: braking; default: 0,0.9)")
     _add_soil_options(fig3)
     run = commands.add_parser("run", help="co-simulate a system file (TOML or SSP) -> CSV + JSON sidecar")
-    run.add_argument("system", help="system file (.toml, or an .ssp archive), one FMU (.fmu: run alone, with its "
+    run.add_argument("system", type=_path_text,
+                     help="system file (.toml, or an .ssp archive), one FMU (.fmu: run alone, with its "
                      "DefaultExperiment unless --stop-time/--step say otherwise), or the name of a shipped example: "
                      + ", ".join(EXAMPLES))
-    run.add_argument("-o", "--output", type=Path, default=None,
+    run.add_argument("-o", "--output", type=_path, default=None,
                      help="CSV (full precision) or .parquet to write (default: results/<system name>.csv); a .json "
                      "sidecar goes beside it")
-    run.add_argument("--fmu-dir", type=Path, default=None,
+    run.add_argument("--fmu-dir", type=_path, default=None,
                      help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
     run.add_argument("--algorithm", choices=("jacobi", "gauss-seidel", "iterative"), default=None,
                      help="override the system file's master algorithm")
@@ -138,7 +172,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--start", type=_assignment, action="append", metavar="NAME=VALUE",
                      help="one FMU run alone: a parameter or start value (repeatable; TOML values: 2.5, 3, true, "
                      "\"text\")")
-    run.add_argument("--input", type=Path, default=None, metavar="CSV",
+    run.add_argument("--input", type=_path, default=None, metavar="CSV",
                      help="one FMU run alone: input signals, first column time [s], one column per input "
                      "(continuous Real inputs interpolated, the others held; a repeated time is a step)")
     run.add_argument("--overwrite", action="store_true",
@@ -148,26 +182,27 @@ def build_parser() -> argparse.ArgumentParser:
 
     ssp = commands.add_parser("export-ssp", help="write a system file (TOML) as an SSP 1.0 archive (.ssp) that "
                               "FMPy, libcosim and OMSimulator read")
-    ssp.add_argument("system", help="system file, or the name of a shipped example: " + ", ".join(EXAMPLES))
-    ssp.add_argument("-o", "--output", type=Path, required=True, help="the .ssp archive to write")
+    ssp.add_argument("system", type=_path_text,
+                     help="system file, or the name of a shipped example: " + ", ".join(EXAMPLES))
+    ssp.add_argument("-o", "--output", type=_path, required=True, help="the .ssp archive to write")
     ssp.add_argument("--overwrite", action="store_true",
                      help="replace --output even if it is not an archive this command wrote")
-    ssp.add_argument("--fmu-dir", type=Path, default=None,
+    ssp.add_argument("--fmu-dir", type=_path, default=None,
                      help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
 
     study = commands.add_parser("cosim-study", help="coupling error of the co-simulated rover against the "
                                 "monolithic one, Jacobi, Gauss-Seidel and iterative, steps 1-10 ms -> CSV + PNG")
-    study.add_argument("--out", type=Path, default=Path("results/cosim_study"), help="output folder")
-    study.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
+    study.add_argument("--out", type=_path, default=Path("results/cosim_study"), help="output folder")
+    study.add_argument("--fmu-dir", type=_path, default=Path("fmus"), help="where the FMUs are (default: fmus)")
     study.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
     ident = commands.add_parser("identify", help="paper Sec. 3: step-torque sweep on SingleWheel.fmu, LUT and "
                                 "Fx(W, slip) fits, validation at 275/575/875 N -> results/identification/")
-    ident.add_argument("--out", type=Path, default=Path("results/identification"), help="output folder")
-    ident.add_argument("--fmu", type=Path, default=Path("fmus/SingleWheel.fmu"), help="the test-bed FMU")
+    ident.add_argument("--out", type=_path, default=Path("results/identification"), help="output folder")
+    ident.add_argument("--fmu", type=_path, default=Path("fmus/SingleWheel.fmu"), help="the test-bed FMU")
     ident.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
-    ident.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
-    ident.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    ident.add_argument("--scheduler", type=_scheduler, default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
+    ident.add_argument("--cache", type=_path, default=None, help="run cache (default: <out>/cache)")
     ident.add_argument("--record-interval", type=float, default=0.001,
                        help="rows kept in runs.csv [s] (a whole number of the sweep's 0.1 ms samples; default "
                        "0.001; 0.0001: every sample); the fits use every sample")
@@ -177,9 +212,9 @@ def build_parser() -> argparse.ArgumentParser:
     simulate = commands.add_parser("simulate", help="paper Sec. 4: closed-loop rover, 20 s, on Rover.fmu and on "
                                    "RoverBody + 6 Wheel; then the steerable rover following a turn and a lane "
                                    "change -> results/simulation/")
-    simulate.add_argument("--out", type=Path, default=Path("results/simulation"), help="output folder")
-    simulate.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are")
-    simulate.add_argument("--model", type=Path, default=Path("results/identification/model.json"),
+    simulate.add_argument("--out", type=_path, default=Path("results/simulation"), help="output folder")
+    simulate.add_argument("--fmu-dir", type=_path, default=Path("fmus"), help="where the FMUs are")
+    simulate.add_argument("--model", type=_path, default=Path("results/identification/model.json"),
                           help="identified model (from `rover-cosim identify`)")
     simulate.add_argument("--only", choices=("straight", "path"), default=None,
                           help="only the paper's straight run, or only the path following (default: both)")
@@ -194,18 +229,18 @@ def build_parser() -> argparse.ArgumentParser:
     monte = commands.add_parser("montecarlo", help="Monte Carlo over soil uncertainty: the paper's closed loop with "
                                 "the identified model on every sampled soil, local processes or a Dask cluster -> "
                                 "results/montecarlo/")
-    monte.add_argument("--study", default="lunar_regolith",
+    monte.add_argument("--study", type=_path_text, default="lunar_regolith",
                        help="study file (TOML), or a shipped study: lunar_regolith (default)")
-    monte.add_argument("--model", type=Path, default=Path("results/identification/model.json"),
+    monte.add_argument("--model", type=_path, default=Path("results/identification/model.json"),
                        help="identified model (from `rover-cosim identify` on the study's nominal soil)")
-    monte.add_argument("--fmu-dir", type=Path, default=Path("fmus"), help="where the FMUs are")
-    monte.add_argument("--out", type=Path, default=Path("results/montecarlo"), help="output folder")
+    monte.add_argument("--fmu-dir", type=_path, default=Path("fmus"), help="where the FMUs are")
+    monte.add_argument("--out", type=_path, default=Path("results/montecarlo"), help="output folder")
     monte.add_argument("--runs", type=int, default=None, help="number of samples, the nominal included "
                        "(default: the study's)")
     monte.add_argument("--seed", type=int, default=None, help="random seed (default: the study's)")
     monte.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
-    monte.add_argument("--scheduler", default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
-    monte.add_argument("--cache", type=Path, default=None, help="run cache (default: <out>/cache)")
+    monte.add_argument("--scheduler", type=_scheduler, default=None, help="run on a Dask cluster, e.g. tcp://host:8786")
+    monte.add_argument("--cache", type=_path, default=None, help="run cache (default: <out>/cache)")
     monte.add_argument("--allow-model-mismatch", action="store_true",
                        help="use a model identified on another soil or wheel than the study's nominal ones "
                        "(refused otherwise; recorded)")
@@ -213,19 +248,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     soils = commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources; "
                                 "`soils NAME` shows one with every value and its unit")
-    soils.add_argument("name", nargs="?", default=None, help="a soil or wheel (shipped name, TOML file or FILE:NAME)")
+    soils.add_argument("name", nargs="?", type=_path_text, default=None,
+                       help="a soil or wheel (shipped name, TOML file or FILE:NAME)")
     commands.add_parser("blocks", help="the block types of system files, with their keys, units and defaults")
 
     report = commands.add_parser("report", help="results/report.html: figures and tables beside the paper's")
-    report.add_argument("--results", type=Path, default=Path("results"), help="the results folder")
-    report.add_argument("--out", type=Path, default=None, help="HTML file (default: <results>/report.html)")
+    report.add_argument("--results", type=_path, default=Path("results"), help="the results folder")
+    report.add_argument("--out", type=_path, default=None, help="HTML file (default: <results>/report.html)")
     report.add_argument("--overwrite", action="store_true",
                         help="replace --out even if it is not a report this command wrote")
 
     build = commands.add_parser("build-fmus", help="build the FMI 2.0 FMUs (ME + CS) from modelica/ into fmus/")
     build.add_argument("models", nargs="*", help="models to build (default: SingleWheel Rover RoverBody Wheel "
                        "SteerableRover SteerableRoverBody)")
-    build.add_argument("--out", type=Path, default=Path("fmus"), help="output folder (default: fmus)")
+    build.add_argument("--out", type=_path, default=Path("fmus"), help="output folder (default: fmus)")
     build.add_argument("--backend", default="auto", choices=("auto", "builtin", "omc"),
                        help="auto: omc where OpenModelica is on PATH, else the built-in rumoca/CasADi exporter")
     build.add_argument("--force", action="store_true", help="rebuild even when the FMU is up to date")
@@ -402,7 +438,7 @@ def _run_system(args: argparse.Namespace, system, path: Path,  # noqa: ANN001 - 
     except ValueError as error:
         print(f"rover-cosim run: {error}", file=sys.stderr)
         return 2
-    problem = _unwritable(output) or (None if args.overwrite else _foreign(output, "run"))
+    problem = _unwritable(output, _run_bytes(system)) or (None if args.overwrite else _foreign(output, "run"))
     if problem:  # said before the run, not after it
         print(f"rover-cosim run: output {output}: {problem}", file=sys.stderr)
         return 2
@@ -426,13 +462,28 @@ def _run_system(args: argparse.Namespace, system, path: Path,  # noqa: ANN001 - 
     return 0
 
 
+def _run_bytes(system) -> float:  # noqa: ANN001 - System, imported lazily
+    """About the bytes of a run's CSV: its rows and recorded columns at ~25 characters a value."""
+    rows = (system.stop_time - system.start_time) / system.step / system.record_every + 2
+    return rows * (len(system.record) + 1) * 25
+
+
 def _cosim_study(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.cosim_study import write_cosim_study
+    from rover_cosim.jobs.cosim_study import systems, write_cosim_study
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
     from rover_cosim.progress import ProgressBar
 
     if not _output_folder(args.out, "cosim-study"):
+        return 2
+    if not args.fmu_dir.is_dir():
+        print(f"rover-cosim cosim-study: --fmu-dir {args.fmu_dir}: no such folder (build the FMUs with "
+              "`rover-cosim build-fmus`)", file=sys.stderr)
+        return 2
+    try:
+        systems(args.fmu_dir)  # its FMUs there
+    except SystemFileError as error:
+        print(f"rover-cosim cosim-study: --fmu-dir {args.fmu_dir}: {error}", file=sys.stderr)
         return 2
     bar = ProgressBar("cosim-study", enabled=not args.quiet)
     try:
@@ -449,17 +500,29 @@ def _cosim_study(args: argparse.Namespace) -> int:
 
 
 def _identify(args: argparse.Namespace) -> int:
+    from rover_cosim.common.rows import steps_between_rows
+    from rover_cosim.identification.sweep import SweepPlan
     from rover_cosim.jobs.identify import run_identification
     from rover_cosim.progress import ProgressBar
 
-    if not _output_folder(args.out, "identify"):
+    if not _output_folder(args.out, "identify") or (args.cache and not _output_folder(args.cache, "identify", 0,
+                                                                                       "--cache")):
         return 2
     if args.workers is not None and args.workers < 1:
         print(f"rover-cosim identify: --workers {args.workers}: expected >= 1", file=sys.stderr)
         return 2
+    try:
+        steps_between_rows(args.record_interval, SweepPlan().sample_time)
+    except ValueError as error:
+        print(f"rover-cosim identify: --record-interval: {error}", file=sys.stderr)
+        return 2
     if not args.fmu.is_file():
         print(f"rover-cosim identify: FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)",
               file=sys.stderr)
+        return 2
+    if not _is_fmu(args.fmu):
+        print(f"rover-cosim identify: --fmu {args.fmu}: not an FMU (expected a zip archive holding a "
+              "modelDescription.xml, e.g. fmus/SingleWheel.fmu)", file=sys.stderr)
         return 2
     choice = _choice(args, "identify")
     if choice is None:
@@ -486,9 +549,21 @@ def _identify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _is_fmu(path: Path) -> bool:
+    """Whether ``path`` is an FMU: a zip archive with a modelDescription.xml."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as archive:
+            return "modelDescription.xml" in archive.namelist()
+    except (OSError, zipfile.BadZipFile):
+        return False
+
+
 def _simulate(args: argparse.Namespace) -> int:
+    from rover_cosim.common.rows import steps_between_rows
     from rover_cosim.jobs.path_following import run_path_following
-    from rover_cosim.jobs.simulate import run_simulation
+    from rover_cosim.jobs.simulate import STEP, run_simulation
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
     from rover_cosim.progress import ProgressBar
@@ -499,9 +574,12 @@ def _simulate(args: argparse.Namespace) -> int:
         print(f"rover-cosim simulate: --fmu-dir {args.fmu_dir}: no such folder (build the FMUs with "
               "`rover-cosim build-fmus`)", file=sys.stderr)
         return 2
-    if not args.model.is_file():
-        print(f"rover-cosim simulate: identified model {args.model} not found (make it with `rover-cosim identify`)",
-              file=sys.stderr)
+    try:
+        steps_between_rows(args.record_interval, STEP)
+    except ValueError as error:
+        print(f"rover-cosim simulate: --record-interval: {error}", file=sys.stderr)
+        return 2
+    if not _model_readable(args.model, "simulate"):
         return 2
     choice = _choice(args, "simulate")
     if choice is None:
@@ -526,12 +604,22 @@ def _simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _model_readable(path: Path, command: str) -> bool:
+    """Whether ``path`` is an identified model (read whole, as the command will); else says why."""
+    from rover_cosim.identification.model_set import ModelFileError, ModelSet
+
+    try:
+        ModelSet.read(path)
+    except ModelFileError as error:
+        print(f"rover-cosim {command}: {error}", file=sys.stderr)
+        return False
+    return True
+
+
 def _montecarlo(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
     from rover_cosim.progress import ProgressBar
 
-    if not _output_folder(args.out, "montecarlo"):
-        return 2
     for option, value, least in (("--workers", args.workers, 1), ("--runs", args.runs, 1), ("--seed", args.seed, 0)):
         if value is not None and value < least:
             print(f"rover-cosim montecarlo: {option} {value}: expected >= {least}", file=sys.stderr)
@@ -541,9 +629,10 @@ def _montecarlo(args: argparse.Namespace) -> int:
     except StudyError as error:
         print(f"rover-cosim montecarlo: {error}", file=sys.stderr)
         return 2
-    if not args.model.is_file():
-        print(f"rover-cosim montecarlo: identified model {args.model} not found (make it with `rover-cosim identify`)",
-              file=sys.stderr)
+    if not _output_folder(args.out, "montecarlo", NEEDS["montecarlo"] + MONTECARLO_RUN_BYTES * study.runs) or (
+            args.cache and not _output_folder(args.cache, "montecarlo", 0, "--cache")):
+        return 2
+    if not _model_readable(args.model, "montecarlo"):
         return 2
     bar = ProgressBar("montecarlo", enabled=not args.quiet)
     try:
@@ -642,6 +731,10 @@ def _build_fmus(args: argparse.Namespace) -> int:
     if args.jobs is not None and args.jobs < 1:
         print(f"rover-cosim build-fmus: --jobs {args.jobs}: expected >= 1", file=sys.stderr)
         return 2
+    unknown = [name for name in args.models if name not in FMU_MODELS]
+    if unknown:
+        print(f"rover-cosim build-fmus: model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}", file=sys.stderr)
+        return 2
     try:
         platforms = parse_platforms(args.platforms)
     except ValueError as error:
@@ -672,7 +765,7 @@ def _report(args: argparse.Namespace) -> int:
         print(f"rover-cosim report: nothing to report in {args.results} (no results of fig3, identify or "
               "simulate; make them with `rover-cosim fig3`, `identify`, `simulate`)", file=sys.stderr)
         return 1
-    problem = _unwritable(target) or (None if args.overwrite else _foreign(target, "report"))
+    problem = _unwritable(target, NEEDS["report"]) or (None if args.overwrite else _foreign(target, "report"))
     if problem:
         print(f"rover-cosim report: --out {target}: {problem}", file=sys.stderr)
         return 2
@@ -719,27 +812,28 @@ def _foreign(target: Path, command: str) -> str | None:
     return (f"{target} exists and is not a result of rover-cosim {command}: pass --overwrite to replace it")
 
 
-def _unwritable(target: Path) -> str | None:
-    """Why ``target`` (a file to write) cannot be written, or None: a folder in its place, a file
-    where its folder should be, a folder we may not write."""
-    import os
-
-    if target.is_dir():
-        return "is a folder: expected a file name"
-    folder = target.parent
-    while not folder.exists() and folder != folder.parent:
-        folder = folder.parent
-    if not folder.is_dir():
-        return f"{folder} is a file, not a folder"
-    if not os.access(folder, os.W_OK | os.X_OK):
-        return f"the folder {folder} cannot be written"
-    return None
+#: Bytes a command's results take, about (with its run cache; checked against the free space before
+#: the work starts). The Monte Carlo adds MONTECARLO_RUN_BYTES per run, `run` its rows.
+NEEDS = {"fig3": 5e6, "identify": 80e6, "simulate": 60e6, "montecarlo": 10e6, "cosim-study": 5e6, "report": 20e6,
+         "export-ssp": 0.0}
+MONTECARLO_RUN_BYTES = 5e3
 
 
-def _output_folder(out: Path, command: str) -> bool:
-    """Whether ``out`` can be an output folder (absent or a folder); else says why (on stderr)."""
-    if out.exists() and not out.is_dir():
-        print(f"rover-cosim {command}: --out {out} is a file: expected a folder (absent or existing)", file=sys.stderr)
+def _unwritable(target: Path, need_bytes: float = 0) -> str | None:
+    """Why ``target`` (a file to write) cannot be written, or None (common.outputs.output_problem)."""
+    from rover_cosim.common.outputs import output_problem
+
+    return output_problem(target, folder=False, need_bytes=need_bytes)
+
+
+def _output_folder(out: Path, command: str, need_bytes: float | None = None, option: str = "--out") -> bool:
+    """Whether ``out`` can be an output folder (absent or a writable folder, with room for about
+    the command's results); else says why (on stderr)."""
+    from rover_cosim.common.outputs import output_problem
+
+    problem = output_problem(out, folder=True, need_bytes=NEEDS[command] if need_bytes is None else need_bytes)
+    if problem:
+        print(f"rover-cosim {command}: {option} {out}: {problem}", file=sys.stderr)
         return False
     return True
 
@@ -826,38 +920,82 @@ def _terminate(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+def _result_sets(args: argparse.Namespace) -> int | None:
+    """How many result sets (common.outputs.write_all calls) make the command's results whole;
+    None: a command without results to write this way."""
+    if args.command == "simulate":
+        return 1 if args.only else 2
+    return None if args.command in ("soils", "blocks", "build-fmus", "export-ssp") else 1
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    """The command of ``argv`` (default: the process's arguments); its exit code. Run as the
+    process itself (argv None), a signal that comes once the code is known no longer changes it."""
+    code = _main(argv)
+    if argv is None and threading.current_thread() is threading.main_thread():
+        for number in (signal.SIGINT, signal.SIGTERM):  # the process only exits from here on
+            signal.signal(number, signal.SIG_IGN)
+    return code
+
+
+def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
-    from rover_cosim.common import figures
-    from rover_cosim.common.outputs import set_command_line
-
-    try:
-        figures.configure(args.figures, args.dpi)
-    except ValueError as error:
-        print(f"rover-cosim: {error}", file=sys.stderr)
-        return 2
-
-    set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if main_thread else None
-    from rover_cosim.common.outputs import Busy, writing
-
-    target = getattr(args, "out", None) or getattr(args, "output", None)
     try:
+        return _command(args, argv)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _command(args: argparse.Namespace, argv: Sequence[str] | None) -> int:
+    """The command of ``args`` with its output held (a second writer refused), and the exit code
+    of how it ended."""
+    from rover_cosim.common.outputs import Busy, OutputError, committed, set_command_line, writing
+
+    before, needed = committed(), _result_sets(args)
+    try:
+        from rover_cosim.common import figures  # matplotlib: a while to import, a signal may come meanwhile
+
+        try:
+            figures.configure(args.figures, args.dpi)
+        except ValueError as error:
+            print(f"rover-cosim: {error}", file=sys.stderr)
+            return 2
+        set_command_line(["rover-cosim", *(sys.argv[1:] if argv is None else argv)])
+        target = getattr(args, "out", None) or getattr(args, "output", None)
         with writing(target, f"rover-cosim {args.command}") if target is not None else nullcontext():
             return COMMANDS[args.command](args)
     except Busy as busy:
         print(f"rover-cosim {args.command}: {busy}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except OutputError as error:
+        print(f"rover-cosim {args.command}: {error}", file=sys.stderr)
+        return 1
+    except (KeyboardInterrupt, ImportError) as error:
+        if isinstance(error, ImportError) and not _cut_short(error):
+            raise
+        if needed is not None and committed() - before >= needed:  # the signal came after the results
+            print(f"rover-cosim {args.command}: interrupted after its results were written; they are whole",
+                  file=sys.stderr)
+            return 0
         print(f"rover-cosim {args.command}: interrupted; nothing more written", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader went away (`rover-cosim soils | head`)
         sys.stderr.close()
         return 0
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+
+
+def _cut_short(error: BaseException) -> bool:
+    """Whether ``error`` (an ImportError) comes of a KeyboardInterrupt: a C extension whose
+    initialisation a signal interrupted reports "initialization failed" instead."""
+    seen: BaseException | None = error
+    while seen is not None:
+        if isinstance(seen, KeyboardInterrupt):
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return False
 
 
 if __name__ == "__main__":

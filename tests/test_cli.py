@@ -83,7 +83,7 @@ def test_papercuts_are_messages_naming_the_value(tmp_path, capsys):
     existing.write_text("x")
     for command in (["fig3"], ["simulate"], ["identify"], ["cosim-study"]):
         assert main([*command, "--out", str(existing)]) == 2
-        assert f"--out {existing} is a file: expected a folder" in capsys.readouterr().err
+        assert f"--out {existing}: is a file: expected a folder" in capsys.readouterr().err
     assert existing.read_text() == "x"
     assert main(["fig3", "--soil", str(tmp_path / "nofile.toml"), "--out", str(tmp_path / "f")]) == 2
     assert "nofile.toml not found" in capsys.readouterr().err
@@ -191,3 +191,79 @@ def test_a_scheduler_that_does_not_answer_is_named(monkeypatch):
     monkeypatch.setenv("ROVER_COSIM_SCHEDULER_TIMEOUT", "2")
     with pytest.raises(RuntimeError, match=r"Dask scheduler tcp://127.0.0.1:1: no Dask scheduler answered within 2 s"):
         list(parallel_map(time.sleep, [(0,)], scheduler="tcp://127.0.0.1:1"))
+
+
+@pytest.mark.parametrize(("command", "option"), [
+    (["montecarlo", "--study"], "--study"), (["montecarlo", "--model"], "--model"), (["identify", "--fmu"], "--fmu"),
+    (["simulate", "--fmu-dir"], "--fmu-dir"), (["report", "--results"], "--results"), (["run"], "system"),
+    (["soils"], "name"), (["fig3", "--soil"], "--soil"), (["fig3", "--out"], "--out"),
+    (["run", "x.toml", "-o"], "-o/--output")])
+@pytest.mark.parametrize("value", ["a" * 300, "/" + "b/" * 2100])
+def test_paths_too_long_for_the_file_system_are_named(command, option, value, capsys):
+    """Before: OSError (File name too long) tracebacks from the first look at the path."""
+    with pytest.raises(SystemExit) as ended:
+        main([*command, value])
+    assert ended.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert f"error: argument {option}: " in err and "too long for a file name (expected at most 255 bytes a name" in err
+
+
+@pytest.mark.parametrize(("command", "option"), [(["fig3", "--out"], "--out"), (["fig3", "--soil"], "--soil"),
+                                                 (["fig3", "--wheel"], "--wheel"), (["run"], "system"),
+                                                 (["identify", "--cache"], "--cache")])
+def test_an_empty_path_is_refused_not_taken_as_the_current_folder_or_the_default(command, option, capsys):
+    """Before: fig3 --out '' wrote into the current folder, --soil '' and --wheel '' ran the paper's."""
+    with pytest.raises(SystemExit) as ended:
+        main([*command, ""])
+    assert ended.value.code == 2
+    assert f"error: argument {option}: '': expected a path or a name (empty)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("arguments", "message"), [
+    (["simulate", "--record-interval", "inf"], "rover-cosim simulate: --record-interval: record interval inf s: "
+                                                "expected a whole number of steps of 0.001 s"),
+    (["simulate", "--record-interval", "-1"], "rover-cosim simulate: --record-interval: record interval -1.0 s: "
+                                               "expected a whole number of steps of 0.001 s"),
+    (["identify", "--record-interval", "inf"], "rover-cosim identify: --record-interval: record interval inf s: "
+                                                "expected a whole number of steps of 0.0001 s"),
+    (["build-fmus", "Nope"], "rover-cosim build-fmus: model 'Nope': expected one of SingleWheel, Rover"),
+    (["cosim-study", "--fmu-dir", "/nonexistent"], "rover-cosim cosim-study: --fmu-dir /nonexistent: no such folder"),
+    (["cosim-study", "--fmu-dir", "TMP"], "rover-cosim cosim-study: --fmu-dir TMP: /"),  # a folder without the FMUs
+    (["identify", "--fmu", "TEXT"], "rover-cosim identify: --fmu TEXT: not an FMU (expected a zip archive holding a "
+                                    "modelDescription.xml"),
+    (["simulate", "--model", "TEXT"], "rover-cosim simulate: TEXT: not a JSON file"),
+    (["montecarlo", "--model", "TEXT"], "rover-cosim montecarlo: TEXT: not a JSON file"),
+])
+def test_bad_input_found_by_the_fuzz_is_refused_before_the_work(arguments, message, tmp_path, capsys):
+    """Before: simulate --record-interval inf an OverflowError traceback; -1, an unknown model of
+    build-fmus, a missing --fmu-dir of cosim-study, an identified model that is not one and an
+    FMU that is not one (identify's every run failing) exit 1 (the work failed) after starting it."""
+    (tmp_path / "model.json").write_text("{}")
+    extra = {"simulate": ["--fmu-dir", str(tmp_path), "--model", str(tmp_path / "model.json")]}.get(arguments[0], [])
+    extra = extra if "--model" not in arguments else extra[:2]
+    (tmp_path / "text.json").write_text("not JSON\n")
+    named = {"TEXT": str(tmp_path / "text.json"), "TMP": str(tmp_path)}
+    arguments = [named.get(a, a) for a in arguments]
+    assert main([*arguments, *extra, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(message.replace("TEXT", named["TEXT"]).replace("TMP", named["TMP"])), err
+    assert "Rover.fmu not found" in err or "TMP" not in message
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("address", ["5000", "/etc/passwd", "soil.c=800", "tcp://host", "host:port"])
+def test_a_scheduler_that_is_not_an_address_is_refused_at_once(address, capsys):
+    """Before: "no Dask scheduler answered within 30 s (ValueError: missing port number ...)", exit 1."""
+    for command in ("identify", "montecarlo"):
+        with pytest.raises(SystemExit) as ended:
+            main([command, "--scheduler", address])
+        assert ended.value.code == 2
+        assert f"argument --scheduler: {address!r}: expected a Dask scheduler's address, e.g. tcp://host:8786" in \
+            capsys.readouterr().err
+
+
+def test_a_monte_carlo_of_absurdly_many_runs_is_refused_naming_the_limit(tmp_path, capsys):
+    """Before: --runs 10**30 reached the free-space check ("needs about 5e27 MB")."""
+    assert main(["montecarlo", "--runs", str(10**30), "--out", str(tmp_path / "mc")]) == 2
+    assert f"runs = {10**30}: expected a whole number from 1 (the nominal included) to 1,000,000" in \
+        capsys.readouterr().err

@@ -67,12 +67,25 @@ def test_failed_drawing_leaves_previous_results_untouched(tmp_path, monkeypatch)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fig3_fx_vs_slip.csv"]
 
 
-def test_write_all_is_all_or_nothing(tmp_path):
-    blocker = tmp_path / "not_a_dir"
+def test_write_all_is_all_or_nothing_and_saves_what_it_could_not_write(tmp_path, monkeypatch):
+    import re
+    import tempfile
+
+    from rover_cosim.common.outputs import OutputError
+
+    (tmp_path / "tmp").mkdir()
+    monkeypatch.setenv("TMPDIR", str(tmp_path / "tmp"))
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    out = tmp_path / "out"
+    out.mkdir()
+    blocker = out / "not_a_dir"
     blocker.write_text("x")
-    with pytest.raises(OSError):
-        write_all({tmp_path / "a.csv": b"1", blocker / "b.csv": b"2"})
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_dir"]
+    with pytest.raises(OutputError, match=rf"could not be written to {out} \(.*\); they are saved in ") as failed:
+        write_all({out / "a.csv": b"1", blocker / "b.csv": b"2"})
+    assert sorted(p.name for p in out.iterdir()) == ["not_a_dir"]
+    saved = Path(re.search(r"saved in (\S+):", str(failed.value)).group(1))  # type: ignore[union-attr]
+    assert saved.parent == tmp_path / "tmp"
+    assert (saved / "a.csv").read_bytes() == b"1" and (saved / "not_a_dir" / "b.csv").read_bytes() == b"2"
 
 
 def test_a_slip_range_with_braking_and_files_named_by_the_soil(tmp_path):

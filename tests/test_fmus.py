@@ -567,7 +567,7 @@ def test_build_cli_reports_up_to_date_fmus(fmu_dir, fmus, capsys):
 
     assert main(["build-fmus", "--out", str(fmu_dir), "--backend", "builtin", "--jobs", "1", "Wheel"]) == 0
     assert "Wheel.fmu is up to date" in capsys.readouterr().out
-    assert main(["build-fmus", "--out", str(fmu_dir), "NoSuchModel"]) == 1
+    assert main(["build-fmus", "--out", str(fmu_dir), "NoSuchModel"]) == 2  # bad input: nothing built
     assert "NoSuchModel" in capsys.readouterr().err
 
 

@@ -52,7 +52,7 @@ def test_system_files_with_odd_values_end_in_a_message(fmu_dir, fmus):
     for case in range(300):
         data = copy.deepcopy(base)
         for _ in range(rng.randint(1, 3)):
-            _set(data, rng.choice(_paths(data) or paths), rng.choice(ODD))
+            _set(data, rng.choice(_paths(data) or paths), copy.deepcopy(rng.choice(ODD)))  # not ODD's own list
         try:
             system_from_dict(data, name=f"fuzz case {case}", base=fmu_dir)
         except SystemFileError:
@@ -77,9 +77,12 @@ def test_soil_tables_with_odd_values_end_in_a_message():
 
 def test_command_line_options_with_odd_values_end_in_a_message(tmp_path, capsys):
     rng = random.Random(SEED + 2)
-    values = ["-1", "0", "nan", "inf", "1e300", "1e-300", "x", "", "300,", ",", "1,2,3", "-0.5,0.9", "0.5", "5000"]
+    values = ["-1", "0", "nan", "inf", "1e300", "1e-300", "x", "", "300,", ",", "1,2,3", "-0.5,0.9", "0.5", "5000",
+              "a" * 300, "/" + "b/" * 2100]
     commands = [["fig3", "--loads"], ["fig3", "--slip-step"], ["fig3", "--slip-range"], ["fig3", "--set"],
-                ["fig3", "--soil"], ["soils"], ["--dpi"], ["--figures"], ["run", "nosuch.toml", "--step"]]
+                ["fig3", "--soil"], ["soils"], ["--dpi"], ["--figures"], ["run", "nosuch.toml", "--step"],
+                ["run"], ["montecarlo", "--study"], ["montecarlo", "--model"], ["identify", "--fmu"],
+                ["simulate", "--model"], ["report", "--results"], ["export-ssp", "-o", "x.ssp"]]
     for case in range(120):
         command = [*rng.choice(commands), rng.choice(values)]
         if command[0] == "--dpi" or command[0] == "--figures":

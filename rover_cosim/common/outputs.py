@@ -6,32 +6,117 @@ import hashlib
 import json
 import os
 import platform
+import shutil
+import signal
 import subprocess
 import sys
 import tempfile
-from collections.abc import Iterator, Mapping, Sequence
-from contextlib import ExitStack, contextmanager
+import threading
+from collections.abc import Collection, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 
-_UMASK = os.umask(0)
-os.umask(_UMASK)
+from .folders import exchange_folder
+from .locks import Busy as Busy  # noqa: F401 - re-exported: the CLI takes them from here
+from .locks import folder_locks
+from .locks import writing as writing  # noqa: F401
+from .scratch import UMASK
 
 PACKAGES = ("rover-cosim", "numpy", "scipy", "pandas", "matplotlib", "fmpy", "casadi", "rumoca")
 
 
-def write_all(files: Mapping[Path, bytes]) -> None:
+class OutputError(Exception):
+    """The results were computed but could not be written where asked; the message says why and
+    where they were saved instead."""
+
+
+def write_all(files: Mapping[Path, bytes], folder: Path | None = None, stale: Collection[str] = (),
+              complete: bool = True) -> None:
     """Write every file or none of them.
 
-    Each payload goes to a temporary file beside its target first; only when all temporaries
-    are complete are they renamed into place (a rename within a directory is atomic), so a
-    failure leaves no half-written result and no stray temporary. The renames happen under a lock
-    of each target folder (a lock file in the temporary folder, named by the folder's digest), so
-    two commands writing the same files at once leave one's set or the other's, never a mix.
+    ``folder`` given (a results folder of one command, holding every file of ``files``): the
+    folder is replaced as one unit (common.folders: a sibling with the new files and the rest of
+    the old folder, hard-linked, then one exchange), the files of ``stale`` (patterns relative to
+    the folder: this result set's files it did not write this time) left out. Otherwise, or where
+    the folder is shared or the system cannot exchange folders: each payload goes to a temporary
+    file beside its target, and only when all are complete are they renamed into place (each
+    rename is atomic), under a lock of each target folder (a lock file in the temporary folder,
+    named by the folder's digest), so two commands writing the same files at once leave one's set
+    or the other's, never a mix; SIGINT and SIGTERM wait until the renames are done.
+
+    A failure leaves the previous results and no stray temporary, and raises OutputError naming
+    a folder (in the temporary folder, else the home folder) where the new files were saved.
+    ``complete``: the files are a command's result set (counted by :func:`committed`), not what
+    is kept of a failed run.
     """
-    staged: list[tuple[Path, Path]] = []
     files = _with_other_renderings(files)
+    try:
+        if folder is None or not _exchange(Path(folder), files, stale, complete):
+            _rename_each(files, complete)
+    except OSError as error:
+        raise OutputError(_saved(files, folder, error)) from None
+
+
+def committed() -> int:
+    """How many result sets this process has written (write_all calls of complete results)."""
+    return _COMMITTED
+
+
+_COMMITTED = 0
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM held back while the last step of a write is done and counted, so that
+    they cannot cut it short: their handlers (Python's, run in the main thread) are replaced by
+    one that notes them, and the notes are handed to the previous handlers afterwards. (Blocking
+    them with pthread_sigmask would not do: the kernel gives them to another thread, e.g. BLAS's.)"""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = {number: signal.signal(number, lambda caught_number, frame: caught.append(caught_number))
+                for number in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for held, handler in previous.items():
+            signal.signal(held, handler)
+        for number in caught:
+            handler = previous[signal.Signals(number)]
+            if callable(handler):
+                handler(number, None)  # KeyboardInterrupt, as the command's handlers raise it
+            elif handler == signal.SIG_DFL:
+                os.kill(os.getpid(), number)
+
+
+def _exchange(folder: Path, files: Mapping[Path, bytes], stale: Collection[str], complete: bool) -> bool:
+    """``files`` written by replacing ``folder`` as one unit; False where it cannot be."""
+    global _COMMITTED
+    relative = {target: Path(target).relative_to(folder) for target in files}
+
+    def write(staging: Path) -> list[Path]:
+        for target, payload in files.items():
+            path = staging / relative[target]
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(payload)
+            os.chmod(path, result_mode())
+        return list(relative.values())
+
+    if any(".." in path.parts or path.is_absolute() for path in relative.values()):
+        return False
+    with folder_locks([folder]), _signals_held():
+        done = exchange_folder(folder, write, stale)
+        _COMMITTED += done and complete
+    return done
+
+
+def _rename_each(files: Mapping[Path, bytes], complete: bool) -> None:
+    """Temporaries beside the targets, renamed into place under the folders' locks."""
+    global _COMMITTED
+    staged: list[tuple[Path, Path]] = []
     try:
         for target, payload in files.items():
             target.parent.mkdir(parents=True, exist_ok=True)
@@ -40,45 +125,65 @@ def write_all(files: Mapping[Path, bytes]) -> None:
             with os.fdopen(handle, "wb") as stream:
                 stream.write(payload)
             os.chmod(name, result_mode())  # mkstemp makes 0600; results are ordinary files
-        with _folder_locks(sorted({target.parent for _, target in staged})):
+        with folder_locks(sorted({target.parent for _, target in staged})), _signals_held():
             for temporary, target in staged:
                 os.replace(temporary, target)
+            _COMMITTED += complete
     finally:
         for temporary, _ in staged:
             temporary.unlink(missing_ok=True)
 
 
-def _lock_file(target: Path, kind: str) -> Path:
-    """The lock file of ``target`` (kind: lock, for the renames; busy, for a whole command), in the
-    temporary folder, named by the digest of the target's path."""
-    name = hashlib.sha256(str(target.resolve()).encode()).hexdigest()[:24]
-    return Path(tempfile.gettempdir()) / f"rover-cosim-{kind}-{name}"
+def _saved(files: Mapping[Path, bytes], folder: Path | None, error: OSError) -> str:
+    """Save ``files`` where they can be (a new folder in the temporary folder, else in the home
+    folder), with their paths below their common folder; the message of the failure."""
+    root = Path(folder) if folder is not None else Path(os.path.commonpath([Path(t).parent for t in files]))
+    reason = f"{error.strerror or error}" + (f": {error.filename}" if error.filename else "")
+    for place in (Path(tempfile.gettempdir()), Path.home()):
+        try:
+            kept = Path(tempfile.mkdtemp(prefix=f"rover-cosim-saved.{root.name or 'results'}.", dir=place))
+            for target, payload in files.items():
+                path = kept / Path(target).relative_to(root)
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_bytes(payload)
+        except OSError:
+            continue
+        return (f"the results could not be written to {root} ({reason}); they are saved in {kept}: move them where "
+                "they belong")
+    return f"the results could not be written to {root} ({reason}), nor saved elsewhere; they are lost"
 
 
-@contextmanager
-def _folder_locks(folders: list[Path]) -> Iterator[None]:
-    """Exclusive locks (flock) on ``folders`` (taken in order, so two writers cannot deadlock);
-    where there is no flock (Windows) or the lock file cannot be opened (another user's), the
-    renames go on without it."""
+def output_problem(path: Path, folder: bool, need_bytes: float = 0) -> str | None:
+    """Why results cannot go to ``path`` (a folder to write into, or a file to write when
+    ``folder`` is False), or None: a file where a folder is expected or the other way round, a
+    file above it, a folder that cannot be written (a file is made and removed there to know), or
+    less free space than ``need_bytes`` (an estimate) on its file system."""
+    path = Path(path)
+    if folder and path.exists() and not path.is_dir():
+        return "is a file: expected a folder (absent or existing)"
+    if not folder and path.is_dir():
+        return "is a folder: expected a file name"
+    existing = path if folder else path.parent
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        return f"{existing} is a file, not a folder"
     try:
-        import fcntl
-    except ImportError:  # not POSIX
-        yield
-        return
-    with ExitStack() as stack:
-        for folder in folders:
-            try:
-                handle = stack.enter_context(open(_lock_file(folder, "lock"), "a"))  # noqa: SIM115 - held open while locked
-            except OSError:
-                continue
-            fcntl.flock(handle, fcntl.LOCK_EX)
-            stack.callback(fcntl.flock, handle, fcntl.LOCK_UN)
-        yield
+        handle, probe = tempfile.mkstemp(prefix=".rover-cosim-probe.", dir=existing)
+    except OSError as error:
+        return f"the folder {existing} cannot be written ({error.strerror})"
+    os.close(handle)
+    os.unlink(probe)
+    free = shutil.disk_usage(existing).free
+    if free < need_bytes:
+        return (f"{free / 1e6:.1f} MB free on the file system of {existing}; the results need about "
+                f"{need_bytes / 1e6:.1f} MB")
+    return None
 
 
 def result_mode() -> int:
     """The file mode of every result: 0666 less the process's umask (0644 under the usual 022)."""
-    return 0o666 & ~_UMASK
+    return 0o666 & ~UMASK
 
 
 def _with_other_renderings(files: Mapping[Path, bytes]) -> dict[Path, bytes]:
@@ -155,41 +260,3 @@ def summary_repr(kind: str, files: Sequence[Path] | None = None, **facts: object
         parts.append(f"{len(files)} files in {', '.join(folders)}")
     parts += [f"{key}={value}" for key, value in facts.items()]
     return f"{kind}({'; '.join(parts)})"
-
-
-class Busy(RuntimeError):
-    """Another command is writing the same results; the message names it and its PID."""
-
-
-@contextmanager
-def writing(target: Path, command: str) -> Iterator[None]:
-    """Hold ``target`` (a results folder or file) for ``command`` while it computes and writes:
-    a second command on the same target is refused (Busy, naming the first and its PID) instead
-    of the two mixing their files. Best effort where there is no flock (Windows)."""
-    try:
-        import fcntl
-    except ImportError:
-        yield
-        return
-    try:
-        handle = open(_lock_file(Path(target), "busy"), "a+")  # noqa: SIM115 - held for the whole command
-    except OSError:
-        yield
-        return
-    with handle:
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            handle.seek(0)
-            holder = handle.read().strip() or "another process"
-            raise Busy(f"{target} is being written by {holder}; wait for it to end, or write elsewhere") from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(f"PID {os.getpid()} ({command})")
-        handle.flush()
-        try:
-            yield
-        finally:
-            handle.seek(0)
-            handle.truncate()
-            fcntl.flock(handle, fcntl.LOCK_UN)

@@ -6,6 +6,7 @@ parent once its workers have ended."""
 
 from __future__ import annotations
 
+import glob
 import os
 import re
 import shutil
@@ -15,6 +16,14 @@ from pathlib import Path
 #: The start of every such folder's name.
 PREFIX = "rover-cosim-"
 _NAME = re.compile(rf"{PREFIX}([a-z]+)-(\d+)-")
+#: The process's umask (read once: reading it means setting it).
+UMASK = os.umask(0)
+os.umask(UMASK)
+
+
+def folder_mode() -> int:
+    """The mode of a folder of results: 0777 less the process's umask."""
+    return 0o777 & ~UMASK
 
 
 def scratch_prefix(kind: str) -> str:
@@ -22,11 +31,12 @@ def scratch_prefix(kind: str) -> str:
     return f"{PREFIX}{kind}-{os.getpid()}-"
 
 
-def remove_stale_folders() -> list[Path]:
-    """Remove the temporary folders of processes that are gone; returns what was removed."""
+def remove_stale_folders(where: Path | None = None, prefix: str = "") -> list[Path]:
+    """Remove the temporary folders of processes that are gone (in the temporary folder, or in
+    ``where`` those whose names start with ``prefix`` and then ours); returns what was removed."""
     removed = []
-    for folder in Path(tempfile.gettempdir()).glob(f"{PREFIX}*-*-*"):
-        found = _NAME.match(folder.name)
+    for folder in Path(where or tempfile.gettempdir()).glob(f"{glob.escape(prefix)}{PREFIX}*-*-*"):
+        found = _NAME.match(folder.name[len(prefix):])
         if found is None or int(found.group(2)) == os.getpid() or _alive(int(found.group(2))):
             continue
         shutil.rmtree(folder, ignore_errors=True)

@@ -104,6 +104,16 @@ def figure_png(table: pd.DataFrame) -> bytes:
     return rendered
 
 
+#: The example systems the study runs (the monolithic rover, the co-simulated one).
+SYSTEMS = ("rover_open_loop", "rover_cosim")
+
+
+def systems(fmu_dir: Path) -> dict[str, System]:
+    """The study's systems on the FMUs of ``fmu_dir`` (SystemFileError naming a missing FMU: the
+    command checks them so before the work)."""
+    return {name: load_system(example(name), fmu_dir=fmu_dir) for name in SYSTEMS}
+
+
 def write_cosim_study(fmu_dir: Path, out_dir: Path,
                       progress: Callable[[float], None] | None = None) -> CosimStudyResult:
     """Run the study and write coupling_error.csv, .png and .json into ``out_dir`` (all or none)."""
@@ -111,11 +121,10 @@ def write_cosim_study(fmu_dir: Path, out_dir: Path,
     table = coupling_errors(fmu_dir, progress=progress)
     record = run_record("rover-cosim cosim-study", {"fmu_dir": str(fmu_dir), "steps_s": list(STEPS),
                                                     "algorithms": list(ALGORITHMS)})
-    record["systems"] = {name: system_record(load_system(example(name), fmu_dir=fmu_dir))
-                         for name in ("rover_open_loop", "rover_cosim")}
+    record["systems"] = {name: system_record(system) for name, system in systems(fmu_dir).items()}
     record["wall_seconds"] = time.perf_counter() - started
     files = {out_dir / "coupling_error.csv": table.to_csv(index=False, float_format="%.6g").encode(),
              out_dir / "coupling_error.png": figure_png(table),
              out_dir / "coupling_error.json": json_bytes(record)}
-    write_all(files)
+    write_all(files, folder=out_dir, stale=("coupling_error.*",))
     return CosimStudyResult(table, list(files))

@@ -116,5 +116,5 @@ def write_fig3(out_dir: Path, loads: tuple[float, ...] = PAPER_LOADS,
         out_dir / names["png"]: png,
         out_dir / names["json"]: json_bytes(run_record("rover-cosim fig3", parameters)),
     }
-    write_all(files)
+    write_all(files, folder=out_dir)  # results/ itself is shared: renamed file by file there
     return list(files)

@@ -215,6 +215,6 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     lateral_files, lateral_fit = _lateral_files(out, lateral_sweep, lateral_table_, lateral_models,
                                                 lateral_validation)
     files.update(lateral_files)
-    write_all(files)
+    write_all(files, folder=out, stale=("*.png", "*.pdf", "*.svg"))  # its figures: all written anew
     return IdentificationResult(sorted(files), validation.fit, sweep, record, json.loads(files[out / "model.json"]),
                                 lateral_sweep, lateral_fit)

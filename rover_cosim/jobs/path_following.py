@@ -221,5 +221,5 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     })
     for s in scenarios:
         files[out / f"path_wheels_{s}.png"] = path_figures.wheels(tables[s, "inverse"], s)
-    write_all(files)
+    write_all(files, folder=out, stale=("path_*",))  # the straight run's files stay
     return PathResult(sorted(files), tables, metric_table, agreement_table, record)

@@ -198,6 +198,6 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
         out / "fig_tracking.png": tracking(tables["monolithic"], tables["cosim"]),
         out / "simulation.json": json_bytes(record),
     }
-    write_all(files)
+    write_all(files, folder=out, stale=("fig10_*", "fig_tracking.*"))  # path following's files stay
     return SimulationResult(sorted(files), record, tables, {"monolithic": rms_mono, "cosim": rms_cosim},
                             ablation_table)

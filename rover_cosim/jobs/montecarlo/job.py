@@ -269,7 +269,7 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
              out / "sensitivity.csv": ranking.to_csv(index=False).encode(),
              out / "summary.json": json_bytes(summary)}
     files.update({out / name: png for name, png in _figures(study, straight, ranking).items()})
-    write_all(files)
+    write_all(files, folder=out, stale=("fig_*",))
     return MonteCarloResult(sorted(files), runs, failures, ranking, summary, len(missing),
                             len(specs) - len(missing), rejected)
 

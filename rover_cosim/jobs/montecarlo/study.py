@@ -45,6 +45,8 @@ SCENARIOS = ("straight", "path")
 #: Shipped studies (``--study NAME`` or a file).
 STUDIES = Path(__file__).with_name("studies")
 KINDS = {"uniform": ("lower", "upper"), "normal": ("mean", "std"), "lognormal": ("median", "sigma")}
+#: The most runs a study may ask for (a million 20 s runs: ~40 days of one core).
+MAX_RUNS = 1_000_000
 TOP_KEYS = {"title", "source", "runs", "seed", "scenarios", "stop_time", "path_stop_time", "soil", "wheel",
             "parameters", "correlation"}
 
@@ -188,8 +190,9 @@ def _top(where: str, data: dict[str, Any]) -> dict[str, Any]:
     if unknown:
         raise StudyError(f"{where}: unknown key(s) {unknown}; expected {', '.join(sorted(TOP_KEYS))}")
     runs, seed = data.get("runs"), data.get("seed")
-    if isinstance(runs, bool) or not isinstance(runs, int) or runs < 1:
-        raise StudyError(f"{where}: runs = {runs!r}: expected a whole number >= 1 (the nominal included)")
+    if isinstance(runs, bool) or not isinstance(runs, int) or not 1 <= runs <= MAX_RUNS:
+        raise StudyError(f"{where}: runs = {runs!r}: expected a whole number from 1 (the nominal included) to "
+                         f"{MAX_RUNS:,} (~3.5 s of a core each)")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise StudyError(f"{where}: seed = {seed!r}: expected a whole number >= 0")
     scenarios = data.get("scenarios", ["straight"])
