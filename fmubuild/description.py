@@ -64,6 +64,22 @@ def _unit_definitions(root: ET.Element, model_layout: ModelLayout) -> None:
             ET.SubElement(node, "DisplayUnit", {"name": display, "factor": _number(DISPLAY_UNITS[unit, display])})
 
 
+def value_attributes(v: FmuVariable) -> dict[str, str]:
+    """unit, displayUnit, min, max and start of a Real (FMI 2.0) or Float64 (FMI 3.0) variable."""
+    attributes: dict[str, str] = {}
+    if v.unit is not None:
+        attributes["unit"] = v.unit
+    if _display_unit(v):
+        attributes["displayUnit"] = str(v.display_unit)
+    if v.minimum is not None:
+        attributes["min"] = _number(v.minimum)
+    if v.maximum is not None:
+        attributes["max"] = _number(v.maximum)
+    if v.start is not None:
+        attributes["start"] = _number(v.start)
+    return attributes
+
+
 def _scalar_variable(parent: ET.Element, v: FmuVariable, index: dict[int, int]) -> None:
     attributes = {"name": v.name, "valueReference": str(v.value_reference), "causality": v.causality,
                   "variability": v.variability}
@@ -72,17 +88,7 @@ def _scalar_variable(parent: ET.Element, v: FmuVariable, index: dict[int, int]) 
     if v.initial is not None:
         attributes["initial"] = v.initial
     node = ET.SubElement(parent, "ScalarVariable", attributes)
-    real: dict[str, str] = {}
-    if v.unit is not None:
-        real["unit"] = v.unit
-    if _display_unit(v):
-        real["displayUnit"] = str(v.display_unit)
-    if v.minimum is not None:
-        real["min"] = _number(v.minimum)
-    if v.maximum is not None:
-        real["max"] = _number(v.maximum)
-    if v.start is not None:
-        real["start"] = _number(v.start)
+    real = value_attributes(v)
     if v.derivative_of is not None:
         real["derivative"] = str(index[v.derivative_of])
     ET.SubElement(node, "Real", real)

@@ -10,7 +10,7 @@ import datetime
 import xml.etree.ElementTree as ET
 
 from .codegen import FmuVariable, ModelLayout
-from .description import _display_unit, _number, _unit_definitions
+from .description import _unit_definitions, value_attributes
 from .source import Experiment
 
 GENERATOR = "rover-cosim fmubuild (rumoca + CasADi + own FMI 2.0/3.0 runtime)"
@@ -36,16 +36,7 @@ def _float64(parent: ET.Element, v: FmuVariable) -> None:
         attributes["description"] = v.description
     if v.initial is not None:
         attributes["initial"] = v.initial
-    if v.unit is not None:
-        attributes["unit"] = v.unit
-    if _display_unit(v):
-        attributes["displayUnit"] = str(v.display_unit)
-    if v.minimum is not None:
-        attributes["min"] = _number(v.minimum)
-    if v.maximum is not None:
-        attributes["max"] = _number(v.maximum)
-    if v.start is not None:
-        attributes["start"] = _number(v.start)
+    attributes.update(value_attributes(v))
     if v.derivative_of is not None:
         attributes["derivative"] = str(v.derivative_of)
     ET.SubElement(parent, "Float64", attributes)
