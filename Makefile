@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
+.PHONY: run test test-fast lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -96,6 +96,11 @@ cosim-study: fmus
 ## fails with a message, so `python -m pytest` works the same)
 test: $(STAMP)
 	$(PY) -P -m pytest
+
+## test-fast: the tests that build and run no FMU (physics, engine logic, CLI parsing, soils, report
+## pages, fuzz): seconds, for the edit-test loop; make test runs them all
+test-fast: $(STAMP)
+	$(PY) -P -m pytest -m "not fmu and not slow" -q
 
 ## lint: ruff (rules in pyproject.toml) and mypy over the package, tests and benchmarks
 lint: $(STAMP)

@@ -55,3 +55,23 @@ def identified(fmus: dict[str, Path], results_root: Path) -> IdentificationResul
 def simulated(fmu_dir: Path, identified: IdentificationResult, results_root: Path) -> SimulationResult:
     """`make simulate` with the identified model into <results>/simulation (once per session)."""
     return run_simulation(fmu_dir, results_root / "identification" / "model.json", results_root / "simulation")
+
+
+#: Fixtures that build or run FMUs (and the pipeline on them): a test that uses one, directly or
+#: through another fixture, belongs to the full tier only.
+FMU_FIXTURES = {"fmus", "fmu_dir", "identified", "simulated", "typed"}
+
+#: Modules that build FMUs, translate the Modelica library or run whole commands of their own (C test
+#: FMUs, zig cross-builds, rumoca, killed processes) without those fixtures.
+FULL_TIER_MODULES = {"test_platforms", "test_killed_commands", "test_fmi_kinds", "test_ssp_foreign",
+                     "test_inputs_outputs", "test_fmi3", "test_layout", "test_fmus", "test_modelica_rumoca",
+                     "test_translate"}
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark the tests of the full tier ``fmu`` (they build or run FMUs), so that ``make test-fast``
+    (``-m "not fmu and not slow"``) runs the rest in seconds; ``make test`` runs every test."""
+    for item in items:
+        module = item.module.__name__ if getattr(item, "module", None) is not None else ""
+        if FMU_FIXTURES & set(getattr(item, "fixturenames", ())) or module in FULL_TIER_MODULES:
+            item.add_marker(pytest.mark.fmu)
