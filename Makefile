@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test test-fast lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
+.PHONY: run test test-fast docs lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -30,7 +30,7 @@ $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "rover-cosim needs Python >= 3.11, found " + sys.version.split()[0])'
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test,lint,platforms]'
+	$(PY) -m pip install --quiet -e '.[test,lint,platforms,docs]'
 	@touch $@
 
 venv: $(STAMP)
@@ -101,6 +101,10 @@ test: $(STAMP)
 ## pages, fuzz): seconds, for the edit-test loop; make test runs them all
 test-fast: $(STAMP)
 	$(PY) -P -m pytest -m "not fmu and not slow" -q
+
+## docs: the documentation site -> site/ (MkDocs; reference pages generated from the code)
+docs: $(STAMP)
+	$(VENV)/bin/mkdocs build --strict --site-dir site
 
 ## lint: ruff (rules in pyproject.toml) and mypy over the package, tests and benchmarks
 lint: $(STAMP)

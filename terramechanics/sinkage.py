@@ -187,7 +187,8 @@ def wheel_state(
     Args:
         load: vertical wheel load W [N], each > 0 (and at most what the wheel carries at h = r).
         slip: slip ratio κ [-], each in [-1, 1]; broadcasts against ``load``.
-        wheel, soil: parameters (paper Table 2 by default).
+        wheel: wheel parameters (paper Table 2 by default).
+        soil: soil parameters (paper Table 2 by default).
         rtol: relative tolerance on Fz = W [-].
         nodes: Gauss-Legendre nodes per piece of the contact patch.
         slip_angle: slip angle β [rad], each in (-π/2, π/2); broadcasts. At 0 every output is

@@ -72,6 +72,6 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     """Mark the tests of the full tier ``fmu`` (they build or run FMUs), so that ``make test-fast``
     (``-m "not fmu and not slow"``) runs the rest in seconds; ``make test`` runs every test."""
     for item in items:
-        module = item.module.__name__ if getattr(item, "module", None) is not None else ""
+        module = getattr(getattr(item, "module", None), "__name__", "")
         if FMU_FIXTURES & set(getattr(item, "fixturenames", ())) or module in FULL_TIER_MODULES:
             item.add_marker(pytest.mark.fmu)
