@@ -246,15 +246,15 @@ def test_the_layer_folders_refuse_their_top_level_name(package):
     assert done.returncode != 0 and f"import rover_cosim.{package}, not {package}" in done.stderr, done.stderr
 
 
-def test_the_readme_example_builds_and_runs_the_co_simulated_rover(fmus, monkeypatch, capsys):
-    """The README's ~15 lines, executed as written (FMUs in fmus/ of the checkout)."""
-    text = (REPOSITORY / "README.md").read_text()
+def test_the_guides_example_builds_and_runs_the_co_simulated_rover(fmus, monkeypatch, capsys):
+    """The co-simulation guide's ~15 lines, executed as written (FMUs in fmus/ of the checkout)."""
+    text = (REPOSITORY / "docs" / "guide" / "cosimulation.md").read_text()
     begin = text.index("from rover_cosim.jobs.plants import add_rover")
     example = text[begin:text.index("```", begin)]
     assert len(example.strip().splitlines()) <= 15
     monkeypatch.chdir(REPOSITORY)
     namespace: dict[str, Any] = {}
-    exec(compile(example, "README.md", "exec"), namespace)  # noqa: S102 - our own README
+    exec(compile(example, "cosimulation.md", "exec"), namespace)  # noqa: S102 - our own documentation
     result = namespace["result"]
     assert result.stopped.startswith("body.x = ") and result.data["body.v"].iloc[-1] > 0
     assert result.data["body.x"].iloc[-2] < 1.0 <= result.data["body.x"].iloc[-1]

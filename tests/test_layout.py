@@ -19,7 +19,7 @@ import pytest
 REPOSITORY = Path(__file__).resolve().parent.parent
 PACKAGE = REPOSITORY / "rover_cosim"
 
-#: What each layer may import besides itself (README "Architecture"); "top" may import anything.
+#: What each layer may import besides itself (docs/design/development.md "Architecture"); "top" may import anything.
 ALLOWED = {
     "common": set(),
     "terramechanics": {"common"},
