@@ -64,6 +64,18 @@ def _unit_definitions(root: ET.Element, model_layout: ModelLayout) -> None:
             ET.SubElement(node, "DisplayUnit", {"name": display, "factor": _number(DISPLAY_UNITS[unit, display])})
 
 
+def variable_attributes(v: FmuVariable) -> dict[str, str]:
+    """name, valueReference, causality, variability, description and initial of a variable (the
+    same in FMI 2.0's ScalarVariable and FMI 3.0's Float64)."""
+    attributes = {"name": v.name, "valueReference": str(v.value_reference), "causality": v.causality,
+                  "variability": v.variability}
+    if v.description:
+        attributes["description"] = v.description
+    if v.initial is not None:
+        attributes["initial"] = v.initial
+    return attributes
+
+
 def value_attributes(v: FmuVariable) -> dict[str, str]:
     """unit, displayUnit, min, max and start of a Real (FMI 2.0) or Float64 (FMI 3.0) variable."""
     attributes: dict[str, str] = {}
@@ -81,12 +93,7 @@ def value_attributes(v: FmuVariable) -> dict[str, str]:
 
 
 def _scalar_variable(parent: ET.Element, v: FmuVariable, index: dict[int, int]) -> None:
-    attributes = {"name": v.name, "valueReference": str(v.value_reference), "causality": v.causality,
-                  "variability": v.variability}
-    if v.description:
-        attributes["description"] = v.description
-    if v.initial is not None:
-        attributes["initial"] = v.initial
+    attributes = variable_attributes(v)
     node = ET.SubElement(parent, "ScalarVariable", attributes)
     real = value_attributes(v)
     if v.derivative_of is not None:

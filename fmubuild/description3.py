@@ -10,7 +10,7 @@ import datetime
 import xml.etree.ElementTree as ET
 
 from .codegen import FmuVariable, ModelLayout
-from .description import _unit_definitions, value_attributes
+from .description import _unit_definitions, value_attributes, variable_attributes
 from .source import Experiment
 
 GENERATOR = "rover-cosim fmubuild (rumoca + CasADi + own FMI 2.0/3.0 runtime)"
@@ -30,12 +30,7 @@ def _interfaces(root: ET.Element, model_layout: ModelLayout) -> None:
 
 
 def _float64(parent: ET.Element, v: FmuVariable) -> None:
-    attributes = {"name": v.name, "valueReference": str(v.value_reference), "causality": v.causality,
-                  "variability": v.variability}
-    if v.description:
-        attributes["description"] = v.description
-    if v.initial is not None:
-        attributes["initial"] = v.initial
+    attributes = variable_attributes(v)
     attributes.update(value_attributes(v))
     if v.derivative_of is not None:
         attributes["derivative"] = str(v.derivative_of)
