@@ -103,7 +103,7 @@ test-fast: $(STAMP)
 	$(PY) -P -m pytest -m "not fmu and not slow" -q
 
 ## docs: the documentation site -> site/ (MkDocs; reference pages generated from the code)
-docs: $(STAMP)
+docs: fmus
 	$(VENV)/bin/mkdocs build --strict --site-dir site
 
 ## lint: ruff (rules in pyproject.toml) and mypy over the package, tests and benchmarks

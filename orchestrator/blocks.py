@@ -28,6 +28,7 @@ import inspect
 import math
 import sys
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -323,21 +324,41 @@ def _check_keys(name: str, what: str, constructor: Any, params: Mapping[str, Any
         raise ValueError(f"block {name!r} ({what}): {problem}; it accepts {', '.join(names) or 'no keys'}{required}")
 
 
-def describe_blocks() -> str:
-    """A plain-text table of the block types: each key with its default (from the constructors'
-    signatures and docstrings), for ``rover-cosim blocks`` and the README."""
-    lines = []
+@dataclass(frozen=True)
+class BlockKey:
+    """One key of a block type: its name, default (``None``: required) and meaning with its unit."""
+
+    name: str
+    default: str | None
+    meaning: str
+
+
+def block_reference() -> list[tuple[str, str, list[BlockKey]]]:
+    """Every built-in block type: (type, what it does, its keys), from the constructors' signatures
+    and docstrings and ``KEY_MEANINGS`` (for ``rover-cosim blocks`` and the documentation)."""
+    types = []
     for kind, constructor in BLOCK_TYPES.items():
         doc = " ".join((constructor.__doc__ or "").split()).replace("``", "")
+        keys = [BlockKey(p.name, None if p.default is inspect.Parameter.empty else repr(p.default),
+                         KEY_MEANINGS.get(f"{kind}.{p.name}", KEY_MEANINGS.get(p.name, "")))
+                for p in inspect.signature(constructor).parameters.values() if p.name != "name"]
+        types.append((kind, doc, keys))
+    return types
+
+
+PYTHON_BLOCK = ('your own block, factory = "module:callable" (the module is looked up beside the system file '
+                "first); every other key goes to the callable")
+
+
+def describe_blocks() -> str:
+    """A plain-text table of the block types: each key with its default, for ``rover-cosim blocks``."""
+    lines = []
+    for kind, doc, keys in block_reference():
         lines.append(f"type = \"{kind}\": {doc}")
-        for parameter in inspect.signature(constructor).parameters.values():
-            if parameter.name == "name":
-                continue
-            default = "required" if parameter.default is inspect.Parameter.empty else f"default {parameter.default!r}"
-            meaning = KEY_MEANINGS.get(f"{kind}.{parameter.name}", KEY_MEANINGS.get(parameter.name, ""))
-            lines.append(f"    {parameter.name:9s} {default:16s} {meaning}")
-    lines.append('type = "python": your own block, factory = "module:callable" (the module is looked up beside '
-                 "the system file first); every other key goes to the callable")
+        for key in keys:
+            default = "required" if key.default is None else f"default {key.default}"
+            lines.append(f"    {key.name:9s} {default:16s} {key.meaning}")
+    lines.append(f'type = "python": {PYTHON_BLOCK}')
     return "\n".join(lines)
 
 

@@ -63,15 +63,49 @@ from .model import (
     SystemFileError,
 )
 
-#: The keys each section of a system file may have.
-SECTION_KEYS = {
-    "simulation": {"stop_time", "step", "start_time", "algorithm", "order", "tolerance", "max_iterations",
-                   "relaxation", "allow_algebraic_loops", "threads", "native", "relative_tolerance",
-                   "output_interval"},
-    "fmu": {"name", "path", "parameters", "start", "interface"},
-    "connection": {"from", "to"},
-    "record": {"variables"},
+#: Every key each section of a system file may have, with what it means (units in brackets); the
+#: reader accepts exactly these and the documentation's reference is generated from this table.
+KEY_MEANINGS: dict[str, dict[str, str]] = {
+    "simulation": {
+        "stop_time": "end of the run [s]",
+        "step": "communication step [s]",
+        "start_time": "start of the run [s]",
+        "algorithm": f"the master algorithm: one of {', '.join(ALGORITHMS)}",
+        "order": "Gauss-Seidel order: a list of instance names (default: sources, FMUs, other blocks)",
+        "tolerance": "iterative only: a step is repeated until every exchanged value changes by less than "
+                     "tolerance x (1 + |value|) [1]",
+        "max_iterations": "iterative only: the most passes per step",
+        "relaxation": "iterative only: how far (0 < relaxation <= 1) each pass moves towards the new values [1]",
+        "allow_algebraic_loops": "run a Jacobi/Gauss-Seidel system with a direct-feedthrough loop "
+                                 "(its values then lag a step); else such a system is refused",
+        "threads": "FMUs stepped at the same time (default: the cores)",
+        "native": "step the FMUs from C (the native stepper) where the system allows it",
+        "relative_tolerance": "of the integrator (CVode) of Model Exchange FMUs, and told to every FMU [1]",
+        "output_interval": "rows recorded every so often [s] (a whole number of steps; default every step)",
+    },
+    "fmu": {
+        "name": "instance name (letters, digits, _; it names a folder)",
+        "path": "the FMU file, relative to the system file (or to --fmu-dir)",
+        "parameters": "a table of parameter values by variable name, in the variables' units",
+        "start": "a table of start values of inputs (and of states with an exact start)",
+        "interface": f"which interface runs it: one of {', '.join(INTERFACES)} (default: co-simulation where "
+                     "offered)",
+    },
+    "block": {
+        "name": "instance name",
+        "type": "the block type (see the block reference); every other key is the block's own",
+    },
+    "connection": {
+        "from": "an output, \"instance.variable\"",
+        "to": "an input, \"instance.variable\" (each input driven at most once)",
+    },
+    "record": {
+        "variables": "the ports recorded, \"instance.variable\" (default: every output of every participant)",
+    },
 }
+
+#: The keys each section of a system file may have (a block's own keys are checked by its type).
+SECTION_KEYS = {section: set(keys) for section, keys in KEY_MEANINGS.items() if section != "block"}
 
 
 def _table(value: Any, where: str) -> dict[str, Any]:

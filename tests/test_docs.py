@@ -1,28 +1,55 @@
 """The documentation site builds without a warning (mkdocs --strict: broken links, docstrings that
-name parameters a function does not have), and its generated reference pages follow the code:
-every rover-cosim command, every shipped soil and wheel."""
+name parameters a function does not have), and its generated pages follow the code and the results:
+every rover-cosim command, every shipped soil and wheel, every system-file key and block type, every
+FMU variable, the benchmark files and the pipeline's validation tables."""
 
 from __future__ import annotations
 
+import json
+import os
 import subprocess
 import sys
 import tomllib
 from pathlib import Path
 
 import pytest
+from fmpy import read_model_description
 
 from rover_cosim.cli import build_parser
+from rover_cosim.common.outputs import run_record
+from rover_cosim.orchestrator.blocks import BLOCK_TYPES
+from rover_cosim.orchestrator.system import SECTION_KEYS
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 
 
-def test_the_docs_site_builds_strictly_with_the_generated_references(tmp_path):
+def test_the_docs_site_builds_strictly_with_the_generated_references(tmp_path, fmu_dir, simulated, results_root):
     pytest.importorskip("mkdocs", reason="mkdocs not installed (the docs extra: pip install -e '.[docs]')")
     pytest.importorskip("mkdocstrings", reason="mkdocstrings not installed (the docs extra)")
+    results = tmp_path / "results"  # the pipeline's results (linked) and one benchmark file
+    results.mkdir()
+    for name in ("identification", "simulation"):
+        (results / name).symlink_to(results_root / name)
+    (results / "bench").mkdir()
+    bench = {**run_record("make bench", {"repeats": 3}), "results": {"closed_loop": {"wall_s": 0.6789, "rtf": 29.4}}}
+    (results / "bench" / "closed_loop.json").write_text(json.dumps(bench))
     site = tmp_path / "site"
+    environment = {**os.environ, "ROVER_COSIM_DOCS_FMUS": str(fmu_dir), "ROVER_COSIM_DOCS_RESULTS": str(results)}
     result = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(site)],
-                            cwd=REPOSITORY, capture_output=True, text=True, check=False)
+                            cwd=REPOSITORY, capture_output=True, text=True, check=False, env=environment)
     assert result.returncode == 0, result.stderr[-3000:]
+    page = (site / "reference" / "system-files" / "index.html").read_text()
+    for section, keys in SECTION_KEYS.items():
+        assert all(f"<code>{key}</code>" in page for key in keys), section
+    assert all(f'type = "{kind}"' in page.replace("&quot;", '"') for kind in BLOCK_TYPES)
+    page = (site / "reference" / "fmu-variables" / "index.html").read_text()
+    for fmu in sorted(fmu_dir.glob("*.fmu")):
+        names = [v.name for v in read_model_description(str(fmu)).modelVariables if v.causality in ("input", "output")]
+        assert "<h2 id=" in page and all(f"<code>{n}</code>" in page for n in names), fmu.name
+    page = (site / "results" / "benchmarks" / "index.html").read_text()
+    assert "closed_loop.wall_s" in page and "0.6789" in page and bench["git_commit"][:12] in page
+    page = (site / "results" / "validation" / "index.html").read_text()
+    assert "Table 1" in page and "data:image" not in page  # the report's tables, without its figures
     cli = (site / "reference" / "cli" / "index.html").read_text()
     commands = next(a for a in build_parser()._actions if a.__class__.__name__ == "_SubParsersAction")
     assert isinstance(commands.choices, dict)
@@ -36,3 +63,13 @@ def test_the_docs_site_builds_strictly_with_the_generated_references(tmp_path):
     api = (site / "reference" / "python" / "index.html").read_text()
     assert "wheel_state" in api and "sinkage" in api  # rendered from the docstrings
     assert not (site / "hooks.py").exists()
+
+
+def test_the_readme_python_quick_start_runs_and_prints_physical_values():
+    text = (REPOSITORY / "README.md").read_text()
+    block = text.split("```python\n", 1)[1].split("```", 1)[0]
+    result = subprocess.run([sys.executable, "-P", "-c", block], capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr[-2000:]
+    numbers = [float(word) for word in result.stdout.replace(",", " ").split() if word.replace(".", "").isdigit()]
+    pull, torque, sinkage_mm = numbers
+    assert 0 < pull < 424 and 0 < torque < 424 * 0.355 and 1 < sinkage_mm < 355
