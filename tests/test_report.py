@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import html
+import json
 import re
 import shutil
 import subprocess
@@ -113,3 +115,41 @@ def test_report_renders_in_headless_chromium_at_1024_px(page, tmp_path):
     drawn = np.nonzero((image < 200).any(axis=0))[0]
     assert drawn.min() > 5 and drawn.max() < 1019   # nothing cut off at the window's edges
     assert (image < 200).mean() > 0.01              # text, tables and figures, not a blank page
+
+
+#: Measures the page in the browser once it has loaded: its width against the window's, every
+#: image decoded, every error event (a resource that failed, a script error).
+PROBE = ("<script>window.__errors=[];window.addEventListener('error',function(e){window.__errors.push("
+         "String(e.message||(e.target&&(e.target.src||e.target.href))))},true);"
+         "window.addEventListener('load',function(){var images=Array.prototype.slice.call(document.images);"
+         "var broken=images.filter(function(i){return !(i.complete&&i.naturalWidth>0)}).length;"
+         "var d=document.documentElement;document.body.setAttribute('data-check',JSON.stringify({scroll:"
+         "d.scrollWidth,client:d.clientWidth,images:images.length,broken:broken,errors:window.__errors}))});"
+         "</script>")
+
+
+def _rendered(page: str, folder) -> dict:
+    """What the probe measured in headless Chromium at 1024 px."""
+    html_file = folder / "probed.html"
+    html_file.write_text(page.replace("<head>", "<head>" + PROBE, 1))
+    dom = subprocess.run(["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                          "--window-size=1024,800", "--virtual-time-budget=5000", "--dump-dom", html_file.as_uri()],
+                         check=True, capture_output=True, text=True, timeout=120).stdout
+    found = re.search(r'data-check="([^"]*)"', dom)
+    assert found, "the probe did not run"
+    return json.loads(html.unescape(found.group(1)))
+
+
+@pytest.mark.skipif(shutil.which("chromium") is None, reason="chromium not on PATH (Debian package `chromium`)")
+def test_the_report_loads_every_figure_without_errors_or_overflow_in_chromium(page, tmp_path):
+    check = _rendered(page, tmp_path)
+    assert check["client"] == 1024 and check["scroll"] <= check["client"], check  # no sideways scrolling
+    assert check["images"] >= 8 and check["broken"] == 0 and check["errors"] == [], check
+
+
+@pytest.mark.skipif(shutil.which("chromium") is None, reason="chromium not on PATH (Debian package `chromium`)")
+def test_the_probe_sees_overflow_broken_figures_and_errors(tmp_path):
+    bad = ("<html><head></head><body><img src='data:image/png;base64,AAAA'><div style='width:1500px'>x</div>"
+           "</body></html>")
+    check = _rendered(bad, tmp_path)
+    assert check["scroll"] > 1024 and check["broken"] == 1 and len(check["errors"]) == 1, check

@@ -146,11 +146,12 @@ def _steps(length: float, spacing: float) -> np.ndarray:
     return np.linspace(length / count, length, count)
 
 
-def turn_path() -> Path:
-    """The issue's first scenario: 10 m straight, a 90 deg left turn of radius 10 m, 10 m straight."""
-    return Path((Line(10.0), Arc(10.0, math.pi / 2), Line(10.0)))
+def turn_path(straight: float = 10.0) -> Path:
+    """The issue's first scenario: ``straight`` [m] (10 m) straight, a 90 deg left turn of radius
+    10 m, ``straight`` straight (the tests shorten the straights, the turn stays)."""
+    return Path((Line(straight), Arc(10.0, math.pi / 2), Line(straight)))
 
 
-def lane_change_path() -> Path:
-    """The second: 10 m straight, 3 m to the left over 15 m, 10 m straight."""
-    return Path((Line(10.0), LaneChange(15.0, 3.0), Line(10.0)))
+def lane_change_path(straight: float = 10.0) -> Path:
+    """The second: ``straight`` [m] (10 m) straight, 3 m to the left over 15 m, ``straight`` straight."""
+    return Path((Line(straight), LaneChange(15.0, 3.0), Line(straight)))

@@ -53,7 +53,7 @@ class PathFollowingController:
     (wheels). Outputs: tau[1..6], steer[1..6], Fx_des[1..6], Fy_des[1..6], s, s_ref,
     cross_track, heading_error."""
 
-    def __init__(self, name: str, model: ModelSet | str, path: str = "turn", v_target: float = 0.5,
+    def __init__(self, name: str, model: ModelSet | str, path: str | Path = "turn", v_target: float = 0.5,
                  steering: str = "inverse", mass: float = 1570.0, yaw_inertia: float = 1980.0,
                  x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5), y_limb: float = 1.5,
                  kv: float = 1.0, kp: float = 0.01, a_max: float = 0.1,
@@ -63,8 +63,8 @@ class PathFollowingController:
         models, longitudinal, _ = read_model(model, name)
         if models.lateral is None:
             raise ValueError(f"block {name!r}: {models.source} has no lateral model (run `make identify`)")
-        if path not in PATHS:
-            raise ValueError(f"block {name!r}: path = {path!r}: expected one of {sorted(PATHS)}")
+        if not isinstance(path, Path) and path not in PATHS:
+            raise ValueError(f"block {name!r}: path = {path!r}: expected one of {sorted(PATHS)} or a Path")
         if steering not in ("inverse", "kinematic"):
             raise ValueError(f"block {name!r}: steering = {steering!r}: expected 'inverse' or 'kinematic'")
         for key, value in (("v_target", v_target), ("mass", mass), ("yaw_inertia", yaw_inertia), ("y_limb", y_limb),
@@ -72,7 +72,7 @@ class PathFollowingController:
             if not value > 0:
                 raise ValueError(f"block {name!r}: {key} = {value!r}: expected > 0")
         self.name, self.steering, self.step_size = name, steering, step
-        self.path: Path = PATHS[path]()
+        self.path: Path = path if isinstance(path, Path) else PATHS[path]()
         self.lateral = models.lateral
         self.inverse = LongitudinalInverse(longitudinal, WHEELS, wn, step, name)
         self.v_target, self.mass, self.yaw_inertia = v_target, mass, yaw_inertia

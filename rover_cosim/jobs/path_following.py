@@ -25,6 +25,7 @@ results/simulation/
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -37,6 +38,7 @@ import pandas as pd
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.rows import every, steps_between_rows
 from rover_cosim.control import path_figures
+from rover_cosim.control.path import Path as ReferencePath
 from rover_cosim.control.path_controller import PATHS, PathFollowingController
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
@@ -53,6 +55,7 @@ from .simulate import RECORD_INTERVAL, checked_models, models_of
 STEP = 1e-3  # s
 WHEELS = range(1, 7)
 SCENARIOS = {"turn": 0.5, "lane_change": 1.0}  # path -> target speed [m/s]
+STRAIGHT = 10.0  # m, the straights before and after each path's curve
 BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
 PER_WHEEL = ("tau", "steer", "Fx", "Fy", "Fz", "slip", "slipAngle", "sinkage", "omega", "Fx_des", "Fy_des")
 FMUS = ("SteerableRover", "SteerableRoverBody", "Wheel")
@@ -72,15 +75,22 @@ class PathResult:
         return summary_repr("PathResult", self.files, runs=len(self.tables))
 
 
-def stop_time(scenario: str) -> float:
+def scenario_path(scenario: str, straight: float = STRAIGHT) -> ReferencePath:
+    """The path of ``scenario`` with straights of ``straight`` [m] before and after its curve."""
+    if not (math.isfinite(straight) and straight > 0):
+        raise ValueError(f"straight = {straight!r} m: expected a length > 0")
+    return PATHS[scenario](straight)
+
+
+def stop_time(scenario: str, straight: float = STRAIGHT) -> float:
     """s: until the reference point reaches the end of the path (to the step)."""
-    return float(np.floor(PATHS[scenario]().length / SCENARIOS[scenario] / STEP) * STEP)
+    return float(np.floor(scenario_path(scenario, straight).length / SCENARIOS[scenario] / STEP) * STEP)
 
 
-def controller(models: ModelSet, scenario: str, steering: str) -> PathFollowingController:
+def controller(models: ModelSet, scenario: str, steering: str, straight: float = STRAIGHT) -> PathFollowingController:
     """The path-following controller block ``ctrl`` of ``scenario``."""
-    return PathFollowingController("ctrl", models, path=scenario, v_target=SCENARIOS[scenario], steering=steering,
-                                   step=STEP)
+    return PathFollowingController("ctrl", models, path=scenario_path(scenario, straight),
+                                   v_target=SCENARIOS[scenario], steering=steering, step=STEP)
 
 
 def _connect_controller(builder: SystemBuilder, body: str, wheel: Any) -> None:
@@ -91,21 +101,21 @@ def _connect_controller(builder: SystemBuilder, body: str, wheel: Any) -> None:
         builder.connect(wheel(i, "Fz"), f"ctrl.W[{i}]").connect(wheel(i, "slipAngle"), f"ctrl.slipAngle[{i}]")
 
 
-def _path_run(name: str, scenario: str) -> SystemBuilder:
+def _path_run(name: str, scenario: str, straight: float) -> SystemBuilder:
     # The controller's steering reaches the slip angles it reads within the instant: an algebraic
     # loop, broken by the order (the controller first sees the slip angles of the step before).
-    return SystemBuilder(name).simulation(stop_time=stop_time(scenario), step=STEP, algorithm="gauss-seidel",
-                                          allow_algebraic_loops=True)
+    return SystemBuilder(name).simulation(stop_time=stop_time(scenario, straight), step=STEP,
+                                          algorithm="gauss-seidel", allow_algebraic_loops=True)
 
 
 def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, steering: str = "inverse",
-                      choice: Choice | None = None) -> System:
+                      choice: Choice | None = None, straight: float = STRAIGHT) -> System:
     """``scenario`` on SteerableRover.fmu, started rolling at its speed."""
     speed = SCENARIOS[scenario]
-    builder = _path_run(f"path {scenario} ({steering})", scenario)
+    builder = _path_run(f"path {scenario} ({steering})", scenario, straight)
     start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
-    builder.add_block("ctrl", controller(models_of(model), scenario, steering))
+    builder.add_block("ctrl", controller(models_of(model), scenario, steering, straight))
     _connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
     for i in WHEELS:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
@@ -116,14 +126,15 @@ def _radius(choice: Choice | None) -> float:
     return (choice.wheel if choice else Wheel()).r
 
 
-def cosim_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: Choice | None = None) -> System:
+def cosim_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: Choice | None = None,
+                 straight: float = STRAIGHT) -> System:
     """``scenario`` on SteerableRoverBody + 6 Wheel (the hubs of the shipped
     steerable_rover_cosim.toml), started rolling at its speed, the controller first in the order."""
     speed = SCENARIOS[scenario]
-    builder = _path_run(f"path {scenario} (cosim)", scenario)
+    builder = _path_run(f"path {scenario} (cosim)", scenario, straight)
     wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(WHEELS),
                        choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": speed / _radius(choice)})
-    builder.add_block("ctrl", controller(models_of(model), scenario, "inverse"))
+    builder.add_block("ctrl", controller(models_of(model), scenario, "inverse", straight))
     _connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
     for i, wheel in zip(WHEELS, wheels):
         builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
@@ -172,20 +183,23 @@ def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str
 def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SCENARIOS),
                        choice: Choice | Soil | Wheel | None = None, *, allow_model_mismatch: bool = False,
                        progress: Callable[[float], None] | None = None,
-                       record_interval: float = RECORD_INTERVAL) -> PathResult:
+                       record_interval: float = RECORD_INTERVAL, straight: float = STRAIGHT) -> PathResult:
     """Every scenario on both plants and with kinematic steering, on the soil and wheel of
     ``choice`` (default: the paper's); writes every file (all or none). A model identified on
-    another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``."""
+    another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``.
+    ``straight`` [m]: the straights before and after each path's curve (10 m; shorter ones keep
+    the curve and shorten the run)."""
     started = time.perf_counter()
     choice = as_choice(choice)
     steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
+    scenario_path(next(iter(SCENARIOS)), straight)  # a bad length refused before anything runs
     fmu_dir = Path(fmu_dir).resolve()
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     walls: dict[str, float] = {}
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
-    builds = {"inverse": lambda s: monolithic_system(fmu_dir, models, s, choice=choice),
-              "cosim": lambda s: cosim_system(fmu_dir, models, s, choice),
-              "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice)}
+    builds = {"inverse": lambda s: monolithic_system(fmu_dir, models, s, choice=choice, straight=straight),
+              "cosim": lambda s: cosim_system(fmu_dir, models, s, choice, straight),
+              "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice, straight)}
     stages = Stages(progress, len(scenarios) * len(builds))
     systems: dict[str, Any] = {}
     for i, scenario in enumerate(scenarios):
@@ -201,8 +215,8 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"],
                                                                 SCENARIOS[s])} for s in scenarios])
     record = run_record("rover-cosim simulate (path following)",
-                        {"scenarios": {s: {"target_speed_m_s": SCENARIOS[s], "stop_time_s": stop_time(s)}
-                                       for s in scenarios}, "step_s": STEP, "model": str(model),
+                        {"scenarios": {s: {"target_speed_m_s": SCENARIOS[s], "stop_time_s": stop_time(s, straight)}
+                                       for s in scenarios}, "straight_m": straight, "step_s": STEP, "model": str(model),
                          "algorithm": "gauss-seidel", "record_interval_s": record_interval})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
@@ -216,7 +230,7 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     files.update({
         out / "path_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "path_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),
-        out / "path_xy.png": path_figures.path_xy({s: PATHS[s]() for s in scenarios}, tables),
+        out / "path_xy.png": path_figures.path_xy({s: scenario_path(s, straight) for s in scenarios}, tables),
         out / "path_following.json": json_bytes(record),
     })
     for s in scenarios:
