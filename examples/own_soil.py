@@ -58,9 +58,10 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", default=bool(os.environ.get("ROVER_COSIM_EXAMPLE_QUICK")),
                         help="a coarse Fig. 3 and a small sweep; also ROVER_COSIM_EXAMPLE_QUICK=1")
     args = parser.parse_args()
-    missing = [n for n in ("SingleWheel", "Rover", "RoverBody", "Wheel") if not (args.fmu_dir / f"{n}.fmu").is_file()]
+    needed = ("SingleWheel.fmu", "Rover.fmu", "RoverBody.fmu", "Wheel.fmu")
+    missing = [name for name in needed if not (args.fmu_dir / name).is_file()]
     if missing:
-        parser.error(f"{', '.join(missing)}.fmu not in {args.fmu_dir}: build them with `make fmus`")
+        parser.error(f"{', '.join(missing)} not in {args.fmu_dir}: build them with `make fmus`")
     out = output_folder(parser, args.out)
 
     # The soil library reads the file: unknown keys and impossible values are errors naming them.
