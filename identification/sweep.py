@@ -53,6 +53,12 @@ class Case(NamedTuple):
 
 @dataclass(frozen=True)
 class SweepPlan:
+    """What an identification sweep runs: every (load [N], torque step [N·m], slip angle [deg])
+    of ``loads`` x ``torques`` x ``slip_angles_deg``, each a run of ``stop_time`` [s] sampled every
+    ``sample_time`` [s], starting rolling at ``start_speed`` [m/s], on ``soil`` and ``wheel``
+    (None: the FMU's own, the paper's). The default is the paper's longitudinal sweep;
+    ``run_identification`` takes one for the longitudinal and one for the lateral model."""
+
     loads: tuple[float, ...] = PAPER_LOADS
     torques: tuple[float, ...] = PAPER_TORQUES
     #: deg; the carriage's track to the wheel plane (0: the paper's longitudinal sweep)

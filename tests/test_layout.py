@@ -154,7 +154,8 @@ def wheel(release) -> Path:
 
 def test_the_sdist_carries_the_release_files_and_the_sources_the_wheel_is_built_from(release):
     """The source distribution holds the licence, changelog and citation, the Modelica library, the
-    C runtime and the shipped soils (the wheel above was built from it, not from the checkout)."""
+    C runtime, the shipped soils and the examples (the wheel above was built from it, not from the
+    checkout)."""
     import tarfile
 
     sdist, _ = release
@@ -163,7 +164,8 @@ def test_the_sdist_carries_the_release_files_and_the_sources_the_wheel_is_built_
     for expected in ("LICENSE", "CHANGELOG.md", "CITATION.cff", "README.md", "pyproject.toml",
                      "rover_cosim/modelica/RoverTerramechanics/package.mo",
                      "rover_cosim/fmubuild/runtime/fmi2_api.c", "rover_cosim/terramechanics/library/soils.toml",
-                     "rover_cosim/py.typed"):
+                     "rover_cosim/py.typed", "examples/README.md", "examples/own_soil.py", "examples/grc1.toml",
+                     "examples/my_study.toml"):
         assert expected in names, expected
 
 

@@ -45,6 +45,8 @@ from .study import Study
 
 @dataclass
 class MonteCarloResult:
+    """What ``run_montecarlo`` wrote and found."""
+
     files: list[Path]
     runs: pd.DataFrame              # runs.csv
     failures: pd.DataFrame          # failures.csv
