@@ -406,16 +406,18 @@ class SoilEstimate:
         return predict(self.soil, self.wheel, load_N, slip, slip_angle_deg)
 
     def summary(self) -> str:
-        """A few lines for a person: the estimates, what is fixed and why, what trades off."""
+        """A few lines for a person: the estimates, what is kept at the prior, the residuals and
+        what the data determine, in words."""
         lines = [f"estimated from {self.data.rows} rows ({', '.join(self.data.channels)}) in {self.seconds:.2f} s "
                  f"({self.evaluations} wheel evaluations); {100 * self.confidence:g} % intervals:"]
         lines += [f"  {estimate.text()}" for estimate in self.parameters.values()]
-        lines.append(f"  k_c/b + k_φ = {self.bekker_modulus.value:.4g} N/m^(n+2) [{self.bekker_modulus.low:.4g}, "
-                     f"{self.bekker_modulus.high:.4g}]")
-        lines += [f"  fixed {f.name} = {f.value:.4g}: {f.reason}" for f in self.fixed.values()]
-        lines += [f"  residual RMS {c.channel}: {c.rms:.3g} (noise scale {c.noise_scale:.3g}"
-                  f"{', given' if c.noise_given else ', estimated'})" for c in self.residuals.values()]
-        lines += [f"  {s}" for s in self.identifiability.statements]
+        modulus = self.bekker_modulus
+        lines.append(f"  k_c/b + k_φ = {modulus.value:.4g} N/m^(n+2) [{modulus.low:.4g}, {modulus.high:.4g}]")
+        kept = ", ".join(f"{f.name} = {f.value:.4g}" for f in self.fixed.values())
+        lines.append(f"kept at the prior's values: {kept}")
+        lines += [f"residual RMS {c.channel}: {c.rms:.3g} {CHANNELS[c.channel]} (noise scale {c.noise_scale:.3g}, "
+                  f"{'given' if c.noise_given else 'estimated'})" for c in self.residuals.values()]
+        lines += [f"- {s}" for s in self.identifiability.statements]
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
@@ -711,8 +713,9 @@ def _identifiability(problem: _Problem, statistics: _Statistics, estimates: Mapp
             statements.append(f"{SPECS[e.name].words} ends on a bound of the search ({e.value:.4g} {e.unit}): the "
                               "data push it beyond; its interval does not hold.")
     if math.isfinite(index) and index > 15:
-        statements.append(f"Collinearity index {index:.3g} (> 15): the searched set as a whole is poorly identifiable; "
-                          f"its least determined combination is {_combination(weakest)}.")
+        statements.append(f"Collinearity index {index:.3g} (above ~15, Brun et al. 2001: the set is identified only "
+                          "from precise data; the intervals above say how precise these are); the least determined "
+                          f"combination is {_combination(weakest)}.")
     return Identifiability(tuple(float(s) for s in singular), index, tuple(pairs), weakest, tuple(statements))
 
 
