@@ -101,6 +101,7 @@ UNCARRIED_RESIDUAL = 1e3
 #: Relative tolerances of the sinkage solve inside the fit, and of least_squares.
 SOLVE_RTOL = 1e-12
 FIT_TOL = 1e-10
+METHOD = "dogbox"
 #: Measurements per estimated parameter at least.
 MEASUREMENTS_PER_PARAMETER = 2
 
@@ -210,7 +211,7 @@ def _plan_pressure(facts: _Facts, estimated: list[str], fixed: dict[str, str], s
 
 def _plan_patch(facts: _Facts, optional: list[str], fixed: dict[str, str], statements: list[str]) -> None:
     if facts.force or facts.sinkage:
-        optional += ["a0", "a1", "lam"]
+        optional += ["a1", "a0", "lam"]
         statements.append("a0, a1 (the angle of the largest normal stress) and λ (the exit angle) are estimated only "
                           "if the data determine them; otherwise kept at the prior's values with the reason.")
     else:  # only Fy: plan_parameters adds the lateral ones
@@ -569,7 +570,7 @@ def _fit(problem: _Problem, z: NDArray[np.float64], low: NDArray[np.float64],
     if not problem.names:
         return z, "nothing to search"
     steps = np.array([SPECS[name].step for name in problem.names])
-    result = optimize.least_squares(problem.residuals, z, bounds=(low, high), method="trf", x_scale=steps,
+    result = optimize.least_squares(problem.residuals, z, bounds=(low, high), method=METHOD, x_scale=steps,
                                     diff_step=1e-7, ftol=FIT_TOL, xtol=FIT_TOL, gtol=FIT_TOL, max_nfev=200)
     return np.asarray(result.x, dtype=float), str(result.message)
 
@@ -723,35 +724,24 @@ def _combination(weakest: Mapping[str, float]) -> str:
     return " ".join(f"{v:+.2f}·{k}" for k, v in weakest.items())
 
 
-def _worst_optional(problem: _Problem, statistics: _Statistics, estimates: Mapping[str, ParameterEstimate],
-                    optional: Sequence[str]) -> tuple[str, str] | None:
-    """The optional parameter the data determine least (and why), or None if they determine all."""
-    worst: tuple[float, str, str] | None = None
-    names = problem.names
-    for name in optional:
-        if name not in names:
-            continue
-        k = names.index(name)
-        estimate = estimates[name]
-        correlations = np.abs(np.nan_to_num(np.delete(statistics.correlation[k], k), nan=1.0))
-        width = 2 * estimate.standard_error * float(stats.t.ppf(0.975, statistics.dof))
-        badness = max(width / SPECS[name].resolution if math.isfinite(width) else math.inf,
-                      float(correlations.max(initial=0.0)) / CORRELATION_LIMIT, 1.01 if estimate.at_bound else 0.0)
-        if badness > 1 and (worst is None or badness > worst[0]):
-            worst = (badness, name, _why_dropped(name, estimate, correlations, names, k))
-    return None if worst is None else worst[1:]
-
-
-def _why_dropped(name: str, estimate: ParameterEstimate, correlations: NDArray[np.float64], names: Sequence[str],
-                 k: int) -> str:
-    others = [n for n in names if n != name]
+def _rejection(problem: _Problem, statistics: _Statistics, estimates: Mapping[str, ParameterEstimate],
+               name: str) -> str | None:
+    """Why the data do not determine the optional parameter ``name`` beside the others searched
+    (it trades off with one of them, ends on a bound, or its interval is wider than its
+    resolution), or None if they do."""
+    k = problem.names.index(name)
+    estimate = estimates[name]
+    others = [n for n in problem.names if n != name]
+    correlations = np.abs(np.nan_to_num(np.delete(statistics.correlation[k], k), nan=1.0))
     if correlations.size and correlations.max() > CORRELATION_LIMIT:
         partner = others[int(np.argmax(correlations))]
         return (f"the data do not determine it: it trades off with {SPECS[partner].words} (|correlation| "
                 f"{correlations.max():.3f} > {CORRELATION_LIMIT})")
     if estimate.at_bound:
-        return "the data do not determine it: the search ends on a bound"
-    return f"the data do not determine it well enough (interval {estimate.text()})"
+        return f"the data do not determine it: the search ends on a bound ({estimate.value:.4g})"
+    if estimate.determined != "well":
+        return f"the data do not determine it well enough ({estimate.text()})"
+    return None
 
 
 def estimate_soil(data: TestBedData, wheel: Wheel = Wheel(), prior: Soil = Soil(),
@@ -760,13 +750,17 @@ def estimate_soil(data: TestBedData, wheel: Wheel = Wheel(), prior: Soil = Soil(
     """The soil whose reference wheel best explains ``data`` (weighted least squares, see the module
     docstring).
 
+    The plan's parameters are searched first; then each optional one in turn (a1, a0, λ, k_x,β,
+    k_y,β) is added, searched from the previous values, and kept only if the data determine it
+    beside the others (no |correlation| above 0.95, not on a bound, an interval within its
+    resolution); otherwise it keeps the prior's value, and the reason is recorded.
+
     Args:
         data: steady-state single-wheel measurements.
         wheel: the wheel of the test bed.
         prior: the soil the search starts from; every parameter not estimated keeps its value.
         parameters: the Soil fields to estimate (names of :data:`SPECS`); None: the plan of
-            :func:`plan_parameters` from the data's columns, optional ones kept only while the
-            data determine them.
+            :func:`plan_parameters` from the data's columns.
         noise: the standard deviation of each channel's measurement noise (``{"Fx_N": 2.0}``, the
             channel's unit); channels not given get theirs from the fit's residuals.
         bounds: search bounds [SI] replacing those of :data:`BOUNDS`.
@@ -782,21 +776,20 @@ def estimate_soil(data: TestBedData, wheel: Wheel = Wheel(), prior: Soil = Soil(
     _check_fit_data(data, wheel, plan)
     scales, given = _noise_scales(data, noise)
     limits = _bounds(prior, bounds)
-    names = list(plan.estimated) + list(plan.optional)
+    problem = _Problem(data, wheel, prior, plan.estimated, scales)
+    found = _search(problem, {}, limits, given, confidence)
+    evaluations = problem.evaluations
     dropped: list[FixedParameter] = []
-    evaluations = 0
-    previous: dict[str, float] = {}
-    while True:
-        problem = _Problem(data, wheel, prior, names, scales)
-        z, message, statistics, estimates = _search(problem, previous, limits, given, confidence)
-        evaluations += problem.evaluations
-        worst = _worst_optional(problem, statistics, estimates, plan.optional)
-        if worst is None:
-            break
-        dropped.append(FixedParameter(worst[0], getattr(prior, worst[0]), worst[1]))
-        previous = dict(zip(names, (float(v) for v in z)))
-        names.remove(worst[0])
-        scales = {n: s if n in given else 0.01 * _channel_scale(data.channel(n)) for n, s in problem.scales.items()}
+    for name in plan.optional:
+        trial = _Problem(data, wheel, prior, (*problem.names, name), problem.scales)
+        attempt = _search(trial, dict(zip(problem.names, (float(v) for v in found[0]))), limits, given, confidence)
+        evaluations += trial.evaluations
+        reason = _rejection(trial, attempt[2], attempt[3], name)
+        if reason is None:
+            problem, found = trial, attempt
+        else:
+            dropped.append(FixedParameter(name, getattr(prior, name), reason))
+    z, message, statistics, estimates = found
     fitted = problem.predict(z)
     residuals = {name: ChannelResiduals(name, data.channel(name), fitted.channel(name), problem.scales[name],
                                         name in given) for name in data.channels}

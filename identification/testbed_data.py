@@ -63,8 +63,8 @@ def check_values(columns: Mapping[str, FloatArray], lines: Sequence[int] | None 
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:
             row = int(bad[0])
-            raise ValueError(f"{source}: {_row_name(row, lines)}, column {name}: {values[row]!r} is not a finite "
-                             "number")
+            raise ValueError(f"{source}: {_row_name(row, lines)}, column {name}: {float(values[row])!r} is not a "
+                             "finite number")
         if name in _RANGES:
             test, expected = _RANGES[name]
             bad = np.flatnonzero(~test(values))
@@ -293,7 +293,7 @@ def _carried(load: FloatArray, slip: FloatArray, beta: FloatArray, wheel: Wheel,
     return load < capacity
 
 
-def generate_testbed_data(soil: Soil, wheel: Wheel = Wheel(), loads: Sequence[float] = (150, 300, 450, 600, 750),
+def generate_testbed_data(soil: Soil, wheel: Wheel = Wheel(), *, loads: Sequence[float] = (150, 300, 450, 600, 750),
                           slips: Sequence[float] = tuple(np.round(np.arange(-0.2, 0.81, 0.1), 10)),
                           slip_angles_deg: Sequence[float] = (0.0,),
                           channels: Sequence[str] | None = None, noise: float = 0.0, seed: int = 0,

@@ -139,8 +139,8 @@ def write_testbed_data(path: Path, choice: Choice | None = None, loads: Sequence
     if rows > MAX_ROWS:
         raise ValueError(f"{len(loads)} loads x {len(slips)} slips x {len(slip_angles_deg)} slip angles = {rows:,} "
                          f"rows: more than the {MAX_ROWS:,} testbed-data writes")
-    data = generate_testbed_data(choice.soil, choice.wheel, loads, slips, slip_angles_deg, channels, noise, seed,
-                                 source=str(path))
+    data = generate_testbed_data(choice.soil, choice.wheel, loads=loads, slips=slips, slip_angles_deg=slip_angles_deg,
+                                 channels=channels, noise=noise, seed=seed, source=str(path))
     text = data.to_csv()
     beta = 0.0 if data.slip_angle_deg is None else data.slip_angle_deg
     exact = predict(choice.soil, choice.wheel, data.load_N, data.slip, beta)
