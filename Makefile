@@ -123,6 +123,7 @@ bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
 	$(PY) -P benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
 	$(PY) -P benchmarks/bench_controller.py --out $(RESULTS)/bench/controller.json --model $(RESULTS)/identification/model.json
+	$(PY) -P benchmarks/bench_soil_estimation.py --out $(RESULTS)/bench/soil_estimation.json --markdown $(RESULTS)/bench/soil_estimation.md
 	$(PY) -P benchmarks/bench_closed_loop.py --out $(RESULTS)/bench/closed_loop.json --model $(RESULTS)/identification/model.json
 
 clean:

@@ -251,6 +251,7 @@ def build_parser() -> argparse.ArgumentParser:
     soils.add_argument("name", nargs="?", type=_path_text, default=None,
                        help="a soil or wheel (shipped name, TOML file or FILE:NAME)")
     commands.add_parser("blocks", help="the block types of system files, with their keys, units and defaults")
+    _add_soil_estimation_commands(commands)
 
     report = commands.add_parser("report", help="results/report.html: figures and tables beside the paper's")
     report.add_argument("--results", type=_path, default=Path("results"), help="the results folder")
@@ -281,6 +282,111 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _names(text: str) -> tuple[str, ...]:
+    """Comma-separated soil fields to estimate (--parameters)."""
+    from rover_cosim.identification.soil_estimation import SPECS
+
+    names = tuple(part.strip() for part in text.split(",") if part.strip())
+    unknown = [name for name in names if name not in SPECS]
+    if unknown or not names or len(set(names)) != len(names):
+        raise argparse.ArgumentTypeError(f"parameters={text!r}: expected distinct names of {', '.join(SPECS)}, "
+                                         "comma-separated")
+    return names
+
+
+def _noise_scales(text: str) -> dict[str, float]:
+    """CHANNEL=SD,... of --noise-scale: the noise's standard deviation per channel, in its unit."""
+    from rover_cosim.identification.testbed_data import CHANNELS
+
+    scales: dict[str, float] = {}
+    for part in text.split(","):
+        name, equals, value = part.partition("=")
+        name = name.strip()
+        try:
+            number = float(value)
+        except ValueError:
+            number = float("nan")
+        if not equals or name not in CHANNELS or not (0 < number < float("inf")) or name in scales:
+            raise argparse.ArgumentTypeError(f"noise scale {part.strip()!r}: expected CHANNEL=SD with CHANNEL one of "
+                                             f"{', '.join(CHANNELS)} (once each) and SD > 0 in its unit, e.g. "
+                                             "Fx_N=2,Tx_Nm=0.8")
+        scales[name] = number
+    return scales
+
+
+def _numbers(kind: str, low: float, high: float, unit: str):  # noqa: ANN202 - an argparse type
+    """A type of comma-separated numbers in [low, high] (``kind`` names them in messages)."""
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(part) for part in text.split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind}={text!r}: expected comma-separated numbers{unit}") from None
+        bad = [v for v in values if not low <= v <= high]
+        if bad:
+            raise argparse.ArgumentTypeError(f"{kind} {bad[0]!r}: expected a number in [{low:g}, {high:g}]{unit}")
+        return values
+    return parse
+
+
+def _fraction(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 <= value <= 1:
+        raise argparse.ArgumentTypeError(f"noise={text!r}: expected a fraction of each channel's range in [0, 1] "
+                                         "(e.g. 0.02)")
+    return value
+
+
+def _add_soil_estimation_commands(commands: Any) -> None:
+    """estimate-soil and testbed-data (issue 33)."""
+    from rover_cosim.identification.testbed_data import CHANNELS
+
+    est = commands.add_parser("estimate-soil", help="soil parameters (c, phi, kphi, n, kx, ...) estimated from "
+                              "single-wheel test-bed data (CSV) -> soil.toml, estimate.json, figures")
+    est.add_argument("data", type=_path, help="CSV file: columns load_N, slip, any of Fx_N, Tx_Nm, sinkage_m, Fy_N "
+                     "and optionally slip_angle_deg; one row per steady-state measurement")
+    est.add_argument("--out", type=_path, default=Path("results/soil_estimate"), help="output folder")
+    est.add_argument("--wheel", type=_path_text, default=None,
+                     help="the test bed's wheel: a name of the shipped library, a TOML file, or FILE:NAME (default: "
+                     "paper)")
+    est.add_argument("--prior", type=_path_text, default=None,
+                     help="the soil the search starts from; what is not estimated keeps its value: a shipped name, a "
+                     "TOML file or FILE:NAME (default: paper)")
+    est.add_argument("--set", dest="assignments", action="append", default=[], metavar="KIND.NAME=VALUE",
+                     help="change one value of the prior or wheel (soil.c=500, wheel.b=0.2; repeatable)")
+    est.add_argument("--parameters", type=_names, default=None, metavar="NAMES",
+                     help="comma-separated soil fields to estimate, e.g. c,phi,kphi,n,kx (default: what the data's "
+                     "columns allow; a0, a1, lam and the slip-angle growths only if the data determine them)")
+    est.add_argument("--noise-scale", type=_noise_scales, default=None, metavar="CHANNEL=SD,...",
+                     help="standard deviation of each channel's measurement noise in its unit, e.g. Fx_N=2,Tx_Nm=0.8 "
+                     "(default: estimated from the fit's residuals)")
+    gen = commands.add_parser("testbed-data", help="single-wheel test-bed data (the CSV estimate-soil reads) from the "
+                              "reference wheel on a known soil, with seeded noise")
+    gen.add_argument("--out", type=_path, required=True, help="the CSV file to write (.csv; a .json record of the "
+                     "truth goes beside it)")
+    _add_soil_options(gen)
+    gen.add_argument("--loads", type=_positive_loads, default=None,
+                     help="comma-separated wheel loads [N] (default: 150,300,450,600,750)")
+    gen.add_argument("--slips", type=_numbers("slip", -1.0, 1.0, ""), default=None,
+                     help="comma-separated slip ratios in [-1, 1] (default: -0.2,-0.1,...,0.8)")
+    gen.add_argument("--slip-angles", type=_numbers("slip angle", -89.0, 89.0, " deg"), default=(0.0,),
+                     metavar="DEGREES", help="comma-separated slip angles [deg]; any other than 0 adds Fy_N "
+                     "(default: 0)")
+    gen.add_argument("--channels", type=lambda text: tuple(p.strip() for p in text.split(",")), default=None,
+                     help=f"measured columns, of {', '.join(CHANNELS)} (default: Fx_N, Tx_Nm, sinkage_m, and Fy_N "
+                     "at slip angles other than 0)")
+    gen.add_argument("--sinkage", action=argparse.BooleanOptionalAction, default=True,
+                     help="write the sinkage_m column (--no-sinkage: a test bed without a sinkage sensor)")
+    gen.add_argument("--noise", type=_fraction, default=0.0,
+                     help="Gaussian noise on every measured channel, its standard deviation a fraction of the "
+                     "channel's range, e.g. 0.02 (default: 0)")
+    gen.add_argument("--seed", type=int, default=0, help="seed of the noise (default: 0)")
+    gen.add_argument("--overwrite", action="store_true",
+                     help="replace --out even if it is not data this command wrote")
+
+
 #: Per command: what it does (one line), then examples.
 USAGE = {
     "fig3": ("Paper Fig. 3 from the numpy reference wheel: Fx against slip for several loads (CSV, PNG, JSON).",
@@ -300,6 +406,12 @@ USAGE = {
                  "rover-cosim simulate --out results/simulation", "rover-cosim simulate --only straight --quiet"),
     "montecarlo": ("The paper's closed loop over sampled soils: how often the 1 N RMS holds, and what matters most.",
                    "rover-cosim montecarlo --runs 20 --workers 2", "rover-cosim montecarlo --study my_study.toml"),
+    "estimate-soil": ("Soil parameters with intervals from single-wheel test-bed data; soil.toml for --soil.",
+                      "rover-cosim estimate-soil data.csv --out results/my_soil",
+                      "rover-cosim estimate-soil data.csv --prior lunar_nominal --parameters c,phi,kphi,n,kx"),
+    "testbed-data": ("Single-wheel test-bed data from the reference wheel on a known soil, with seeded noise.",
+                     "rover-cosim testbed-data --soil lunar_nominal --noise 0.02 --seed 1 --out data.csv",
+                     "rover-cosim testbed-data --soil paper --slip-angles 0,5,10 --no-sinkage --out lateral.csv"),
     "soils": ("The shipped soils and wheels with their sources; one of them with every value and unit.",
               "rover-cosim soils", "rover-cosim soils lete_sand"),
     "blocks": ("The block types a system file may use, with their keys, units and defaults.", "rover-cosim blocks"),
@@ -796,9 +908,9 @@ def _foreign(target: Path, command: str) -> str | None:
     if not target.exists() or target.is_dir():
         return None
     try:
-        if command == "run":
+        if command in ("run", "testbed-data"):  # a JSON record beside the file names the command
             sidecar = target.with_suffix(".json")
-            if sidecar.is_file() and json.loads(sidecar.read_text()).get("command") == "rover-cosim run":
+            if sidecar.is_file() and json.loads(sidecar.read_text()).get("command") == f"rover-cosim {command}":
                 return None
         elif command == "report":
             if b"rover-cosim report" in target.read_bytes()[:4096]:
@@ -815,7 +927,7 @@ def _foreign(target: Path, command: str) -> str | None:
 #: Bytes a command's results take, about (with its run cache; checked against the free space before
 #: the work starts). The Monte Carlo adds MONTECARLO_RUN_BYTES per run, `run` its rows.
 NEEDS = {"fig3": 5e6, "identify": 80e6, "simulate": 60e6, "montecarlo": 10e6, "cosim-study": 5e6, "report": 20e6,
-         "export-ssp": 0.0}
+         "export-ssp": 0.0, "estimate-soil": 5e6, "testbed-data": 2e6}
 MONTECARLO_RUN_BYTES = 5e3
 
 
@@ -908,9 +1020,64 @@ def _fig3(args: argparse.Namespace) -> int:
     return 0
 
 
+def _estimate_soil(args: argparse.Namespace) -> int:
+    from rover_cosim.jobs.estimate_soil import run_estimate_soil
+    from rover_cosim.terramechanics.library import choose
+
+    if not _output_folder(args.out, "estimate-soil"):
+        return 2
+    try:
+        choice = choose(args.prior, args.wheel, args.assignments)
+        outcome = run_estimate_soil(args.data, args.out, choice, args.parameters, args.noise_scale)
+    except (ValueError, TypeError) as error:
+        print(f"rover-cosim estimate-soil: {error} (nothing written)", file=sys.stderr)
+        return 2
+    except RuntimeError as error:
+        print(f"rover-cosim estimate-soil: {error} (nothing written)", file=sys.stderr)
+        return 1
+    print(outcome.estimate.summary())
+    for path in outcome.files:
+        print(f"wrote {path}")
+    return 0
+
+
+def _testbed_data(args: argparse.Namespace) -> int:
+    from rover_cosim.jobs.estimate_soil import DEFAULT_LOADS, DEFAULT_SLIPS, write_testbed_data
+
+    if args.out.suffix.lower() != ".csv":
+        print(f"rover-cosim testbed-data: --out {args.out}: expected a .csv file name (its record goes beside it as "
+              ".json)", file=sys.stderr)
+        return 2
+    problem = _unwritable(args.out, NEEDS["testbed-data"]) or (None if args.overwrite
+                                                                else _foreign(args.out, "testbed-data"))
+    if problem:
+        print(f"rover-cosim testbed-data: --out {args.out}: {problem}", file=sys.stderr)
+        return 2
+    choice = _choice(args, "testbed-data")
+    if choice is None:
+        return 2
+    channels = args.channels
+    if channels is not None and not args.sinkage:
+        channels = tuple(name for name in channels if name != "sinkage_m")
+    elif channels is None and not args.sinkage:
+        channels = ("Fx_N", "Tx_Nm") + (("Fy_N",) if any(a != 0 for a in args.slip_angles) else ())
+    try:
+        outcome = write_testbed_data(args.out, choice, args.loads or DEFAULT_LOADS, args.slips or DEFAULT_SLIPS,
+                                     args.slip_angles, channels, args.noise, args.seed)
+    except ValueError as error:
+        print(f"rover-cosim testbed-data: {error} (nothing written)", file=sys.stderr)
+        return 2
+    print(f"{outcome.data.rows} rows ({', '.join(outcome.data.channels)}) on soil {choice.soil_name}, wheel "
+          f"{choice.wheel_name}, noise {args.noise:g} of each channel's range (seed {args.seed})")
+    for path in outcome.files:
+        print(f"wrote {path}")
+    return 0
+
+
 COMMANDS = {"build-fmus": _build_fmus, "run": _run, "export-ssp": _export_ssp, "cosim-study": _cosim_study,
             "identify": _identify,
             "simulate": _simulate, "montecarlo": _montecarlo, "report": _report, "fig3": _fig3, "soils": _soils,
+            "estimate-soil": _estimate_soil, "testbed-data": _testbed_data,
             "blocks": _blocks}
 
 
