@@ -158,16 +158,16 @@ def _rolling(table: pd.DataFrame) -> pd.DataFrame:
     return table[table["rolling"].astype(bool)] if "rolling" in table else table
 
 
-def fx_per_load(table: pd.DataFrame, degree: int = 1) -> pd.DataFrame:
+def fx_per_load(table: pd.DataFrame, degree: int = 1, torque_max: float = FIT_TORQUE_MAX) -> pd.DataFrame:
     """Per load, the polynomial Fx(slip) of ``degree`` through the settled points with torque up
-    to FIT_TORQUE_MAX and slip in SLIP_FIT_RANGE: columns load_N, c0 (= b), c1 (= a), ..."""
+    to ``torque_max`` [N·m] and slip in SLIP_FIT_RANGE: columns load_N, c0 (= b), c1 (= a), ..."""
     rows = []
     for load, part in _rolling(table).groupby("load_N"):
         inside = part[(part["slip"] >= SLIP_FIT_RANGE[0]) & (part["slip"] <= SLIP_FIT_RANGE[1])
-                      & (part["torque_N_m"] <= FIT_TORQUE_MAX)]
+                      & (part["torque_N_m"] <= torque_max)]
         if len(inside) < degree + 1:
             raise ValueError(f"load {load} N: {len(inside)} settled points with slip in {SLIP_FIT_RANGE} and torque "
-                             f"<= {FIT_TORQUE_MAX} N·m, need {degree + 1} for a degree-{degree} fit")
+                             f"<= {torque_max} N·m, need {degree + 1} for a degree-{degree} fit")
         coefficients = np.polynomial.polynomial.polyfit(inside["slip"], inside["Fx_N"], degree)
         rows.append({"load_N": load, **{f"c{k}": float(c) for k, c in enumerate(coefficients)}})
     return pd.DataFrame(rows)
@@ -188,13 +188,14 @@ def _filled(table: pd.DataFrame, column: str, loads: np.ndarray, torques: np.nda
     return values
 
 
-def identify(table: pd.DataFrame, degree: int = 1) -> IdentifiedModel:
-    """The identified model from the step table (LUTs) and the Fx fits (quadratic in W)."""
+def identify(table: pd.DataFrame, degree: int = 1, torque_max: float = FIT_TORQUE_MAX) -> IdentifiedModel:
+    """The identified model from the step table (LUTs) and the Fx fits (quadratic in W) through the
+    points with torque up to ``torque_max`` [N·m]."""
     loads = np.array(sorted(table["load_N"].unique()))
     torques = np.array(sorted(table["torque_N_m"].unique()))
     gain = _filled(_rolling(table), "K_per_N_m", loads, torques)
     constant = _filled(_rolling(table), "T_s", loads, torques)
-    per_load = fx_per_load(table, degree)
+    per_load = fx_per_load(table, degree, torque_max)
     coefficients = np.array([np.polynomial.polynomial.polyfit(per_load["load_N"], per_load[f"c{k}"], 2)
                              for k in range(degree + 1)])
     return IdentifiedModel(loads, torques, gain, constant, coefficients, degree)

@@ -12,6 +12,7 @@ results/simulation/
 
 from __future__ import annotations
 
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -24,9 +25,12 @@ import pandas as pd
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
 from rover_cosim.common.rows import every, steps_between_rows
+from rover_cosim.control.adaptive import AdaptiveController, Calibration
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
 from rover_cosim.identification.model_set import ModelMismatch, ModelSet
+from rover_cosim.identification.online import Adaptation, adapt_model
+from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
@@ -82,6 +86,39 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | No
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
     for i in LIMBS:
         builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
+    return builder.build()
+
+
+def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, *,
+                    nominal: Choice | None = None, calibration: Calibration = Calibration(),
+                    cache_dir: Path | None = None, **options: Any) -> System:
+    """The closed loop on Rover.fmu (on the soil and wheel of ``choice``) with the adaptive
+    controller: a calibration phase, the soil estimated from the rover's telemetry starting from
+    ``nominal``'s soil (default: the paper's; the wheel is ``nominal``'s, the rover's own), the
+    model identified again on SingleWheel.fmu (the sweep's cache in ``cache_dir``; None: a
+    temporary folder), then the paper's law with it."""
+    nominal = nominal or choose()
+    models = models_of(model)
+    degree = models.model().degree
+    single_wheel = Path(fmu_dir) / "SingleWheel.fmu"
+
+    def adapter(data: TestBedData) -> Adaptation:
+        if cache_dir is not None:
+            return adapt_model(data, single_wheel, nominal.wheel, nominal.soil, Path(cache_dir), degree)
+        with tempfile.TemporaryDirectory(prefix="rover-cosim-adapt-") as folder:
+            return adapt_model(data, single_wheel, nominal.wheel, nominal.soil, Path(folder), degree)
+
+    builder = _closed_loop("closed loop (adaptive)")
+    add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
+    block = AdaptiveController("ctrl", models, adapter, wheel=nominal.wheel, calibration=calibration,
+                               **{"step": STEP, **options})
+    builder.add_block("ctrl", block)
+    builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v").connect("rover.pitch", "ctrl.pitch")
+    for i in LIMBS:
+        builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
+        builder.connect(f"rover.omega[{i}]", f"ctrl.omega[{i}]")
+        if calibration.sinkage_sensor:
+            builder.connect(f"rover.sinkage[{i}]", f"ctrl.sinkage[{i}]")
     return builder.build()
 
 
