@@ -30,15 +30,16 @@ from rover_cosim.terramechanics import Soil, Wheel
 
 from .fits import IdentifiedModel, identify, step_table
 
+from .soil_estimation import SoilEstimate, estimate_soil
+from .sweep import SweepPlan, run_sweep
+from .testbed_data import TestBedData
+
 #: N·m: the Fx(slip) fit of a model identified again uses the settled points up to this torque, the
 #: range the closed loop drives with once it has left the start (the paper's identification fits up
 #: to 40 N·m, the open-loop run's range). Measured on two soils far from the paper's (c 150 Pa,
 #: phi 45 deg, k_phi 3e5; c 2.5 kPa, phi 31 deg, k_phi 5e6) with the true soil: the largest
 #: RMS(Fx - Fx_des) after the calibration 2.0 -> 1.0 N and 0.74 -> 0.74 N.
 ADAPTED_FIT_TORQUE_MAX = 20.0
-from .soil_estimation import SoilEstimate, estimate_soil
-from .sweep import SweepPlan, run_sweep
-from .testbed_data import TestBedData
 
 
 @dataclass(frozen=True)
