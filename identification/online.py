@@ -29,7 +29,6 @@ from pathlib import Path
 from rover_cosim.terramechanics import Soil, Wheel
 
 from .fits import IdentifiedModel, identify, step_table
-
 from .soil_estimation import SoilEstimate, estimate_soil
 from .sweep import SweepPlan, run_sweep
 from .testbed_data import TestBedData
