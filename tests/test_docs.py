@@ -1,6 +1,6 @@
 """The documentation site builds without a warning (mkdocs --strict: broken links, docstrings that
 name parameters a function does not have), and its generated reference pages follow the code:
-every rover-cosim command, every shipped soil and wheel."""
+every rover-cosim command, every shipped soil and wheel, the Modelica package's UsersGuide."""
 
 from __future__ import annotations
 
@@ -36,3 +36,8 @@ def test_the_docs_site_builds_strictly_with_the_generated_references(tmp_path):
     api = (site / "reference" / "python" / "index.html").read_text()
     assert "wheel_state" in api and "sinkage" in api  # rendered from the docstrings
     assert not (site / "hooks.py").exists()
+    modelica = (site / "guide" / "modelica" / "index.html").read_text()  # with the package's UsersGuide
+    guide = REPOSITORY / "modelica" / "RoverTerramechanics" / "UsersGuide"
+    for section in (guide / "package.order").read_text().split():
+        assert f'id="{section.lower()}"' in modelica, section
+    assert "<h4>Wheel</h4>" in modelica and "modelica://" not in modelica
