@@ -2,7 +2,8 @@
 kept as files, so they cannot drift): the command line from ``rover_cosim.cli``'s parser, the soil
 and wheel library from its TOML files, the system-file keys and block types from the reader's own
 tables, the FMUs' variables from their model descriptions, and the benchmark and validation
-figures from ``results/`` (``make bench``, ``make run``).
+figures from ``results/`` (``make bench``, ``make run``); and the Modelica package's ``UsersGuide``,
+set into the page ``guide/modelica.md`` from the package's own Documentation annotations.
 
 Where they are read from: the FMUs from ``$ROVER_COSIM_DOCS_FMUS`` (default ``fmus/``), the results
 from ``$ROVER_COSIM_DOCS_RESULTS`` (default ``results/``)."""
@@ -10,6 +11,7 @@ from ``$ROVER_COSIM_DOCS_RESULTS`` (default ``results/``)."""
 from __future__ import annotations
 
 import argparse
+import html
 import json
 import os
 import re
@@ -196,6 +198,43 @@ def validation_page() -> str:
 GENERATED = {"reference/cli.md": cli_page, "reference/soils.md": library_page,
              "reference/system-files.md": system_files_page, "reference/fmu-variables.md": fmu_variables_page,
              "results/benchmarks.md": benchmarks_page, "results/validation.md": validation_page}
+
+#: Where guide/modelica.md takes the UsersGuide.
+USERS_GUIDE_MARK = "<!-- RoverTerramechanics.UsersGuide -->"
+
+
+def users_guide() -> str:
+    """Every class of ``RoverTerramechanics.UsersGuide``, in its package.order, as a section: its
+    description, then its Documentation HTML (links to the guide's classes become links to the
+    sections, links to other classes their names)."""
+    from rover_cosim.fmubuild import source
+
+    folder = source.MODELICA_ROOT / source.PACKAGE / "UsersGuide"
+    sections = [_guide_html(folder / "package.mo"), ""]
+    for name in (folder / "package.order").read_text().split():
+        description = re.search(rf'^class {name} "(.*?)"', (folder / f"{name}.mo").read_text(), re.MULTILINE)
+        if description is None:
+            raise ValueError(f"{folder / name}.mo: expected 'class {name} \"description\"'")
+        sections += [f"## {name}", "", f"*{html.escape(description.group(1))}*", "",
+                     _guide_html(folder / f"{name}.mo"), ""]
+    return "\n".join(sections)
+
+
+def _guide_html(path: Path) -> str:
+    """The Documentation HTML of a class of the guide, its links made to work on the site."""
+    info = re.search(r'Documentation\(info="<html>(.*?)</html>"\)', path.read_text(), re.DOTALL)
+    if info is None:
+        raise ValueError(f"{path}: no Documentation(info=...)")
+    body = info.group(1).replace('\\"', '"').strip()
+    body = re.sub(r'<a\s+href="modelica://RoverTerramechanics\.UsersGuide\.(\w+)">',
+                  lambda m: f'<a href="#{m.group(1).lower()}">', body)
+    return re.sub(r'<a\s+href="modelica://[\w.]+">(.*?)</a>', r"<code>\1</code>", body, flags=re.DOTALL)
+
+
+def on_page_markdown(markdown: str, page: Any, config: Any, files: Files) -> str:
+    if page.file.src_uri == "guide/modelica.md":
+        return markdown.replace(USERS_GUIDE_MARK, users_guide())
+    return markdown
 
 
 def on_files(files: Files, config: Any) -> Files:

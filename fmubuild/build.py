@@ -45,7 +45,8 @@ from .omc import build_fmu_omc
 from .platforms import HOST, PLATFORMS, ZIG_FLAGS, host_compiler, host_folder, host_suffix, zig_command, zig_version
 from .platforms import parse as parse_platforms
 
-#: The FMUs ``make fmus`` builds (classes of the Modelica package).
+#: The FMUs ``make fmus`` builds: the classes of the Modelica package's FMU sub-package
+#: (:func:`source.fmu_class`), in its package.order.
 FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel", "SteerableRover", "SteerableRoverBody")
 
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
@@ -112,7 +113,7 @@ def fmi_headers() -> Path:
 def _default_experiment(name: str) -> source.Experiment | None:
     """The class's ``experiment`` annotation, for the model description's DefaultExperiment."""
     try:
-        return source.experiment(f"{source.PACKAGE}.{name}")
+        return source.experiment(source.fmu_class(name))
     except ValueError:
         return None
 
@@ -123,7 +124,7 @@ def _class_documentation(name: str) -> str:
     import re
 
     parts = []
-    for qualified in (f"{source.PACKAGE}.{name}", f"{source.PACKAGE}.Parameters.SoilParameters",
+    for qualified in (source.fmu_class(name), f"{source.PACKAGE}.Parameters.SoilParameters",
                       f"{source.PACKAGE}.Parameters.WheelParameters"):
         text = source.class_file(qualified).read_text()
         found = re.search(r'info="(.*?)"\)', text, re.S)
@@ -134,7 +135,7 @@ def _class_documentation(name: str) -> str:
 
 
 def _class_description(name: str) -> str:
-    text = source.class_file(f"{source.PACKAGE}.{name}").read_text()
+    text = source.class_file(source.fmu_class(name)).read_text()
     head = text.split("\n", 3)
     for line in head:
         if line.strip().startswith(("model ", "block ")) and '"' in line:
@@ -256,7 +257,7 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
     with tempfile.TemporaryDirectory(prefix=f"fmubuild-{name}-") as tmp_name:
         tmp = Path(tmp_name)
         t0 = time.perf_counter()
-        model = ode.translate(source.load(f"{source.PACKAGE}.{name}"), name)
+        model = ode.translate(source.load(source.fmu_class(name)), name)
         model_layout = codegen.layout(model)
         stages["translate"] = time.perf_counter() - t0
         if step:
@@ -283,7 +284,7 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
         # Inputs the Modelica source gives a start value: a system may leave them unconnected.
         optional = [v for v in model.inputs if model.variables[v].start is not None]
         host = [t for t in chosen if "-target" not in t.command]
-        record = {"input_sha256": digest, "backend": "builtin", "model": f"{source.PACKAGE}.{name}",
+        record = {"input_sha256": digest, "backend": "builtin", "model": source.fmu_class(name),
                   "optional_inputs": optional,
                   "guid": guid, "rover_cosim": version,
                   "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")},

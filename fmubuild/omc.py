@@ -35,7 +35,7 @@ def script(name: str) -> str:
     return "\n".join([
         f'setCommandLineOptions("--fmiFlags={FMI_FLAGS}"); getErrorString();',
         f'if not loadFile("{package}") then print(getErrorString()); exit(1); end if;',
-        (f'result := buildModelFMU({source.PACKAGE}.{name}, version="2.0", fmuType="me_cs", '
+        (f'result := buildModelFMU({source.fmu_class(name)}, version="2.0", fmuType="me_cs", '
          f'fileNamePrefix="{name}", platforms={{"static"}});'),
         'print(getErrorString());',
         'if result == "" then exit(1); end if;',
@@ -66,7 +66,7 @@ def build_fmu_omc(name: str, out_dir: Path, *, force: bool = False) -> BuildResu
             raise RuntimeError(f"{name}: omc buildModelFMU failed (exit {result.returncode}):\n"
                                + (result.stdout + result.stderr)[-4000:])
         record = {"input_sha256": digest, "backend": "omc", "omc": version, "fmi_flags": FMI_FLAGS,
-                  "model": f"{source.PACKAGE}.{name}"}
+                  "model": source.fmu_class(name)}
         out_dir.mkdir(parents=True, exist_ok=True)
         partial = out_dir / f".{name}.fmu.partial"
         with zipfile.ZipFile(built) as original, zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as copy:

@@ -19,6 +19,16 @@ import pandas as pd
 MODELICA_ROOT = Path(__file__).parent.parent / "modelica"
 #: Name of the top-level Modelica package.
 PACKAGE = "RoverTerramechanics"
+#: Its sub-package of the FMU top levels: the class ``<PACKAGE>.<FMU_PACKAGE>.<name>`` is exported
+#: as ``<name>.fmu`` with the model identifier ``<name>``.
+FMU_PACKAGE = "FMUs"
+
+
+def fmu_class(name: str) -> str:
+    """The qualified Modelica class exported as the FMU ``name`` (``"Wheel"`` ->
+    ``"RoverTerramechanics.FMUs.Wheel"``): the one place that maps an FMU to its class."""
+    return f"{PACKAGE}.{FMU_PACKAGE}.{name}"
+
 
 def package_file() -> Path:
     """The top-level ``package.mo`` of RoverTerramechanics."""
@@ -38,7 +48,7 @@ def class_files() -> dict[str, Path]:
 
 
 def class_file(name: str) -> Path:
-    """The file defining the class ``name`` (qualified, e.g. ``RoverTerramechanics.Rover``)."""
+    """The file defining the class ``name`` (qualified, e.g. ``RoverTerramechanics.FMUs.Rover``)."""
     files = class_files()
     if name not in files:
         raise ValueError(f"model {name!r}: no such class in {MODELICA_ROOT / PACKAGE}; "

@@ -1,7 +1,8 @@
 """The documentation site builds without a warning (mkdocs --strict: broken links, docstrings that
 name parameters a function does not have), and its generated pages follow the code and the results:
 every rover-cosim command, every shipped soil and wheel, every system-file key and block type, every
-FMU variable, the benchmark files and the pipeline's validation tables."""
+FMU variable, the benchmark files, the pipeline's validation tables and the Modelica
+package's UsersGuide."""
 
 from __future__ import annotations
 
@@ -63,6 +64,11 @@ def test_the_docs_site_builds_strictly_with_the_generated_references(tmp_path, f
     api = (site / "reference" / "python" / "index.html").read_text()
     assert "wheel_state" in api and "sinkage" in api  # rendered from the docstrings
     assert not (site / "hooks.py").exists()
+    modelica = (site / "guide" / "modelica" / "index.html").read_text()  # with the package's UsersGuide
+    guide = REPOSITORY / "modelica" / "RoverTerramechanics" / "UsersGuide"
+    for section in (guide / "package.order").read_text().split():
+        assert f'id="{section.lower()}"' in modelica, section
+    assert "<h4>Wheel</h4>" in modelica and "modelica://" not in modelica
 
 
 def test_the_readme_python_quick_start_runs_and_prints_physical_values():

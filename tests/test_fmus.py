@@ -96,8 +96,8 @@ def test_fmu_metadata_carries_ranges_display_units_and_its_documentation(fmus, n
     assert f"<h1>{name}</h1>" in page and f"{prefix}phi" in page and "rad (shown in deg)" in page
 
 
-def test_model_description_interfaces_match_the_modelica_readme(fmus):
-    """The interfaces DESIGN.md and modelica/README.md promise (spot checks per FMU)."""
+def test_model_description_interfaces_match_the_users_guide(fmus):
+    """The interfaces the UsersGuide (UsersGuide.Models) promises (spot checks per FMU)."""
     single = variables(fmus["SingleWheel"])
     assert single["tau"].causality == "input" and single["tau"].unit == "N.m"
     assert single["W"].causality == "parameter" and single["W"].unit == "N"
@@ -530,7 +530,11 @@ def test_unchanged_sources_are_not_rebuilt(fmu_dir, fmus):
 BAD_PACKAGE = """package Bad
 end Bad;
 """
-BAD_MODEL = """within Bad;
+BAD_FMUS = """within Bad;
+package FMUs
+end FMUs;
+"""
+BAD_MODEL = """within Bad.FMUs;
 model SingleWheel "a model with an event"
   input Real tau(unit="N.m");
   Real omega(start=0, unit="rad/s");
@@ -545,10 +549,12 @@ end SingleWheel;
 
 def test_unsupported_construct_is_rejected_and_leaves_the_output_folder_untouched(tmp_path, monkeypatch):
     root = tmp_path / "modelica"
-    (root / "Bad").mkdir(parents=True)
+    (root / "Bad" / "FMUs").mkdir(parents=True)
     (root / "Bad" / "package.mo").write_text(BAD_PACKAGE)
-    (root / "Bad" / "SingleWheel.mo").write_text(BAD_MODEL)
-    (root / "Bad" / "package.order").write_text("SingleWheel\n")
+    (root / "Bad" / "package.order").write_text("FMUs\n")
+    (root / "Bad" / "FMUs" / "package.mo").write_text(BAD_FMUS)
+    (root / "Bad" / "FMUs" / "SingleWheel.mo").write_text(BAD_MODEL)
+    (root / "Bad" / "FMUs" / "package.order").write_text("SingleWheel\n")
     monkeypatch.setattr(source, "MODELICA_ROOT", root)
     monkeypatch.setattr(source, "PACKAGE", "Bad")
     out = tmp_path / "fmus"
@@ -622,14 +628,15 @@ def test_backend_choice_and_the_omc_script(monkeypatch):
     with pytest.raises(ValueError, match="backend='cmake'"):
         build.resolve_backend("cmake")
     text = script("Rover")
-    assert 'buildModelFMU(RoverTerramechanics.Rover, version="2.0", fmuType="me_cs"' in text
+    assert 'buildModelFMU(RoverTerramechanics.FMUs.Rover, version="2.0", fmuType="me_cs"' in text
+    assert 'fileNamePrefix="Rover"' in text  # the FMU keeps its name and model identifier
     assert "--fmiFlags=s:cvode" in text and source.package_file().as_posix() in text
 
 
 FAKE_OMC = """#!/bin/sh
 # Stands in for OpenModelica: checks the script it is given and "exports" a prepared FMU.
 if [ "$1" = "--version" ]; then echo "OpenModelica 0.0-stand-in"; exit 0; fi
-grep -q 'buildModelFMU(RoverTerramechanics.Wheel, version="2.0", fmuType="me_cs"' "$1" || exit 3
+grep -q 'buildModelFMU(RoverTerramechanics.FMUs.Wheel, version="2.0", fmuType="me_cs"' "$1" || exit 3
 cp "$PREPARED_FMU" Wheel.fmu
 """
 

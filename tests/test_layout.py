@@ -181,7 +181,10 @@ def test_the_wheel_has_only_rover_cosim_at_the_top_level(wheel):
     assert top == {"rover_cosim", wheel.name.split("-")[0] + "-" + wheel.name.split("-")[1] + ".dist-info"}, top
     for expected in ("rover_cosim/orchestrator/systems/rover_cosim.toml", "rover_cosim/fmubuild/runtime/fmi2_api.c",
                      "rover_cosim/modelica/RoverTerramechanics/package.mo",
-                     "rover_cosim/modelica/RoverTerramechanics/package.order", "rover_cosim/terramechanics/forces.py"):
+                     "rover_cosim/modelica/RoverTerramechanics/package.order", "rover_cosim/terramechanics/forces.py",
+                     "rover_cosim/modelica/RoverTerramechanics/FMUs/Wheel.mo",
+                     "rover_cosim/modelica/RoverTerramechanics/Interfaces/WheelHub.mo",
+                     "rover_cosim/modelica/RoverTerramechanics/UsersGuide/package.order"):
         assert expected in names, expected
 
 

@@ -1,29 +1,42 @@
 """The Modelica source through rumoca (the Modelica compiler on PyPI, pinned in pyproject.toml):
-every model flattens balanced, every example simulates, and rumoca's simulation agrees with the
-numpy reference wheel and between the monolithic and the reconnected rover."""
+every model flattens balanced, every example simulates, the UsersGuide documents every FMU's
+interface and its Python examples run, and rumoca's simulation agrees with the numpy reference
+wheel and between the monolithic and the reconnected rover."""
 
 from __future__ import annotations
 
+import html
 import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from rover_cosim.fmubuild import source
+from rover_cosim.fmubuild import build, source
 from rover_cosim.fmubuild.source import MODELICA_ROOT, PACKAGE
 from rover_cosim.terramechanics import Wheel, contact_forces, slip_ratio, wheel_forces, wheel_state
 
+REPOSITORY = Path(__file__).resolve().parents[1]
+
 rumoca = pytest.importorskip("rumoca", reason="rumoca is a pinned dependency; install the project with `make venv`")
 
-MODELS = ["SingleWheel", "Rover", "RoverBody", "Wheel", "RoverReconnected",
+MODELS = ["FMUs.SingleWheel", "FMUs.Rover", "FMUs.RoverBody", "FMUs.Wheel", "Examples.RoverReconnected",
           "Components.RigidWheel", "Components.Chassis"]
 EXAMPLES = ["Examples.SingleWheelStep", "Examples.RoverOpenLoop", "Examples.RoverReconnectedOpenLoop"]
-FMU_ROOTS = ["SingleWheel", "Rover", "RoverBody", "Wheel"]
 
 
 def full(name: str) -> str:
     return f"{PACKAGE}.{name}"
+
+
+def documentation(name: str) -> str:
+    """The Documentation info of the class ``name`` as text: the Modelica string unescaped, the
+    HTML entities resolved (tags kept)."""
+    text = source.class_file(full(name)).read_text()
+    found = re.search(r'Documentation\(info="(.*?)(?<!\\)"\)', text, re.DOTALL)
+    assert found, f"{name}: no Documentation(info=...)"
+    return html.unescape(found.group(1).replace('\\"', '"'))
 
 
 @pytest.mark.parametrize("name", MODELS + EXAMPLES)
@@ -53,12 +66,12 @@ def test_example_simulates_over_its_experiment(name: str):
     assert np.isfinite(df.to_numpy()).all()
 
 
-@pytest.mark.parametrize("name", FMU_ROOTS)
-def test_modelica_readme_lists_inputs_outputs_and_parameters(name: str):
-    readme = (MODELICA_ROOT / "README.md").read_text()
-    section = re.search(rf"^### `{name}`.*?(?=^### |\Z)", readme, re.MULTILINE | re.DOTALL)
-    assert section, f"modelica/README.md has no section '### `{name}`'"
-    model = source.load(full(name))
+@pytest.mark.parametrize("name", build.FMU_MODELS)
+def test_the_users_guide_lists_inputs_outputs_states_and_parameters(name: str):
+    guide = documentation("UsersGuide.Models")
+    section = re.search(rf"<h4>{name}</h4>.*?(?=<h4>|\Z)", guide, re.DOTALL)
+    assert section, f"UsersGuide.Models has no section <h4>{name}</h4>"
+    model = source.load(source.fmu_class(name))
     names = [n for n in list(model.inputs.names) + list(model.outputs.names) + list(model.states.names)
              if "." not in n]
     qualified = list(model.outputs.names) + list(model.states.names)
@@ -67,7 +80,30 @@ def test_modelica_readme_lists_inputs_outputs_and_parameters(name: str):
     names += sorted({p.name.split(".")[0].split("[")[0] for p in model.parameters
                      if not flat.get(p.name, {}).get("is_protected", False)} - components)
     for variable in names:
-        assert f"`{variable}" in section.group(0), f"{name}: `{variable}` not in its README section"
+        assert f"<code>{variable}" in section.group(0), f"{name}: {variable} not in its UsersGuide section"
+
+
+def python_examples() -> list[tuple[str, str]]:
+    """The Python examples of the guide (<pre> blocks with an import), of modelica/README.md and of
+    the site's page on the library."""
+    found = [("UsersGuide.Overview", block) for block in re.findall(r"<pre>\n(.*?)</pre>",
+                                                                   documentation("UsersGuide.Overview"), re.DOTALL)
+             if block.startswith("from ")]
+    for page in (MODELICA_ROOT / "README.md", REPOSITORY / "docs" / "guide" / "modelica.md"):
+        found += [(page.name, block) for block in re.findall(r"```python\n(.*?)```", page.read_text(), re.DOTALL)]
+    return found
+
+
+def test_the_python_examples_of_the_guide_run_with_the_installed_import():
+    """The guide tells users ``from rover_cosim.fmubuild import source`` (the import of an installed
+    rover-cosim; ``fmubuild`` alone is not importable) and its lines run as written."""
+    examples = python_examples()
+    assert [where for where, _ in examples] == ["UsersGuide.Overview", "README.md", "modelica.md"]
+    for where, code in examples:
+        assert "from rover_cosim.fmubuild import source" in code and "from fmubuild" not in code, where
+        namespace: dict[str, object] = {}
+        exec(compile(code, where, "exec"), namespace)  # our own documentation's example, as written
+        assert "model" in namespace, where
 
 
 # --- single-wheel step test against the numpy reference wheel -------------------------------

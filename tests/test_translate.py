@@ -1,15 +1,18 @@
 """The built-in exporter's front half: rumoca flat model → CasADi ODE (fmubuild.ode), checked
-against rumoca's own simulation of the same Modelica, and its rejections of what it cannot
-translate."""
+against rumoca's own simulation of the same Modelica, its rejections of what it cannot translate,
+and the public variables of every FMU model against the list they are held to."""
 
 from __future__ import annotations
+
+import json
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
 import pytest
 import rumoca
 
-from rover_cosim.fmubuild import source
+from rover_cosim.fmubuild import build, codegen, source
 from rover_cosim.fmubuild.expressions import UnsupportedConstruct
 from rover_cosim.fmubuild.ode import translate
 
@@ -29,7 +32,7 @@ def integrate(ode, params: dict[str, float], stop: float, interval: float):
 
 
 def test_single_wheel_step_ode_matches_rumocas_simulation():
-    name = "RoverTerramechanics.Examples.SingleWheelStep"
+    name = f"{source.PACKAGE}.Examples.SingleWheelStep"
     params = {"W": 575.0, "tauStep": 60.0}
     grid, ours = integrate(translate(source.load(name), name), params, 2.0, 0.01)
     theirs = source.simulate(name, params=params, stop=2.0, interval=0.01)
@@ -40,7 +43,7 @@ def test_single_wheel_step_ode_matches_rumocas_simulation():
 
 
 def test_open_loop_rover_ode_matches_rumocas_simulation():
-    name = "RoverTerramechanics.Examples.RoverOpenLoop"
+    name = f"{source.PACKAGE}.Examples.RoverOpenLoop"
     _, ours = integrate(translate(source.load(name), name), {}, 1.0, 0.01)
     theirs = source.simulate(name, stop=1.0, interval=0.01)
     for column, atol in (("rover.v", 1e-5), ("rover.Fz[1]", 0.05), ("rover.Fz[3]", 0.05),
@@ -55,7 +58,7 @@ def test_open_loop_rover_ode_matches_rumocas_simulation():
     ("Rover", [f"tau[{i}]" for i in range(1, 7)]),
 ])
 def test_fmu_models_translate_with_their_interfaces(name: str, inputs: list[str]):
-    ode = translate(source.load(f"RoverTerramechanics.{name}"), name)
+    ode = translate(source.load(source.fmu_class(name)), name)
     assert ode.inputs == inputs
     outputs = [v.name for v in ode.variables.values() if v.role == "output"]
     assert outputs and all(o in ode.observed or o in ode.states for o in outputs)
@@ -65,6 +68,27 @@ def test_fmu_models_translate_with_their_interfaces(name: str, inputs: list[str]
     jac = ca.Function("j", [ode.t, ode.x, ode.u, ode.p], [ca.jacobian(xdot, ode.x)])
     u = ca.DM([424.0 if n == "W" else 10.0 for n in ode.inputs])
     assert np.isfinite(np.array(jac(0.0, initial(p), u, p))).all()
+
+
+#: The public variables (parameters, inputs, outputs: name, causality, variability) of every FMU,
+#: as the FMUs had them when their classes moved into RoverTerramechanics.FMUs (captured from the
+#: layout of the models before the move). A difference is a change of the FMUs' interface: make it
+#: deliberately, here and in the CHANGELOG.
+FMU_VARIABLES = json.loads((Path(__file__).parent / "fmu_variables.json").read_text())
+
+
+@pytest.mark.parametrize("name", build.FMU_MODELS)
+def test_the_public_variables_of_each_fmu_are_those_it_always_had(name: str):
+    """What a user of the FMU sees by name: the exporter's variable layout (the model description's
+    ModelVariables) of the class the FMU is built from, against the captured list."""
+    layout = codegen.layout(translate(source.load(source.fmu_class(name)), name))
+    public = [[v.name, v.causality, v.variability] for v in layout.variables
+              if v.causality in ("parameter", "input", "output")]
+    expected = FMU_VARIABLES[name]
+    missing = [v for v in expected if v not in public]
+    added = [v for v in public if v not in expected]
+    assert not missing and not added, f"{name}: missing {missing}, added {added}"
+    assert public == expected, f"{name}: the same variables in another order (value references change)"
 
 
 BAD_MODELS = {

@@ -1,11 +1,8 @@
 within RoverTerramechanics.Components;
 model Chassis "Rover body in the pitch plane (x, z, pitch) on six vertical compliant limbs, cut at the wheel hubs"
+  extends RoverTerramechanics.Interfaces.BodyHubs;
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
-  input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub";
-  input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the body";
-  output Real W[6](each unit="N") "Wheel loads: the limb forces pressing each wheel into the soil";
-  output Real v_hub[6](each unit="m/s") "Forward speed of each wheel hub";
   output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity";
   output Real v(unit="m/s", start=0, fixed=true) "Forward velocity of the centre of gravity";
   output Real z(unit="m", start=0, fixed=true) "Heave of the centre of gravity from static equilibrium";

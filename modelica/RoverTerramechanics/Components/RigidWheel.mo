@@ -1,5 +1,6 @@
 within RoverTerramechanics.Components;
 model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, drive torque in, contact forces, slip and sinkage out, in every motion regime"
+  extends RoverTerramechanics.Interfaces.WheelHub;
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
@@ -7,19 +8,6 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
-  input Real tau(unit="N.m") "Drive torque applied to the wheel by its motor";
-  input Real W(unit="N") "Vertical load on the wheel";
-  input Real v_hub(unit="m/s") "Forward speed of the wheel hub";
-  input Real v_lat(unit="m/s", start=0) "Speed of the hub to the wheel's left (lateral, in the wheel frame)";
-  output Real omega(unit="rad/s", start=0, fixed=true) "Wheel angular velocity";
-  output Real slip(unit="1") "Slip ratio, Eq. (4)";
-  output Real sinkage(unit="m") "Sinkage h at which Fz = W";
-  output Real Fx(unit="N") "Longitudinal force of the soil on the wheel, Eq. (12) when rolling";
-  output Real Fz(unit="N") "Vertical force of the soil on the wheel, Eq. (11)";
-  output Real Tx(unit="N.m") "Resistance torque of the soil about the axle, Eq. (13) when rolling";
-  output Real entryAngle(unit="rad") "Entry angle, Eq. (1), signed with the direction of travel";
-  output Real Fy(unit="N") "Lateral force of the soil on the wheel, along its left (Ishigami et al. 2007)";
-  output Real slipAngle(unit="rad") "Slip angle of the hub velocity, seen from the direction of travel";
   Real contactEvaluations(unit="1") "Force evaluations of the sinkage solve at this point (a cost, for benchmarks)";
   Real logSinkage(unit="1") "log(sinkage / 1 m), the sinkage solve's last iterate";
   Real contactSlope(unit="1") "d log Fz / d log h near the sinkage, from the solve";

@@ -1,13 +1,7 @@
 within RoverTerramechanics.Components;
 model SteerableChassis "Rover body moving in the plane (x, y, yaw) with heave, pitch and roll on six compliant limbs, every wheel steered, cut at the wheel hubs"
+  extends RoverTerramechanics.Interfaces.SteerableBodyHubs;
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
-  input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub, along the wheel's heading";
-  input Real Fy[6](each unit="N") "Lateral force of each wheel on its hub, to the wheel's left";
-  input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the body";
-  input Real steer[6](each unit="rad") "Steering angle of each wheel against the body's heading, positive to the left";
-  output Real W[6](each unit="N") "Wheel loads: the limb forces pressing each wheel into the soil";
-  output Real v_hub[6](each unit="m/s") "Hub speed along each wheel's heading";
-  output Real v_lat[6](each unit="m/s") "Hub speed to each wheel's left";
   output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity, world x";
   output Real y(unit="m", start=0, fixed=true) "Position of the centre of gravity, world y";
   output Real yaw(unit="rad", start=0, fixed=true) "Heading of the body against world x, positive to the left";

@@ -1,6 +1,6 @@
 within RoverTerramechanics.Examples;
 model RoverOpenLoop "Open-loop run of the monolithic rover: all six wheels driven by openLoopTorque"
-  RoverTerramechanics.Rover rover "Rover";
+  RoverTerramechanics.FMUs.Rover rover "Rover";
 equation
   for i in 1:6 loop
     rover.tau[i] = openLoopTorque(time);

@@ -1,6 +1,6 @@
 within RoverTerramechanics.Examples;
 model RoverReconnectedOpenLoop "The open-loop run of RoverOpenLoop on RoverBody + 6 Wheel reconnected"
-  RoverTerramechanics.RoverReconnected rover "Reconnected rover";
+  RoverTerramechanics.Examples.RoverReconnected rover "Reconnected rover";
 equation
   for i in 1:6 loop
     rover.tau[i] = openLoopTorque(time);

@@ -3,7 +3,7 @@ model SingleWheelStep "Torque step at t = 0 on the single-wheel test bed, wheel 
   parameter Real W(unit="N") = 424 "Load on the wheel";
   parameter Real tauStep(unit="N.m") = 50 "Torque after the step";
   parameter Real slipAngle(unit="rad") = 0 "Angle of the carriage's track to the wheel plane";
-  RoverTerramechanics.SingleWheel testBed(W=W, slipAngle=slipAngle) "Test bed";
+  RoverTerramechanics.FMUs.SingleWheel testBed(W=W, slipAngle=slipAngle) "Test bed";
 equation
   testBed.tau = tauStep;
   testBed.trackAngle = 0;

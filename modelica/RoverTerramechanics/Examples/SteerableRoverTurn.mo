@@ -2,7 +2,7 @@ within RoverTerramechanics.Examples;
 model SteerableRoverTurn "Open-loop turn of the steerable rover: 20 N.m on every wheel, front wheels steered left and rear wheels right, from 0.5 m/s"
   parameter Real tauDrive(unit="N.m") = 20 "Drive torque of every wheel";
   parameter Real steerFront(unit="rad") = 0.05 "Steering of the front wheels (the rear ones take the opposite)";
-  RoverTerramechanics.SteerableRover rover(body(v(start=0.5)), wheels(each omega(start=1.4084507042253522))) "Rover starting at 0.5 m/s, wheels rolling";
+  RoverTerramechanics.FMUs.SteerableRover rover(body(v(start=0.5)), wheels(each omega(start=1.4084507042253522))) "Rover starting at 0.5 m/s, wheels rolling";
 equation
   for i in 1:6 loop
     rover.tau[i] = tauDrive;

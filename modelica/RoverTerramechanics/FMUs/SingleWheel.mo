@@ -1,4 +1,4 @@
-within RoverTerramechanics;
+within RoverTerramechanics.FMUs;
 model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage of mass W/g that moves freely in x, on level ground or a slope"
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";

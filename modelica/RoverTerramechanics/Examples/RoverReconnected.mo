@@ -1,5 +1,6 @@
-within RoverTerramechanics;
+within RoverTerramechanics.Examples;
 model RoverReconnected "RoverBody and six Wheel models reconnected at the hubs: must behave as Rover (a check of the cut)"
+  extends RoverTerramechanics.Interfaces.PitchPlaneRover;
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
@@ -9,23 +10,13 @@ model RoverReconnected "RoverBody and six Wheel models reconnected at the hubs: 
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
-  input Real tau[6](each unit="N.m") "Drive torque of each wheel";
-  output Real x(unit="m") "Position of the centre of gravity";
-  output Real v(unit="m/s") "Forward velocity of the centre of gravity";
-  output Real pitch(unit="rad") "Pitch angle, nose up positive";
-  output Real Fz[6](each unit="N") "Vertical force of each wheel";
-  output Real Fx[6](each unit="N") "Longitudinal force of each wheel";
-  output Real Tx[6](each unit="N.m") "Resistance torque of each wheel";
-  output Real slip[6](each unit="1") "Slip ratio of each wheel";
-  output Real sinkage[6](each unit="m") "Sinkage of each wheel";
-  output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
-  RoverTerramechanics.RoverBody body(rover=rover, slope=slope) "The body FMU's model";
-  RoverTerramechanics.Wheel wheel1(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel2(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel3(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel4(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel5(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
-  RoverTerramechanics.Wheel wheel6(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.FMUs.RoverBody body(rover=rover, slope=slope) "The body FMU's model";
+  RoverTerramechanics.FMUs.Wheel wheel1(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.FMUs.Wheel wheel2(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.FMUs.Wheel wheel3(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.FMUs.Wheel wheel4(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.FMUs.Wheel wheel5(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
+  RoverTerramechanics.FMUs.Wheel wheel6(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick);
 equation
   // The connections of the co-simulated rover, one wheel instance per FMU instance:
   // body.W[i] -> wheel_i.W, body.v_hub[i] -> wheel_i.v_hub, wheel_i.Fx -> body.Fx[i],
@@ -48,7 +39,8 @@ equation
   annotation (Documentation(info="<html>
 <p>The co-simulated rover as one Modelica model: <code>RoverBody</code> and six separate
 <code>Wheel</code> instances (as six Wheel FMU instances would be), wired only through their
-public inputs and outputs. Same inputs and outputs as <code>Rover</code>; the test suite checks
-that the two give the same trajectories, i.e. that the cut interface loses nothing.</p>
+public inputs and outputs. Same inputs and outputs as <code>FMUs.Rover</code>
+(both extend <code>Interfaces.PitchPlaneRover</code>); the test suite checks that the two give
+the same trajectories, i.e. that the cut interface loses nothing.</p>
 </html>"));
 end RoverReconnected;

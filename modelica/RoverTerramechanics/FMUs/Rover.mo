@@ -1,5 +1,6 @@
-within RoverTerramechanics;
+within RoverTerramechanics.FMUs;
 model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechanics wheels (monolithic)"
+  extends RoverTerramechanics.Interfaces.PitchPlaneRover;
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
@@ -9,16 +10,6 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
-  input Real tau[6](each unit="N.m") "Drive torque of each wheel";
-  output Real x(unit="m") "Position of the centre of gravity";
-  output Real v(unit="m/s") "Forward velocity of the centre of gravity";
-  output Real pitch(unit="rad") "Pitch angle, nose up positive";
-  output Real Fz[6](each unit="N") "Vertical force of each wheel, Eq. (11) (= its load)";
-  output Real Fx[6](each unit="N") "Longitudinal force of each wheel, Eq. (12)";
-  output Real Tx[6](each unit="N.m") "Resistance torque of each wheel, Eq. (13)";
-  output Real slip[6](each unit="1") "Slip ratio of each wheel, Eq. (4)";
-  output Real sinkage[6](each unit="m") "Sinkage of each wheel";
-  output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
   RoverTerramechanics.Components.Chassis body(rover=rover, slope=slope) "Body and limbs";
   RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
