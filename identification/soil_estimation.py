@@ -14,7 +14,7 @@ soils too soft to carry the data's loads (where a trial soil cannot carry a row,
 residual is a large constant). The method is ``dogbox`` (a trust region that fixes the variables
 on a bound): cohesion often ends on its lower bound (1 Pa) on sands, where the reflective ``trf``
 crawled (up to 6000 evaluations against 300). The model is the wheel itself, vectorised over
-the rows: one evaluation of 55 rows takes about 1.5 ms; a fit about 150-300 evaluations.
+the rows: one evaluation of 55 rows takes about 1.8 ms; a fit a median of 250 (benchmarks/bench_soil_estimation.py).
 
 Uncertainty. At the optimum, the Jacobian J of the weighted residuals (central differences),
 the Gauss-Newton covariance s² (JᵀJ)⁻¹ with s² the residual variance (sum of squares / (m - p)),
