@@ -529,8 +529,8 @@ def _check_fit_data(data: TestBedData, wheel: Wheel, plan: ParameterPlan) -> Non
         deep = np.flatnonzero(data.sinkage_m >= wheel.r)
         if deep.size:
             row = int(deep[0])
-            raise ValueError(f"{data.source}: row {row + 1}, column sinkage_m: {data.sinkage_m[row]!r} m: expected "
-                             f"a sinkage below the wheel's radius {wheel.r:g} m")
+            raise ValueError(f"{data.source}: {data.row_name(row)}, column sinkage_m: {float(data.sinkage_m[row])!r} "
+                             f"m: expected a sinkage below the wheel's radius {wheel.r:g} m")
     least = MEASUREMENTS_PER_PARAMETER * len(plan.estimated) + 1
     if data.rows * len(data.channels) < least:
         raise ValueError(f"{data.source}: {data.rows} rows x {len(data.channels)} measured columns = "
