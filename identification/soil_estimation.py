@@ -41,7 +41,7 @@ from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
 from rover_cosim.terramechanics import Soil, Wheel
@@ -405,7 +405,7 @@ class SoilEstimate:
         estimate = self.parameters[name]
         return estimate.low, estimate.high
 
-    def predict(self, load_N: Any, slip: Any, slip_angle_deg: Any = 0.0) -> Prediction:
+    def predict(self, load_N: ArrayLike, slip: ArrayLike, slip_angle_deg: ArrayLike = 0.0) -> Prediction:
         """The estimated soil's wheel at other loads and slips (testbed_data.predict)."""
         return predict(self.soil, self.wheel, load_N, slip, slip_angle_deg)
 

@@ -84,7 +84,7 @@ def estimates_text(estimate: SoilEstimate) -> str:
     for e in estimate.parameters.values():
         scale, unit = (180 / np.pi, "deg") if e.name == "phi" else (1.0, "" if e.unit == "1" else e.unit)
         interval = "not determined" if np.isnan(e.low) else f"[{e.low * scale:.3g}, {e.high * scale:.3g}]"
-        note = {"well": "", "poorly": " poorly"}.get(e.determined, f" {e.determined}")
+        note = {"well": "", "poorly": " poorly"}.get(e.determined, f" {e.determined}") + (" at bound" * e.at_bound)
         lines.append(f"{e.name:<7s} {e.value * scale:<9.4g} {interval}{note}")
     units: dict[str, list[str]] = {}
     for e in estimate.parameters.values():
