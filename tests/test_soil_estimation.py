@@ -245,3 +245,21 @@ def test_data_record_checks_its_own_columns():
         TestBedData(load_N=np.array([100.0, 200.0]), slip=np.array([0.1]), Fx_N=np.array([1.0, 2.0]))
     with pytest.raises(ValueError, match=r"row 2, column slip: -3.0: expected a slip ratio in \[-1, 1\]"):
         TestBedData(load_N=np.array([100.0, 200.0]), slip=np.array([0.1, -3.0]), Fx_N=np.array([1.0, 2.0]))
+
+
+def test_a_failed_figure_leaves_the_previous_results_whole(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    from rover_cosim.jobs import estimate_soil as job
+
+    data = generate_testbed_data(Soil(), loads=(200, 400, 600), slips=(0.0, 0.2, 0.4, 0.7))
+    out = tmp_path / "out"
+    first = job.run_estimate_soil(data, out, parameters=["phi", "kx"])
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert sorted(before) == sorted(job.FILES) and first.estimate.parameters["phi"].determined == "well"
+
+    def broken(estimate: SoilEstimate, title: str) -> None:
+        raise RuntimeError("renderer failed")
+
+    monkeypatch.setattr(job, "residual_figure", broken)
+    with pytest.raises(RuntimeError, match="renderer failed"):
+        job.run_estimate_soil(data, out, parameters=["phi", "kx", "n"])
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
