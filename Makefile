@@ -70,6 +70,10 @@ STUDY ?= lunar_regolith
 MC_RUNS ?=
 MC_WORKERS ?=
 MC_SCHEDULER ?=
+# MC_ADAPT=1 (the default): every sample also runs with the adaptive controller (calibration, soil
+# estimated from the rover's telemetry, model identified again), compared after the calibration;
+# MC_ADAPT= leaves it out (about half the time).
+MC_ADAPT ?= 1
 # The Monte Carlo needs an identified model: made once (identify), not again while it is newer
 # than the wheel FMU (a model of another soil is refused by the command, naming both).
 $(RESULTS)/identification/model.json: fmus/SingleWheel.fmu
@@ -81,7 +85,7 @@ fmus/SingleWheel.fmu:
 montecarlo: $(STAMP) $(RESULTS)/identification/model.json
 	$(VENV)/bin/rover-cosim montecarlo --study $(STUDY) $(if $(MC_RUNS),--runs $(MC_RUNS)) --out $(RESULTS)/montecarlo --fmu-dir fmus \
 		--model $(RESULTS)/identification/model.json $(if $(MC_WORKERS),--workers $(MC_WORKERS)) \
-		$(if $(MC_SCHEDULER),--scheduler $(MC_SCHEDULER))
+		$(if $(MC_SCHEDULER),--scheduler $(MC_SCHEDULER)) $(if $(MC_ADAPT),--adapt)
 
 ## report: results/report.html (figures and tables beside the paper's, provenance)
 report: $(STAMP)

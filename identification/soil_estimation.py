@@ -14,7 +14,7 @@ soils too soft to carry the data's loads (where a trial soil cannot carry a row,
 residual is a large constant). The method is ``dogbox`` (a trust region that fixes the variables
 on a bound): cohesion often ends on its lower bound (1 Pa) on sands, where the reflective ``trf``
 crawled (up to 6000 evaluations against 300). The model is the wheel itself, vectorised over
-the rows: one evaluation of 55 rows takes about 1.5 ms; a fit about 150-300 evaluations.
+the rows: one evaluation of 55 rows takes about 1.8 ms; a fit a median of 250 (benchmarks/bench_soil_estimation.py).
 
 Uncertainty. At the optimum, the Jacobian J of the weighted residuals (central differences),
 the Gauss-Newton covariance s² (JᵀJ)⁻¹ with s² the residual variance (sum of squares / (m - p)),
@@ -41,7 +41,7 @@ from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, stats
 
 from rover_cosim.terramechanics import Soil, Wheel
@@ -405,7 +405,7 @@ class SoilEstimate:
         estimate = self.parameters[name]
         return estimate.low, estimate.high
 
-    def predict(self, load_N: Any, slip: Any, slip_angle_deg: Any = 0.0) -> Prediction:
+    def predict(self, load_N: ArrayLike, slip: ArrayLike, slip_angle_deg: ArrayLike = 0.0) -> Prediction:
         """The estimated soil's wheel at other loads and slips (testbed_data.predict)."""
         return predict(self.soil, self.wheel, load_N, slip, slip_angle_deg)
 
@@ -529,8 +529,8 @@ def _check_fit_data(data: TestBedData, wheel: Wheel, plan: ParameterPlan) -> Non
         deep = np.flatnonzero(data.sinkage_m >= wheel.r)
         if deep.size:
             row = int(deep[0])
-            raise ValueError(f"{data.source}: row {row + 1}, column sinkage_m: {data.sinkage_m[row]!r} m: expected "
-                             f"a sinkage below the wheel's radius {wheel.r:g} m")
+            raise ValueError(f"{data.source}: {data.row_name(row)}, column sinkage_m: {float(data.sinkage_m[row])!r} "
+                             f"m: expected a sinkage below the wheel's radius {wheel.r:g} m")
     least = MEASUREMENTS_PER_PARAMETER * len(plan.estimated) + 1
     if data.rows * len(data.channels) < least:
         raise ValueError(f"{data.source}: {data.rows} rows x {len(data.channels)} measured columns = "

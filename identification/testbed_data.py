@@ -97,6 +97,7 @@ class TestBedData:
         slip_angle_deg: slip angle β [deg], |β| < 90; None: 0 for every row.
         Fy_N: lateral force Fy [N] (the soil's force along the wheel's left), or None.
         source: where the data came from (a file name), for messages.
+        lines: the line of each row in its file (messages name them), or None.
     """
 
     __test__ = False  # not a pytest test class, whatever its name
@@ -109,11 +110,14 @@ class TestBedData:
     slip_angle_deg: FloatArray | None = None
     Fy_N: FloatArray | None = None
     source: str = "data"
+    lines: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            if f.name != "source":
+            if f.name not in ("source", "lines"):
                 object.__setattr__(self, f.name, _array(getattr(self, f.name)))
+        if self.lines is not None and len(self.lines) != len(self.load_N):
+            raise ValueError(f"{self.source}: {len(self.lines)} line numbers for {len(self.load_N)} rows")
         sizes = {name: len(values) for name, values in self.columns().items()}
         if len(set(sizes.values())) > 1:
             raise ValueError(f"{self.source}: columns of different lengths: "
@@ -122,7 +126,11 @@ class TestBedData:
             raise ValueError(f"{self.source}: no data rows")
         if not self.channels:
             raise ValueError(f"{self.source}: no measured column: expected at least one of {', '.join(CHANNELS)}")
-        check_values(self.columns(), source=self.source)
+        check_values(self.columns(), self.lines, self.source)
+
+    def row_name(self, row: int) -> str:
+        """"row 3 (line 5)": how messages name row ``row`` (0-based) of the data."""
+        return _row_name(row, self.lines)
 
     def columns(self) -> dict[str, FloatArray]:
         """The columns present, by name, in the file's order."""
@@ -155,8 +163,9 @@ class TestBedData:
 
     def subset(self, rows: ArrayLike) -> TestBedData:
         """The measurements of ``rows`` (a boolean mask or indices)."""
-        index = np.asarray(rows)
-        return replace(self, **{name: values[index] for name, values in self.columns().items()})
+        index = np.arange(self.rows)[np.asarray(rows)]
+        lines = None if self.lines is None else tuple(self.lines[int(k)] for k in index)
+        return replace(self, lines=lines, **{name: values[index] for name, values in self.columns().items()})
 
     def without(self, *channels: str) -> TestBedData:
         """The same measurements with ``channels`` left out (as if not measured)."""
@@ -233,7 +242,7 @@ def parse_testbed_csv(text: str, source: str = "data") -> TestBedData:
         values[k] = [_number(cell, k, line, name, source) for cell, name in zip(row, names)]
     columns = {name: values[:, j] for j, name in enumerate(names)}
     check_values(columns, lines, source)
-    return TestBedData(**columns, source=source)
+    return TestBedData(**columns, source=source, lines=tuple(lines))
 
 
 def read_testbed_csv(path: str | Path) -> TestBedData:

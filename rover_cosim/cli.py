@@ -244,6 +244,10 @@ def build_parser() -> argparse.ArgumentParser:
     monte.add_argument("--allow-model-mismatch", action="store_true",
                        help="use a model identified on another soil or wheel than the study's nominal ones "
                        "(refused otherwise; recorded)")
+    monte.add_argument("--adapt", action="store_true",
+                       help="also run every sample with the adaptive controller (a calibration phase, the soil "
+                       "estimated from the rover's telemetry, the model identified again on SingleWheel.fmu): the "
+                       "scenario straight_adapted beside straight, compared after the calibration")
     monte.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
 
     soils = commands.add_parser("soils", help="the shipped soils and wheels (for --soil, --wheel), with their sources; "
@@ -738,6 +742,10 @@ def _montecarlo(args: argparse.Namespace) -> int:
             return 2
     try:
         study = load_study(args.study, runs=args.runs, seed=args.seed)
+        study = study.adapted() if args.adapt else study
+        if set(study.scenarios) & {"straight_adapted"} and not study.stop_time > study.calibration.duration:
+            raise StudyError(f"{study.path}: stop_time = {study.stop_time!r} s: an adapted run needs more than its "
+                             f"calibration ({study.calibration.duration!r} s)")
     except StudyError as error:
         print(f"rover-cosim montecarlo: {error}", file=sys.stderr)
         return 2
@@ -763,6 +771,10 @@ def _montecarlo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _percent(share: float | None) -> str:
+    return "-" if share is None else f"{100 * share:.1f} %"
+
+
 def _print_montecarlo(outcome) -> None:  # noqa: ANN001 - MonteCarloResult, imported lazily
     for path, problem in outcome.rejected.items():
         print(f"rover-cosim montecarlo: cache file {path}: {problem}; computed again", file=sys.stderr)
@@ -775,6 +787,11 @@ def _print_montecarlo(outcome) -> None:  # noqa: ANN001 - MonteCarloResult, impo
         print(f"{scenario}: {numbers['completed']} of {numbers['runs']} runs completed; RMS(Fx - Fx_des) <= 1 N on "
               f"every limb in {numbers['meeting_1N_rms']} ({'-' if share is None else f'{100 * share:.1f} %'} of "
               f"the completed); stuck in {numbers['stuck']}")
+        if "adapted_share_meeting_1N_rms_of_completed" in numbers:
+            before = numbers["share_meeting_1N_rms_after_calibration_of_completed"]
+            after = numbers["adapted_share_meeting_1N_rms_of_completed"]
+            print(f"  after the calibration (t >= {numbers['after_calibration_from_s']:g} s), RMS <= 1 N on every "
+                  f"limb: {_percent(before)} with the nominal model, {_percent(after)} adapted")
     ranking = outcome.sensitivity[outcome.sensitivity["output"] == "rms_Fx_max_N"].dropna(subset=["rank"])
     if len(ranking):
         print("Sensitivity of the largest RMS(Fx - Fx_des) (rank correlations: partial, and with the distance "

@@ -141,7 +141,8 @@ def test_the_csv_round_trips(tmp_path: Path):
     back = read_testbed_csv(tmp_path / "d.csv")
     for name, values in data.columns().items():
         np.testing.assert_allclose(back.columns()[name], values, rtol=1e-11)
-    assert back.source == str(tmp_path / "d.csv")
+    assert back.source == str(tmp_path / "d.csv") and back.lines == tuple(range(3, 3 + data.rows))
+    assert back.subset(back.load_N > 200).row_name(0) == f"row 1 (line {3 + data.rows // 2})"
 
 
 @pytest.mark.parametrize(("text", "message"), [
@@ -174,6 +175,8 @@ def test_bad_data_are_named_by_row_and_column(text: str, message: str):
     ("load_N,slip,Fx_N\n100,-1.2,5\n", "row 1 (line 2), column slip: -1.2: expected a slip ratio in [-1, 1]"),
     ("load_N,slip,Fx_N,load_N\n100,0.1,5,100\n", "column load_N appears twice in the header"),
     ("load_N,slip,Fx_N\n100,0.1,5\n200,0.2,7\n", "too few points; expected at least 11"),
+    ("load_N,slip,sinkage_m\n100,0.1,0.01\n# deep\n200,0.1,0.5\n",
+     "row 2 (line 4), column sinkage_m: 0.5 m: expected a sinkage below the wheel's radius 0.355 m"),
     (None, "no such file"),
 ])
 def test_bad_data_on_the_command_line_are_one_line_and_exit_2(content: str | None, message: str, tmp_path: Path,
@@ -242,3 +245,21 @@ def test_data_record_checks_its_own_columns():
         TestBedData(load_N=np.array([100.0, 200.0]), slip=np.array([0.1]), Fx_N=np.array([1.0, 2.0]))
     with pytest.raises(ValueError, match=r"row 2, column slip: -3.0: expected a slip ratio in \[-1, 1\]"):
         TestBedData(load_N=np.array([100.0, 200.0]), slip=np.array([0.1, -3.0]), Fx_N=np.array([1.0, 2.0]))
+
+
+def test_a_failed_figure_leaves_the_previous_results_whole(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    from rover_cosim.jobs import estimate_soil as job
+
+    data = generate_testbed_data(Soil(), loads=(200, 400, 600), slips=(0.0, 0.2, 0.4, 0.7))
+    out = tmp_path / "out"
+    first = job.run_estimate_soil(data, out, parameters=["phi", "kx"])
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert sorted(before) == sorted(job.FILES) and first.estimate.parameters["phi"].determined == "well"
+
+    def broken(estimate: SoilEstimate, title: str) -> None:
+        raise RuntimeError("renderer failed")
+
+    monkeypatch.setattr(job, "residual_figure", broken)
+    with pytest.raises(RuntimeError, match="renderer failed"):
+        job.run_estimate_soil(data, out, parameters=["phi", "kx", "n"])
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before

@@ -5,6 +5,7 @@ against slip with the ±2σ noise band (:func:`residual_figure`). Sized for a sc
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -21,24 +22,32 @@ MARKERS = ("o", "s", "^", "D", "v", "P")
 MOST_LOADS, MOST_ANGLES = 8, len(MARKERS)
 
 
-def groups(values: FloatArray, most: int) -> tuple[FloatArray, NDArray[np.intp]]:
+class Groups(NamedTuple):
+    """Rows grouped by a value: the groups' values, the group of every row, whether they are bins."""
+
+    values: FloatArray
+    of_row: NDArray[np.intp]
+    binned: bool
+
+
+def groups(values: FloatArray, most: int) -> Groups:
     """The distinct values (rounded), or at most ``most`` bins of them (each represented by its
     median), and the group of every row."""
     distinct = np.unique(np.round(values, 6))
     if len(distinct) <= most:
-        return distinct, np.searchsorted(distinct, np.round(values, 6))
+        return Groups(distinct, np.searchsorted(distinct, np.round(values, 6)), False)
     edges = np.quantile(values, np.linspace(0, 1, most + 1))
     index = np.clip(np.searchsorted(edges, values, side="right") - 1, 0, most - 1)
     used = np.unique(index)
     medians = np.array([np.median(values[index == k]) for k in used])
-    return medians, np.searchsorted(used, index)
+    return Groups(medians, np.searchsorted(used, index), True)
 
 
 def _layout(panels: int, height: float) -> tuple[Figure, list[Axes], Axes]:
     """A figure 1024 px wide at 100 dpi with ``panels`` axes in two columns and one more cell
     for the legend and notes."""
     rows = (panels + 2) // 2
-    ratios = [1.0] * (rows - 1) + [0.8 if panels % 2 == 0 else 1.0]
+    ratios = [1.0] * (rows - 1) + [0.7 if panels % 2 == 0 else 1.0]
     figure = Figure(figsize=(10.24, height * sum(ratios) + 0.9), dpi=100)
     grid = figure.add_gridspec(rows, 2, height_ratios=ratios)
     axes = [figure.add_subplot(grid[k // 2, k % 2]) for k in range(panels)]
@@ -47,14 +56,15 @@ def _layout(panels: int, height: float) -> tuple[Figure, list[Axes], Axes]:
     return figure, axes, info
 
 
-def _legend(info: Axes, load_groups: FloatArray, angle_groups: FloatArray, colors: Sequence[Color],
+def _legend(info: Axes, loads: Groups, angles: Groups, colors: Sequence[Color],
             extra: list[tuple[Line2D, str]], lines: bool = True) -> None:
+    """The legend: a colour per load, a marker per slip angle (≈: the median of a bin of them)."""
     handles = [Line2D([], [], color=color, marker="o", ls="-" if lines else "") for color in colors]
-    labels = [f"W = {w:.0f} N" for w in load_groups]
-    if len(angle_groups) > 1:
+    labels = [f"W {'≈' if loads.binned else '='} {w:.0f} N" for w in loads.values]
+    if len(angles.values) > 1:
         handles += [Line2D([], [], color="0.3", marker=MARKERS[k], ls="", mfc="none" if lines else None)
-                    for k in range(len(angle_groups))]
-        labels += [f"β = {b:g}°" for b in angle_groups]
+                    for k in range(len(angles.values))]
+        labels += [f"β {'≈' if angles.binned else '='} {b:.3g}°" for b in angles.values]
     for handle, label in extra:
         handles.append(handle)
         labels.append(label)
@@ -74,7 +84,7 @@ def estimates_text(estimate: SoilEstimate) -> str:
     for e in estimate.parameters.values():
         scale, unit = (180 / np.pi, "deg") if e.name == "phi" else (1.0, "" if e.unit == "1" else e.unit)
         interval = "not determined" if np.isnan(e.low) else f"[{e.low * scale:.3g}, {e.high * scale:.3g}]"
-        note = {"well": "", "poorly": " poorly"}.get(e.determined, f" {e.determined}")
+        note = {"well": "", "poorly": " poorly"}.get(e.determined, f" {e.determined}") + (" at bound" * e.at_bound)
         lines.append(f"{e.name:<7s} {e.value * scale:<9.4g} {interval}{note}")
     units: dict[str, list[str]] = {}
     for e in estimate.parameters.values():
@@ -92,8 +102,8 @@ def fit_figure(estimate: SoilEstimate, title: str) -> Figure:
     their intervals beside the legend."""
     data = estimate.data
     beta = np.zeros(data.rows) if data.slip_angle_deg is None else data.slip_angle_deg
-    loads, load_of = groups(data.load_N, MOST_LOADS)
-    angles, angle_of = groups(beta, MOST_ANGLES)
+    load_groups, angle_groups = groups(data.load_N, MOST_LOADS), groups(beta, MOST_ANGLES)
+    (loads, load_of, _), (angles, angle_of, _) = load_groups, angle_groups
     colors = _colors(len(loads))
     figure, axes, info = _layout(len(data.channels), 3.4)
     curves: dict[tuple[int, int], tuple[FloatArray, dict[str, FloatArray]]] = {}
@@ -112,8 +122,9 @@ def fit_figure(estimate: SoilEstimate, title: str) -> Figure:
         ax.set_xlabel("slip ratio κ [-]")
         ax.set_ylabel(LABELS[name])
         ax.grid(alpha=0.3)
-    _legend(info, loads, angles, colors, [(Line2D([], [], color="0.3", marker="o", mfc="none", ls=""), "measured"),
-                                          (Line2D([], [], color="0.3", ls="-"), "estimated soil")])
+    measured = Line2D([], [], color="0.3", marker="o", mfc="none", ls="")
+    _legend(info, load_groups, angle_groups, colors, [(measured, "measured"),
+                                                      (Line2D([], [], color="0.3", ls="-"), "estimated soil")])
     few = len(loads) + len(angles) <= 10
     info.text(0.45 if few else 1.0, 1.0, estimates_text(estimate), transform=info.transAxes, va="top",
               ha="left" if few else "right", fontsize=8.5, family="monospace")
@@ -126,9 +137,9 @@ def residual_figure(estimate: SoilEstimate, title: str) -> Figure:
     """Residuals (model - data) of each channel against slip, coloured by load, with the band of
     ±2 noise scales (given, or estimated from the residuals)."""
     data = estimate.data
-    loads, load_of = groups(data.load_N, MOST_LOADS)
     beta = np.zeros(data.rows) if data.slip_angle_deg is None else data.slip_angle_deg
-    angles, angle_of = groups(beta, MOST_ANGLES)
+    load_groups, angle_groups = groups(data.load_N, MOST_LOADS), groups(beta, MOST_ANGLES)
+    (loads, load_of, _), (angles, angle_of, _) = load_groups, angle_groups
     colors = _colors(len(loads))
     figure, axes, info = _layout(len(data.channels), 3.0)
     for ax, name in zip(axes, data.channels):
@@ -146,7 +157,8 @@ def residual_figure(estimate: SoilEstimate, title: str) -> Figure:
         ax.set_title(f"RMS {channel.rms:.3g} {unit}; σ = {sigma:.3g} {unit} "
                      f"({'given' if channel.noise_given else 'estimated'})", fontsize=9)
         ax.grid(alpha=0.3)
-    _legend(info, loads, angles, colors, [(Line2D([], [], color="0.85", lw=8), "±2σ (noise scale)")], lines=False)
+    _legend(info, load_groups, angle_groups, colors, [(Line2D([], [], color="0.85", lw=8), "±2σ (noise scale)")],
+            lines=False)
     figure.suptitle(title, fontsize=11)
     figure.tight_layout()
     return figure

@@ -113,3 +113,25 @@ def scatter(runs: pd.DataFrame, parameters: list[str], labels: dict[str, str], n
     finish(axes.ravel()[1:len(parameters)], legend=False)
     fig.suptitle("Worst-limb force error against each uncertain parameter (straight run)")
     return png_bytes(fig)
+
+
+def adaptation(plain: pd.DataFrame, adapted: pd.DataFrame, calibration: float) -> bytes:
+    """ECDFs of the worst-limb RMS(Fx - Fx_des) after the calibration phase, with the controller
+    identified on the nominal soil and with the adaptive one, over the same samples; and the
+    whole-run RMS of both (the calibration's own cost)."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    panels = ((axes[0], "rms_Fx_max_after_calibration_N", f"after the calibration (t ≥ {calibration:g} s)"),
+              (axes[1], "rms_Fx_max_N", "over the whole run (calibration included)"))
+    for ax, column, title in panels:
+        for runs, label in ((plain, "identified on the nominal soil"), (adapted, "adaptive (soil estimated)")):
+            values = runs[column].to_numpy(float)
+            share = float(np.mean(values <= RMS_FLOOR)) if len(values) else float("nan")
+            _ecdf(ax, values, f"{label}: {100 * share:.0f} % ≤ 1 N ({len(values)} runs)")
+        ax.axvline(RMS_FLOOR, color="tab:red", ls=":", lw=1.8, label="paper's floor, 1 N")
+        ax.set_xscale("log")
+        ax.set_xlabel("largest RMS(Fx - Fx_des) of the six limbs [N]")
+        ax.set_ylabel("share of runs ≤ x [-]")
+        ax.set_ylim(0, 1.02)
+        ax.set_title(title, fontsize=11)
+    finish(axes)
+    return png_bytes(fig)

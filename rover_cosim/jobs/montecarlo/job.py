@@ -37,10 +37,10 @@ from rover_cosim.terramechanics.library import Choice, choose, describe
 from .. import path_following
 from . import figures
 from .metrics import RMS_FLOOR
-from .runs import FMUS, RunSpec, cache_key, compute_run, fingerprint, nominal_values, read_cached, split
+from .runs import EXTRA_FMUS, FMUS, RunSpec, cache_key, compute_run, fingerprint, nominal_values, read_cached, split
 from .sampling import sample_table
 from .sensitivity import OUTPUTS, sensitivity
-from .study import Study
+from .study import ADAPTED, Study, StudyError
 
 
 @dataclass
@@ -62,7 +62,7 @@ class MonteCarloResult:
 
 
 def _stop_time(study: Study, scenario: str) -> float:
-    if scenario == "straight":
+    if scenario in ("straight", "straight_adapted"):
         return study.stop_time
     return study.path_stop_time or path_following.stop_time("lane_change")
 
@@ -74,9 +74,9 @@ def _specs(study: Study, samples: pd.DataFrame, fmu_dir: Path, models: ModelSet,
         changes, parameters = split({n: row[n] for n in study.names}, bool(row["nominal"]))
         for scenario in study.scenarios:
             stop = _stop_time(study, scenario)
-            key = cache_key(shared, scenario, stop, changes, parameters)
+            key = cache_key(shared, scenario, stop, changes, parameters, study.calibration)
             specs.append(RunSpec(int(row["sample"]), scenario, str(fmu_dir), models, stop, nominal, changes,
-                                 parameters, str(cache / f"{key[:24]}.csv")))
+                                 parameters, str(cache / f"{key[:24]}.csv"), study.calibration))
     return specs
 
 
@@ -144,8 +144,15 @@ def _quantiles(values: pd.Series) -> dict[str, float | None]:
             for q, p in (("p05", 0.05), ("median", 0.5), ("p95", 0.95))}
 
 
+def _share(ok: pd.DataFrame, column: str) -> float | None:
+    """The share of the completed runs ``ok`` whose ``column`` (an RMS [N]) is at most RMS_FLOOR."""
+    return float((ok[column] <= RMS_FLOOR).sum()) / len(ok) if len(ok) and column in ok else None
+
+
 def _summary_numbers(study: Study, runs: pd.DataFrame) -> dict[str, Any]:
-    """Per scenario: counts, share meeting the 1 N RMS, stuck, quantiles; the nominal run."""
+    """Per scenario: counts, share meeting the 1 N RMS (over the whole run and after the
+    calibration phase), stuck, quantiles; the nominal run. The adapted scenario's shares also
+    stand beside the scenario it adapts, as ``adapted_share_...``."""
     numbers: dict[str, Any] = {}
     for scenario in study.scenarios:
         all_runs = runs[runs["scenario"] == scenario]
@@ -157,9 +164,20 @@ def _summary_numbers(study: Study, runs: pd.DataFrame) -> dict[str, Any]:
             "meeting_1N_rms": meeting,
             "share_meeting_1N_rms_of_completed": meeting / len(ok) if len(ok) else None,
             "share_meeting_1N_rms_of_all": meeting / len(all_runs) if len(all_runs) else None,
+            "share_meeting_1N_rms_after_calibration_of_completed": _share(ok, "rms_Fx_max_after_calibration_N"),
             "stuck": int(ok["stuck"].astype(bool).sum()) if len(ok) else 0,
             "quantiles": {c: _quantiles(ok[c]) for c in OUTPUTS if c in ok},
             "nominal": {c: _plain(v) for c, v in nominal.iloc[0].items()} if len(nominal) else None}
+        if scenario in ADAPTED.values():
+            numbers[scenario]["quantiles"].update({c: _quantiles(ok[c]) for c in ("adapt_wall_s", "switched_at_s")
+                                                   if c in ok})
+    for base, adapted in ADAPTED.items():
+        if base in numbers and adapted in numbers:
+            numbers[base]["adapted_share_meeting_1N_rms_of_completed"] = \
+                numbers[adapted]["share_meeting_1N_rms_after_calibration_of_completed"]
+            numbers[base]["adapted_share_meeting_1N_rms_whole_run_of_completed"] = \
+                numbers[adapted]["share_meeting_1N_rms_of_completed"]
+            numbers[base]["after_calibration_from_s"] = study.calibration.duration
     return numbers
 
 
@@ -225,9 +243,12 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     if not model.is_file():
         raise FileNotFoundError(f"identified model {model} not found (make it with `rover-cosim identify`)")
     for scenario in study.scenarios:
-        if not (fmu_dir / FMUS[scenario]).is_file():
-            raise FileNotFoundError(f"FMU {fmu_dir / FMUS[scenario]} not found (build them with "
-                                    "`rover-cosim build-fmus`)")
+        for name in (FMUS[scenario], *EXTRA_FMUS.get(scenario, ())):
+            if not (fmu_dir / name).is_file():
+                raise FileNotFoundError(f"FMU {fmu_dir / name} not found (build them with `rover-cosim build-fmus`)")
+    if set(study.scenarios) & set(ADAPTED.values()) and not study.stop_time > study.calibration.duration:
+        raise StudyError(f"stop_time = {study.stop_time!r} s: an adapted run needs more than its calibration "
+                         f"({study.calibration.duration!r} s)")
     nominal_choice = choose(study.soil, study.wheel)
     models = ModelSet.read(model)
     identified = identified_on(models, nominal_choice)
@@ -236,8 +257,9 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
                             f"{study.wheel})")
     if samples is None:
         samples = sample_table(study, nominal_values(study, nominal_choice, fmu_dir))
-    hashes = fingerprint({name: file_sha256(fmu_dir / name) for name in sorted(set(FMUS.values()))
-                          if (fmu_dir / name).is_file()}, file_sha256(model), nominal_choice)
+    names = sorted({*FMUS.values(), *(n for extra in EXTRA_FMUS.values() for n in extra)})
+    hashes = fingerprint({name: file_sha256(fmu_dir / name) for name in names if (fmu_dir / name).is_file()},
+                         file_sha256(model), nominal_choice)
     cache = Path(cache_dir) if cache_dir is not None else out / "cache"
     cache.mkdir(parents=True, exist_ok=True)
     remove_partial_files(cache)
@@ -271,6 +293,10 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
              out / "sensitivity.csv": ranking.to_csv(index=False).encode(),
              out / "summary.json": json_bytes(summary)}
     files.update({out / name: png for name, png in _figures(study, straight, ranking).items()})
+    if "straight_adapted" in study.scenarios and len(straight):
+        adapted = runs[(runs["scenario"] == "straight_adapted") & (runs["status"] == "ok")]
+        if len(adapted):
+            files[out / "fig_adaptation.png"] = figures.adaptation(straight, adapted, study.calibration.duration)
     write_all(files, folder=out, stale=("fig_*",))
     return MonteCarloResult(sorted(files), runs, failures, ranking, summary, len(missing),
                             len(specs) - len(missing), rejected)

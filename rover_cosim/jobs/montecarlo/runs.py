@@ -27,6 +27,7 @@ from typing import Any
 import fmpy
 import pandas as pd
 
+from rover_cosim.control.adaptive import Calibration
 from rover_cosim.identification.cache import read_run, write_run
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
@@ -35,16 +36,18 @@ from rover_cosim.orchestrator.model import System
 from rover_cosim.terramechanics.library import DEGREES, Choice, vary
 
 from .. import path_following, simulate
-from .metrics import PATH, STRAIGHT, path_metrics, straight_metrics
+from .metrics import ADAPTED, ESTIMATED, PATH, STRAIGHT, path_metrics, straight_metrics
 from .study import Study, StudyError
 
 #: Bumped when a metric's definition changes: every cached run is then computed again.
-METRICS_VERSION = 1
+METRICS_VERSION = 2
 #: The path scenario of a study: the lane change at 1.0 m/s (the paper's speed).
 PATH_SCENARIO = "lane_change"
 #: The FMU of each scenario (in fmu_dir).
-FMUS = {"straight": "Rover.fmu", "path": "SteerableRover.fmu"}
-COLUMNS = {"straight": [*STRAIGHT, "wall_s"], "path": [*PATH, "wall_s"]}
+FMUS = {"straight": "Rover.fmu", "path": "SteerableRover.fmu", "straight_adapted": "Rover.fmu"}
+#: FMUs a scenario needs besides its plant: the adaptive controller identifies its model again on SingleWheel.fmu.
+EXTRA_FMUS = {"straight_adapted": ("SingleWheel.fmu",)}
+COLUMNS = {"straight": [*STRAIGHT, "wall_s"], "path": [*PATH, "wall_s"], "straight_adapted": [*ADAPTED, "wall_s"]}
 
 
 #: (name, value) pairs of a sample.
@@ -64,6 +67,7 @@ class RunSpec:
     changes: Values                             # the sample's soil.X and wheel.X values (SI, X_deg in degrees)
     parameters: Values                          # the sample's other FMU parameters (rover.M ...)
     target: str                                 # the cache file
+    calibration: Calibration = Calibration()    # the adaptive controller's (and the "after" RMS window)
 
     def choice(self) -> Choice:
         """The sample's soil and wheel (ValueError: one the soil model refuses)."""
@@ -117,11 +121,13 @@ def split(values: dict[str, float], nominal: bool) -> tuple[Values, Values]:
 
 
 def cache_key(fingerprint: dict[str, Any], scenario: str, stop_time: float,
-              changes: Values, parameters: Values) -> str:
+              changes: Values, parameters: Values, calibration: Calibration = Calibration()) -> str:
     """The run's cache key (hex): ``fingerprint`` holds the FMUs', the model's and the nominal soil's."""
     content = {"fingerprint": fingerprint, "scenario": scenario, "fmu": fingerprint["fmus"][FMUS[scenario]],
+               "extra_fmus": [fingerprint["fmus"].get(name) for name in EXTRA_FMUS.get(scenario, ())],
                "stop_time": stop_time, "step": simulate.STEP, "changes": [list(c) for c in changes],
-               "parameters": [list(p) for p in parameters], "metrics_version": METRICS_VERSION}
+               "parameters": [list(p) for p in parameters], "calibration": asdict(calibration),
+               "metrics_version": METRICS_VERSION}
     return hashlib.sha256(json.dumps(content, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -135,6 +141,10 @@ def plant(spec: RunSpec) -> System:
     choice, fmu_dir = spec.choice(), Path(spec.fmu_dir)
     if spec.scenario == "straight":
         system = simulate.monolithic_system(fmu_dir, spec.model, choice)
+    elif spec.scenario == "straight_adapted":
+        system = simulate.adaptive_system(fmu_dir, spec.model, choice, nominal=spec.nominal,
+                                          calibration=spec.calibration,
+                                          cache_dir=Path(spec.target).parent / "adaptation")
     else:
         system = path_following.monolithic_system(fmu_dir, spec.model, PATH_SCENARIO, "inverse", choice)
     builder = SystemBuilder.from_system(system, f"Monte Carlo sample {spec.sample} ({spec.scenario})")
@@ -142,11 +152,26 @@ def plant(spec: RunSpec) -> System:
     return builder.build()
 
 
+def adaptation_metrics(system: System) -> dict[str, float]:
+    """What the adaptive controller of ``system`` (block ``ctrl``) estimated, and when."""
+    block = next(b.block for b in system.blocks if b.name == "ctrl")
+    report = block.report()  # type: ignore[attr-defined]
+    soil = report.get("estimated_soil") or {}
+    values = {"c": soil.get("c"), "phi_deg": math.degrees(soil["phi"]) if "phi" in soil else None,
+              "kphi": soil.get("kphi"), "n": soil.get("n"), "kx": soil.get("kx")}
+    row = {"switched_at_s": report["switched_at_s"], "adapt_wall_s": report["adapt_wall_s"],
+           "estimate_rows": report["samples"], **{f"estimated_{n}": values[n] for n in ESTIMATED}}
+    return {k: float("nan") if v is None else float(v) for k, v in row.items()}
+
+
 def simulate_run(spec: RunSpec) -> dict[str, float | bool]:
     """The run's metrics (raises on a sample the soil library or the FMU refuses)."""
-    outcome = run(plant(spec))
-    if spec.scenario == "straight":
-        row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"))
+    system = plant(spec)
+    outcome = run(system)
+    if spec.scenario in ("straight", "straight_adapted"):
+        row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"), calibration=spec.calibration.duration)
+        if spec.scenario == "straight_adapted":
+            row.update(adaptation_metrics(system))
     else:
         table = path_following.trajectories(outcome.data, cosim=False)
         row = path_metrics(table, path_following.metrics(table, path_following.SCENARIOS[PATH_SCENARIO]))

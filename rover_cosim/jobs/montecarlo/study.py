@@ -4,7 +4,9 @@
     runs = 200                  # samples, the nominal (sample 0) included
     seed = 20251123             # numpy Generator seed: the same seed gives the same samples
     scenarios = ["straight"]    # "straight": the paper's closed loop on Rover.fmu;
-                                # "path": the lane change on SteerableRover.fmu
+                                # "path": the lane change on SteerableRover.fmu;
+                                # "straight_adapted": the straight run with the adaptive controller
+                                # (calibration, soil estimated, model identified again)
     stop_time = 20.0            # s, of the straight run (the paper's 20 s; shorter for quick looks)
     path_stop_time = 35.363     # s, of the path run (default: until the reference reaches the end)
     soil = "paper"              # the nominal soil and wheel: the ones the model was identified on
@@ -16,6 +18,12 @@
     sigma = 0.9
     lower = 100.0               # optional bounds: the distribution truncated to [lower, upper]
     upper = 3000.0
+
+    [calibration]               # optional, of "straight_adapted" (control.adaptive.Calibration)
+    duration = 3.0              # s, the calibration phase (also the start of the "after calibration" RMS)
+    segment = 0.25              # s, each excitation level
+    amplitude = 20.0            # N·m, the excitation torque
+    sinkage_sensor = false      # the rover measures its wheels' sinkage
 
     [correlation]               # optional: the correlation of the parameters' normal scores
     parameters = ["soil.kc", "soil.kphi"]
@@ -31,24 +39,28 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from rover_cosim.control.adaptive import Calibration
 from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import DEGREES
 
-#: Scenarios a study can run: "straight" (paper Sec. 4, Rover.fmu), "path" (lane change, SteerableRover.fmu).
-SCENARIOS = ("straight", "path")
+#: Scenarios a study can run: "straight" (paper Sec. 4, Rover.fmu), "path" (lane change,
+#: SteerableRover.fmu), "straight_adapted" (the straight run with the adaptive controller).
+SCENARIOS = ("straight", "path", "straight_adapted")
+#: The scenario ``--adapt`` adds beside each that has an adaptive variant.
+ADAPTED = {"straight": "straight_adapted"}
 #: Shipped studies (``--study NAME`` or a file).
 STUDIES = Path(__file__).with_name("studies")
 KINDS = {"uniform": ("lower", "upper"), "normal": ("mean", "std"), "lognormal": ("median", "sigma")}
 #: The most runs a study may ask for (a million 20 s runs: ~40 days of one core).
 MAX_RUNS = 1_000_000
 TOP_KEYS = {"title", "source", "runs", "seed", "scenarios", "stop_time", "path_stop_time", "soil", "wheel",
-            "parameters", "correlation"}
+            "parameters", "correlation", "calibration"}
 
 
 class StudyError(ValueError):
@@ -93,17 +105,24 @@ class Study:
     wheel: str = "paper"
     source: str = ""
     path: Path | None = None
+    calibration: Calibration = Calibration()
 
     @property
     def names(self) -> list[str]:
         return [p.name for p in self.parameters]
+
+    def adapted(self) -> Study:
+        """The study with each scenario's adaptive variant beside it (``--adapt``)."""
+        extra = [ADAPTED[s] for s in self.scenarios if s in ADAPTED]
+        return replace(self, scenarios=tuple(dict.fromkeys([*self.scenarios, *extra])))
 
     def settings(self) -> dict[str, Any]:
         """What the study is, as JSON-able values (for summary.json)."""
         return {"title": self.title, "runs": self.runs, "seed": self.seed, "scenarios": list(self.scenarios),
                 "stop_time_s": self.stop_time,
                 "path_stop_time_s": self.path_stop_time, "soil": self.soil, "wheel": self.wheel, "file": str(self.path),
-                "parameters": [vars(p) for p in self.parameters], "correlation": self.correlation.tolist()}
+                "parameters": [vars(p) for p in self.parameters], "correlation": self.correlation.tolist(),
+                "calibration": asdict(self.calibration)}
 
 
 def _number(where: str, key: str, value: Any) -> float:
@@ -185,6 +204,21 @@ def _correlation(where: str, table: Any, names: list[str]) -> np.ndarray:
     return matrix
 
 
+def _calibration(where: str, table: Any) -> Calibration:
+    """The [calibration] table (keys of control.adaptive.Calibration); errors name the key."""
+    names = {f.name for f in fields(Calibration)}
+    if not isinstance(table, dict) or set(table) - names:
+        raise StudyError(f"{where}: calibration = {table!r}: expected a table of {', '.join(sorted(names))}")
+    sensor = table.get("sinkage_sensor", False)
+    if not isinstance(sensor, bool):
+        raise StudyError(f"{where}: calibration.sinkage_sensor = {sensor!r}: expected true or false")
+    numbers = {k: _number(where, f"calibration.{k}", v) for k, v in table.items() if k != "sinkage_sensor"}
+    try:
+        return Calibration(**numbers, sinkage_sensor=sensor)
+    except ValueError as error:
+        raise StudyError(f"{where}: {error}") from None
+
+
 def _top(where: str, data: dict[str, Any]) -> dict[str, Any]:
     unknown = sorted(set(data) - TOP_KEYS)
     if unknown:
@@ -207,7 +241,7 @@ def _top(where: str, data: dict[str, Any]) -> dict[str, Any]:
         if not 0.01 <= path_stop_time <= 600:
             raise StudyError(f"{where}: path_stop_time = {path_stop_time!r} s: expected 0.01 .. 600 s")
     return {"runs": runs, "seed": seed, "scenarios": tuple(dict.fromkeys(scenarios)), "stop_time": stop_time,
-            "path_stop_time": path_stop_time,
+            "path_stop_time": path_stop_time, "calibration": _calibration(where, data.get("calibration", {})),
             "title": str(data.get("title", "")), "source": str(data.get("source", "")),
             "soil": str(data.get("soil", "paper")), "wheel": str(data.get("wheel", "paper"))}
 
