@@ -97,7 +97,8 @@ def lateral_case(truth_name: str, noise: float) -> dict[str, Any]:
     data = generate_testbed_data(truth, wheel, noise=noise, seed=seed, **LATERAL)  # type: ignore[arg-type]
     estimate = estimate_soil(data, wheel, prior_for(truth_name))
     held = generate_testbed_data(truth, wheel, **LATERAL_HELD)  # type: ignore[arg-type]
-    errors = prediction_error(estimate.predict(held.load_N, held.slip, held.slip_angle_deg), held)
+    angles = 0.0 if held.slip_angle_deg is None else held.slip_angle_deg
+    errors = prediction_error(estimate.predict(held.load_N, held.slip, angles), held)
     return {"soil": truth_name, "noise": noise, "rows": data.rows, "seconds": estimate.seconds,
             "parameters": recovered(estimate, truth),
             "kept_at_prior": {k: f.reason for k, f in estimate.fixed.items()},

@@ -160,11 +160,15 @@ def _rolling(table: pd.DataFrame) -> pd.DataFrame:
 
 def fx_per_load(table: pd.DataFrame, degree: int = 1, torque_max: float = FIT_TORQUE_MAX) -> pd.DataFrame:
     """Per load, the polynomial Fx(slip) of ``degree`` through the settled points with torque up
-    to ``torque_max`` [N·m] and slip in SLIP_FIT_RANGE: columns load_N, c0 (= b), c1 (= a), ..."""
+    to ``torque_max`` [N·m] and slip in SLIP_FIT_RANGE: columns load_N, c0 (= b), c1 (= a), ...
+    A fit narrower than the paper's (``torque_max`` < FIT_TORQUE_MAX) whose load has too few such
+    points takes that load's degree + 2 lowest-torque points in the slip range instead."""
     rows = []
     for load, part in _rolling(table).groupby("load_N"):
-        inside = part[(part["slip"] >= SLIP_FIT_RANGE[0]) & (part["slip"] <= SLIP_FIT_RANGE[1])
-                      & (part["torque_N_m"] <= torque_max)]
+        in_range = part[(part["slip"] >= SLIP_FIT_RANGE[0]) & (part["slip"] <= SLIP_FIT_RANGE[1])]
+        inside = in_range[in_range["torque_N_m"] <= torque_max]
+        if len(inside) < degree + 1 and torque_max < FIT_TORQUE_MAX:  # a narrower fit: the lowest torques instead
+            inside = in_range.nsmallest(degree + 2, "torque_N_m")
         if len(inside) < degree + 1:
             raise ValueError(f"load {load} N: {len(inside)} settled points with slip in {SLIP_FIT_RANGE} and torque "
                              f"<= {torque_max} N·m, need {degree + 1} for a degree-{degree} fit")

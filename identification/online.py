@@ -9,10 +9,12 @@ controller's longitudinal model identified again on that soil (issue 33, the onl
    (:class:`~rover_cosim.identification.testbed_data.TestBedData`), so
    :func:`~rover_cosim.identification.soil_estimation.estimate_soil` estimates the soil from them
    (starting from the soil the controller was identified on, the prior);
-2. the paper's identification sweep (step torques on ``SingleWheel.fmu``, the loads and torques of
-   ``SweepPlan``) runs on the estimated soil and the wheel, in this process, with the sweep's
-   cache (a soil estimated again to the same values is not run again), and ``fits.identify``
-   makes the model of the same degree the controller used.
+2. the paper's identification sweep (step torques on ``SingleWheel.fmu``, the torques of
+   ``SweepPlan``, loads over the rover's own range: ``sweep_loads``) runs on the estimated soil
+   and the wheel, in this process, with the sweep's cache (a soil estimated again to the same
+   values is not run again), and ``fits.identify`` makes the model of the same degree the
+   controller used, its Fx fit through the torques the closed loop drives with
+   (``ADAPTED_FIT_TORQUE_MAX``).
 
 What the telemetry cannot give: the drawbar pull of each wheel (a rover measures none), so the
 estimate rests on the torques (and the sinkage with a sensor). Noise-free telemetry determines
@@ -25,6 +27,9 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
 
 from rover_cosim.terramechanics import Soil, Wheel
 
@@ -39,6 +44,15 @@ from .testbed_data import TestBedData
 #: phi 45 deg, k_phi 3e5; c 2.5 kPa, phi 31 deg, k_phi 5e6) with the true soil: the largest
 #: RMS(Fx - Fx_des) after the calibration 2.0 -> 1.0 N and 0.74 -> 0.74 N.
 ADAPTED_FIT_TORQUE_MAX = 20.0
+FloatArray = NDArray[np.float64]
+#: The loads [N] of the sweep identified again: LOAD_POINTS from LOAD_SPAN[0] x the smallest to
+#: LOAD_SPAN[1] x the largest load of the calibration (the rover's own range with a margin for
+#: the loads it meets later), instead of the paper's 100-800 N: the model's load dependence is a
+#: quadratic fitted across the sweep's loads, so a sweep over the loads the rover runs at fits
+#: them closely. Measured with the true soil on a sample of the lunar study (c 839 Pa, phi 31.4
+#: deg, k_phi 4.5e5): the largest RMS(Fx - Fx_des) 4-10 s after the start 2.6 -> 0.64 N.
+LOAD_SPAN = (0.6, 1.5)
+LOAD_POINTS = 7
 
 
 @dataclass(frozen=True)
@@ -67,6 +81,12 @@ class Adaptation:
         return self.estimate.soil
 
 
+def sweep_loads(loads: FloatArray) -> tuple[float, ...]:
+    """The loads [N] of the sweep identified again for a rover that measured ``loads`` [N]."""
+    low, high = LOAD_SPAN[0] * float(np.min(loads)), LOAD_SPAN[1] * float(np.max(loads))
+    return tuple(float(round(w)) for w in np.linspace(max(low, 1.0), max(high, low + LOAD_POINTS), LOAD_POINTS))
+
+
 def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path, degree: int,
                      plan: SweepPlan | None = None) -> tuple[IdentifiedModel, int]:
     """The paper's longitudinal model (LUTs and the Fx fit of ``degree``) identified by the sweep on
@@ -87,6 +107,7 @@ def adapt_model(data: TestBedData, fmu_path: Path, wheel: Wheel, prior: Soil, ca
     started = time.perf_counter()
     estimate = estimate_soil(data, wheel, prior)
     estimated = time.perf_counter()
-    model, computed = identify_on_soil(fmu_path, estimate.soil, wheel, cache_dir, degree)
+    plan = SweepPlan(loads=sweep_loads(data.load_N))
+    model, computed = identify_on_soil(fmu_path, estimate.soil, wheel, cache_dir, degree, plan)
     return Adaptation(estimate, model, len(data.load_N), estimated - started, time.perf_counter() - estimated,
                       computed)
