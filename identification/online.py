@@ -48,11 +48,12 @@ FloatArray = NDArray[np.float64]
 #: The loads [N] of the sweep identified again: LOAD_POINTS from LOAD_SPAN[0] x the smallest to
 #: LOAD_SPAN[1] x the largest load of the calibration (the rover's own range with a margin for
 #: the loads it meets later), instead of the paper's 100-800 N: the model's load dependence is a
-#: quadratic fitted across the sweep's loads, so a sweep over the loads the rover runs at fits
-#: them closely. Measured with the true soil on a sample of the lunar study (c 839 Pa, phi 31.4
-#: deg, k_phi 4.5e5): the largest RMS(Fx - Fx_des) 4-10 s after the start 2.6 -> 0.64 N.
-LOAD_SPAN = (0.6, 1.5)
-LOAD_POINTS = 7
+#: quadratic in W fitted across the sweep's loads, so a sweep over the loads the rover runs at fits
+#: them closely. Measured with the true soil on a soft sample of the lunar study (c 431 Pa, phi
+#: 32.4 deg, k_phi 2.5e5, n 0.89), the largest RMS(Fx - Fx_des) 4-10 s after the start: 3.3 N with
+#: 7 loads over 0.6-1.5x the calibration's, 1.1 N over 0.75-1.3x, 0.3 N with 8 loads over ~0.8-1.2x.
+LOAD_SPAN = (0.8, 1.2)
+LOAD_POINTS = 8
 
 
 @dataclass(frozen=True)

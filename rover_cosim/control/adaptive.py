@@ -17,8 +17,9 @@ Calibration (``Calibration``, documented choices):
   with ``sinkage_sensor``;
 - switch-over: at the first step at or after ``duration`` the block calls its ``adapter`` (the
   estimate and the sweep, :func:`rover_cosim.identification.online.adapt_model`, seconds of wall
-  time while the simulated time waits), replaces the law's model and keeps the filter's state,
-  so the torque is continuous apart from the model's change.
+  time while the simulated time waits), replaces the law's model and starts its slip filter
+  settled at the new model's targets, as the law starts at t = 0 (carrying the old filter's state
+  over gave a 10 ms spike of 40-50 N in Fx - Fx_des: that state belongs to the old model's slips).
 
 A run's record takes ``report()``: what was estimated, from how many samples, when the model
 switched and what it cost.
@@ -162,10 +163,8 @@ class AdaptiveController(InverseModelController):
     def _switch(self, t: float) -> None:
         started = time.perf_counter()
         self.adaptation = self.adapter(self.calibration_data())
-        state = self.inverse.filter_state.copy()
         self.model = self.adaptation.model
         self.inverse = LongitudinalInverse(self.model, WHEELS, self.inverse.wn, self.step_size, self.name)
-        self.inverse.filter_state = state
         self.switched_at, self.adapt_wall_seconds = t, time.perf_counter() - started
 
     def _outputs(self, t: float, u: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
@@ -174,6 +173,7 @@ class AdaptiveController(InverseModelController):
                 self._measure(t, u, step or self.step_size)
                 if t >= self.calibration.duration - 1e-12:
                     self._switch(t)
+                    advance = False  # the new law starts settled at its targets, as the law does at t = 0
             else:
                 omega, pitch, _ = self._telemetry(u)
                 self._previous = (omega, pitch)
