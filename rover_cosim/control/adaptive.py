@@ -40,7 +40,6 @@ from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.identification.online import Adaptation
 from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.orchestrator import native as native_code
-from rover_cosim.terramechanics import Wheel
 
 from .controller import WHEELS, InverseModelController
 from .longitudinal import LongitudinalInverse
@@ -95,16 +94,19 @@ class AdaptiveController(InverseModelController):
     """The paper's controller block (``InverseModelController``) with a calibration phase. Inputs:
     x, v, W[1..6] as the paper's, omega[1..6] (wheel spins [rad/s]) and pitch [rad] (the hubs'
     speed is the body's plus its pitch rate times the lever ``x_limb``, ``h_cog`` [m], the rover's
-    geometry), plus sinkage[1..6] [m] with a sinkage sensor. ``adapter`` turns the calibration
+    geometry), plus sinkage[1..6] [m] with a sinkage sensor. The wheel's ``radius`` [m] gives the
+    slip, its ``inertia`` [kg·m²] the torque the soil takes. ``adapter`` turns the calibration
     data into an :class:`Adaptation`."""
 
     def __init__(self, name: str, model: ModelSet | str, adapter: Callable[[TestBedData], Adaptation],
-                 wheel: Wheel = Wheel(), calibration: Calibration = Calibration(),
+                 radius: float = 0.355, inertia: float = 0.5, calibration: Calibration = Calibration(),
                  x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5), h_cog: float = 1.0, **options: Any):
         super().__init__(name, model, **options)
         if options.get("fixed_load"):
             raise ValueError(f"block {name!r}: fixed_load: the adaptive controller uses the measured loads")
-        self.adapter, self.wheel, self.calibration = adapter, wheel, calibration
+        if not (radius > 0 and inertia > 0):
+            raise ValueError(f"block {name!r}: radius = {radius!r} m, inertia = {inertia!r} kg·m²: expected > 0")
+        self.adapter, self.radius, self.inertia, self.calibration = adapter, float(radius), float(inertia), calibration
         spins = [f"omega[{i}]" for i in range(1, WHEELS + 1)]
         sinkages = [f"sinkage[{i}]" for i in range(1, WHEELS + 1)] if calibration.sinkage_sensor else []
         self.inputs = (*self.inputs, *spins, "pitch", *sinkages)
@@ -144,10 +146,10 @@ class AdaptiveController(InverseModelController):
         # The hubs' speed from the body's speed and pitch rate (an IMU's), as the body model moves them.
         z_hub = self.x_hub * math.sin(pitch) - self.h_cog * math.cos(pitch)
         v_hub = v - (pitch - pitch_before) / h * z_hub
-        r_omega = self.wheel.r * omega
+        r_omega = self.radius * omega
         # Eq. (4): (r omega - v) / max(r omega, v), signed as the FMUs' slip (driving > 0, skidding < 0)
         slip = (r_omega - v_hub) / np.maximum(np.maximum(np.abs(r_omega), np.abs(v_hub)), 1e-9)
-        drive = self.torque - self.wheel.J * (omega - before) / h
+        drive = self.torque - self.inertia * (omega - before) / h
         loads = np.asarray(u[2:2 + WHEELS], float)
         self.samples.append(np.column_stack([np.full(WHEELS, t), loads, slip, drive, sinkage]))
 

@@ -110,8 +110,8 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
 
     builder = _closed_loop("closed loop (adaptive)")
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
-    block = AdaptiveController("ctrl", models, adapter, wheel=nominal.wheel, calibration=calibration,
-                               **{"step": STEP, **options})
+    block = AdaptiveController("ctrl", models, adapter, radius=nominal.wheel.r, inertia=nominal.wheel.J,
+                               calibration=calibration, **{"step": STEP, **options})
     builder.add_block("ctrl", block)
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v").connect("rover.pitch", "ctrl.pitch")
     for i in LIMBS:
