@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import signal
 import sys
@@ -220,6 +221,14 @@ def build_parser() -> argparse.ArgumentParser:
                           help="only the paper's straight run, or only the path following (default: both)")
     simulate.add_argument("--allow-model-mismatch", action="store_true",
                           help="use a model identified on another soil or wheel (refused otherwise; recorded)")
+    simulate.add_argument("--adapt", action="store_true",
+                          help="also run the straight run with the adaptive controller: a calibration phase, the "
+                          "soil estimated from the rover's telemetry, the model identified again on SingleWheel.fmu "
+                          "(implies --allow-model-mismatch: the point is a soil the model was not identified on)")
+    simulate.add_argument("--calibration", type=float, default=3.0, metavar="SECONDS",
+                          help="with --adapt: the calibration phase's length [s] (default 3)")
+    simulate.add_argument("--sinkage-sensor", action="store_true",
+                          help="with --adapt: the rover measures its wheels' sinkage (the estimate uses it)")
     simulate.add_argument("--record-interval", type=float, default=0.01,
                           help="rows kept in the trajectory files [s] (a whole number of 1 ms steps; default 0.01; "
                           "0.001: every step); metrics and figures use every step")
@@ -678,6 +687,7 @@ def _is_fmu(path: Path) -> bool:
 
 def _simulate(args: argparse.Namespace) -> int:
     from rover_cosim.common.rows import steps_between_rows
+    from rover_cosim.control.adaptive import Calibration
     from rover_cosim.jobs.path_following import run_path_following
     from rover_cosim.jobs.simulate import STEP, run_simulation
     from rover_cosim.orchestrator.master import RunError
@@ -695,17 +705,22 @@ def _simulate(args: argparse.Namespace) -> int:
     except ValueError as error:
         print(f"rover-cosim simulate: --record-interval: {error}", file=sys.stderr)
         return 2
+    if args.adapt and not (math.isfinite(args.calibration) and 0 < args.calibration < 20.0):
+        print(f"rover-cosim simulate: --calibration {args.calibration}: expected a length in (0, 20) s, shorter "
+              "than the 20 s run", file=sys.stderr)
+        return 2
     if not _model_readable(args.model, "simulate"):
         return 2
     choice = _choice(args, "simulate")
     if choice is None:
         return 2
     try:
-        allow = args.allow_model_mismatch
+        allow = args.allow_model_mismatch or args.adapt
+        adapt = Calibration(duration=args.calibration, sinkage_sensor=args.sinkage_sensor) if args.adapt else None
         if args.only != "path":
             bar = ProgressBar("simulate: the paper's straight run", enabled=not args.quiet)
             straight = run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow,
-                                      progress=bar, record_interval=args.record_interval)
+                                      progress=bar, record_interval=args.record_interval, adapt=adapt)
             bar.close()
             _print_straight(straight)
         if args.only != "straight":
@@ -831,6 +846,16 @@ def _print_straight(outcome) -> None:  # noqa: ANN001 - SimulationResult, import
                           "RMS, one model at 424 N [N]": outcome.ablation["rms_fixed_load_N"]})
     print("Table 3 (limbs 4-6 mirror 1-3):")
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    adaptation = outcome.record.get("adaptation")
+    if adaptation:
+        soil = adaptation.get("estimated_soil") or {}
+        print(f"Adaptive run: the model switched at {adaptation['switched_at_s']:g} s after "
+              f"{adaptation['samples']} calibration samples ({adaptation['adapt_wall_s']:.1f} s to estimate and "
+              f"identify); estimated c {soil.get('c', float('nan')):.4g} Pa, phi "
+              f"{math.degrees(soil.get('phi', float('nan'))):.3g} deg, k_phi {soil.get('kphi', float('nan')):.4g}, "
+              f"n {soil.get('n', float('nan')):.3g}, k_x {soil.get('kx', float('nan')):.3g} m; largest "
+              f"RMS(Fx - Fx_des) after the calibration {max(adaptation['rms_after_calibration_N']):.3f} N "
+              f"(nominal model: {max(adaptation['rms_after_calibration_nominal_model_N']):.3f} N)")
     for path in outcome.files:
         print(f"wrote {path}")
 

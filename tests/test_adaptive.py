@@ -71,8 +71,7 @@ def adaptive_run(fmu_dir, identified, tmp_path_factory):
         seen["data"] = data
         return online.adapt_model(data, *args)  # type: ignore[arg-type]
 
-    system = simulate.adaptive_system(fmu_dir, model, truth, nominal=nominal,
-                                      calibration=Calibration(duration=1.5, segment=0.25),
+    system = simulate.adaptive_system(fmu_dir, model, truth, calibration=Calibration(duration=1.5, segment=0.25),
                                       cache_dir=tmp_path_factory.mktemp("adapt"))
     system = SystemBuilder.from_system(system, "adaptive, short").simulation(stop_time=2.0).build()
     original, simulate.adapt_model = simulate.adapt_model, spy  # type: ignore[assignment] # the adapter calls it
@@ -155,3 +154,35 @@ def test_sweep_loads_cover_the_rovers_range_with_a_margin():
     assert len(loads) == online.LOAD_POINTS and loads[0] == pytest.approx(0.8 * 360, abs=1)
     assert loads[-1] == pytest.approx(1.2 * 480, abs=1) and all(np.diff(loads) > 0)
     assert Path(online.__file__).name == "online.py"
+
+
+def test_simulate_adapt_records_what_it_estimated_and_when_it_switched(fmu_dir, identified, tmp_path):
+    import subprocess
+    import sys
+
+    out = tmp_path / "simulation"
+    done = subprocess.run([sys.executable, "-P", "-m", "rover_cosim", "simulate", "--only", "straight", "--adapt",
+                           "--calibration", "2", "--soil", "lunar_nominal", "--fmu-dir", str(fmu_dir), "--model",
+                           str(identified.files[0].parent / "model.json"), "--out", str(out), "-q"],
+                          capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "Adaptive run: the model switched at 2 s" in done.stdout
+    record = json.loads((out / "simulation.json").read_text())
+    adaptation = record["adaptation"]
+    truth = library.choose("lunar_nominal").soil
+    assert adaptation["switched_at_s"] == pytest.approx(2.0) and adaptation["calibration"]["duration"] == 2.0
+    assert adaptation["estimated_soil"]["phi"] == pytest.approx(truth.phi, rel=0.01)
+    assert max(adaptation["rms_after_calibration_N"]) < 1.0
+    assert (out / "trajectories_adaptive.csv").stat().st_size > 0 and (out / "rms_adaptive.csv").exists()
+    assert record["model_mismatch"]  # the model's soil is not lunar_nominal, and the record says so
+
+
+def test_simulate_refuses_a_bad_calibration_length(tmp_path):
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-P", "-m", "rover_cosim", "simulate", "--adapt", "--calibration", "25",
+                           "--out", str(tmp_path / "s"), "--model", str(tmp_path / "none.json")],
+                          capture_output=True, text=True, check=False)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "--calibration 25.0: expected a length in (0, 20) s" in done.stderr

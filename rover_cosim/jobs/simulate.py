@@ -89,28 +89,35 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | No
     return builder.build()
 
 
+def identified_on(models: ModelSet) -> tuple[Soil, Wheel]:
+    """The soil and wheel the models were identified on (model.json's record; the paper's where it
+    records none)."""
+    soil, wheel = models.details.get("soil", {}).get("values"), models.details.get("wheel", {}).get("values")
+    return (Soil(**soil) if soil else Soil()), (Wheel(**wheel) if wheel else Wheel())
+
+
 def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, *,
-                    nominal: Choice | None = None, calibration: Calibration = Calibration(),
-                    cache_dir: Path | None = None, **options: Any) -> System:
+                    calibration: Calibration = Calibration(), cache_dir: Path | None = None,
+                    **options: Any) -> System:
     """The closed loop on Rover.fmu (on the soil and wheel of ``choice``) with the adaptive
     controller: a calibration phase, the soil estimated from the rover's telemetry starting from
-    ``nominal``'s soil (default: the paper's; the wheel is ``nominal``'s, the rover's own), the
-    model identified again on SingleWheel.fmu (the sweep's cache in ``cache_dir``; None: a
-    temporary folder), then the paper's law with it."""
-    nominal = nominal or choose()
+    the soil the model was identified on (the wheel is that one too: the rover's own), the model
+    identified again on SingleWheel.fmu (the sweep's cache in ``cache_dir``; None: a temporary
+    folder), then the paper's law with it."""
     models = models_of(model)
+    prior, wheel = identified_on(models)
     degree = models.model().degree
     single_wheel = Path(fmu_dir) / "SingleWheel.fmu"
 
     def adapter(data: TestBedData) -> Adaptation:
         if cache_dir is not None:
-            return adapt_model(data, single_wheel, nominal.wheel, nominal.soil, Path(cache_dir), degree)
+            return adapt_model(data, single_wheel, wheel, prior, Path(cache_dir), degree)
         with tempfile.TemporaryDirectory(prefix="rover-cosim-adapt-") as folder:
-            return adapt_model(data, single_wheel, nominal.wheel, nominal.soil, Path(folder), degree)
+            return adapt_model(data, single_wheel, wheel, prior, Path(folder), degree)
 
     builder = _closed_loop("closed loop (adaptive)")
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
-    block = AdaptiveController("ctrl", models, adapter, radius=nominal.wheel.r, inertia=nominal.wheel.J,
+    block = AdaptiveController("ctrl", models, adapter, radius=wheel.r, inertia=wheel.J,
                                calibration=calibration, **{"step": STEP, **options})
     builder.add_block("ctrl", block)
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v").connect("rover.pitch", "ctrl.pitch")
@@ -184,16 +191,18 @@ def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> 
 
 def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soil | Wheel | None = None, *,
                    allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
-                   record_interval: float = RECORD_INTERVAL) -> SimulationResult:
+                   record_interval: float = RECORD_INTERVAL, adapt: Calibration | None = None) -> SimulationResult:
     """The closed loop on both plants and the ablation; writes every file (all or none). The
     FMUs run on the soil and wheel of ``choice`` (default: the paper's); a model identified on
     another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``; ``progress``
     is told how far the three runs are; the trajectory files keep a row every ``record_interval``
-    [s] (the metrics and figures use every step)."""
+    [s] (the metrics and figures use every step). ``adapt``: also the run with the adaptive
+    controller and that calibration (trajectories_adaptive.csv, rms_adaptive.csv, and what it
+    estimated and when it switched in simulation.json's ``adaptation``)."""
     started = time.perf_counter()
     choice = as_choice(choice)
     steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
-    stages = Stages(progress, 3)
+    stages = Stages(progress, 4 if adapt else 3)
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
     walls: dict[str, float] = {}
@@ -209,6 +218,19 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
         results[plant] = checks(tables[plant])
     ablation = rms(trajectories(run(monolithic_system(fmu_dir, models, choice, fixed_load=STATIC_LOAD),
                                     progress=stages.stage(2)).data, "monolithic"))
+    adaptation = None
+    if adapt is not None:
+        system = adaptive_system(fmu_dir, models, choice, calibration=adapt)
+        systems["adaptive"] = system_record(system)
+        outcome = run(system, progress=stages.stage(3))
+        tables["adaptive"] = trajectories(outcome.data, "monolithic")
+        walls["adaptive"] = outcome.wall_seconds
+        results["adaptive"] = checks(tables["adaptive"])
+        block = next(b.block for b in system.blocks if b.name == "ctrl")
+        after = tables["adaptive"][tables["adaptive"]["time"] >= adapt.duration]
+        adaptation = {**block.report(), "rms_after_calibration_N": rms(after)["rms_N"].tolist(),  # type: ignore[attr-defined]
+                      "rms_after_calibration_nominal_model_N":
+                          rms(tables["monolithic"][tables["monolithic"]["time"] >= adapt.duration])["rms_N"].tolist()}
     rms_mono, rms_cosim = rms(tables["monolithic"]), rms(tables["cosim"])
     ablation_table = pd.DataFrame({"limb": list(LIMBS), "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})
@@ -221,6 +243,8 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
                    "wall_seconds": time.perf_counter() - started, "checks": results,
                    "rms_N": {"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
                              "fixed_load_ablation": ablation["rms_N"].tolist()}})
+    if adaptation is not None:
+        record["adaptation"] = adaptation
     out = Path(out_dir)
     files = {
         out / "trajectories.csv": every(tables["monolithic"], record_interval, STEP).to_csv(
@@ -235,6 +259,11 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
         out / "fig_tracking.png": tracking(tables["monolithic"], tables["cosim"]),
         out / "simulation.json": json_bytes(record),
     }
-    write_all(files, folder=out, stale=("fig10_*", "fig_tracking.*"))  # path following's files stay
+    if adapt is not None:
+        files[out / "trajectories_adaptive.csv"] = every(tables["adaptive"], record_interval, STEP).to_csv(
+            index=False, float_format="%.8g").encode()
+        files[out / "rms_adaptive.csv"] = rms(tables["adaptive"]).to_csv(index=False, float_format="%.4f").encode()
+        files[out / "fig10_closed_loop_adaptive.png"] = fig10(tables["adaptive"], "Rover.fmu, adaptive controller")
+    write_all(files, folder=out, stale=("fig10_*", "fig_tracking.*", "*_adaptive.*"))  # path following's stay
     return SimulationResult(sorted(files), record, tables, {"monolithic": rms_mono, "cosim": rms_cosim},
                             ablation_table)

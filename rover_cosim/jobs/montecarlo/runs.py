@@ -142,8 +142,7 @@ def plant(spec: RunSpec) -> System:
     if spec.scenario == "straight":
         system = simulate.monolithic_system(fmu_dir, spec.model, choice)
     elif spec.scenario == "straight_adapted":
-        system = simulate.adaptive_system(fmu_dir, spec.model, choice, nominal=spec.nominal,
-                                          calibration=spec.calibration,
+        system = simulate.adaptive_system(fmu_dir, spec.model, choice, calibration=spec.calibration,
                                           cache_dir=Path(spec.target).parent / "adaptation")
     else:
         system = path_following.monolithic_system(fmu_dir, spec.model, PATH_SCENARIO, "inverse", choice)
