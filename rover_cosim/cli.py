@@ -352,10 +352,13 @@ def _fraction(text: str) -> float:
     return value
 
 
-def _add_soil_estimation_commands(commands: Any) -> None:
-    """estimate-soil and testbed-data (issue 33)."""
-    from rover_cosim.identification.testbed_data import CHANNELS
+#: The measured channels of single-wheel data (identification.testbed_data.CHANNELS).
+CHANNEL_NAMES = ("Fx_N", "Tx_Nm", "sinkage_m", "Fy_N")
 
+
+def _add_soil_estimation_commands(commands: Any) -> None:
+    """estimate-soil and testbed-data (issue 33); the channels are named here without importing the
+    estimator (it imports SciPy: seconds before --help; tests/test_soil_estimation.py keeps them equal)."""
     est = commands.add_parser("estimate-soil", help="soil parameters (c, phi, kphi, n, kx, ...) estimated from "
                               "single-wheel test-bed data (CSV) -> soil.toml, estimate.json, figures")
     est.add_argument("data", type=_path, help="CSV file: columns load_N, slip, any of Fx_N, Tx_Nm, sinkage_m, Fy_N "
@@ -388,8 +391,8 @@ def _add_soil_estimation_commands(commands: Any) -> None:
                      metavar="DEGREES", help="comma-separated slip angles [deg]; any other than 0 adds Fy_N "
                      "(default: 0)")
     gen.add_argument("--channels", type=lambda text: tuple(p.strip() for p in text.split(",")), default=None,
-                     help=f"measured columns, of {', '.join(CHANNELS)} (default: Fx_N, Tx_Nm, sinkage_m, and Fy_N "
-                     "at slip angles other than 0)")
+                     help=f"measured columns, of {', '.join(CHANNEL_NAMES)} (default: Fx_N, Tx_Nm, sinkage_m, and "
+                     "Fy_N at slip angles other than 0)")
     gen.add_argument("--sinkage", action=argparse.BooleanOptionalAction, default=True,
                      help="write the sinkage_m column (--no-sinkage: a test bed without a sinkage sensor)")
     gen.add_argument("--noise", type=_fraction, default=0.0,

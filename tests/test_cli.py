@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from typing import Any
 
 import pytest
@@ -267,3 +269,15 @@ def test_a_monte_carlo_of_absurdly_many_runs_is_refused_naming_the_limit(tmp_pat
     assert main(["montecarlo", "--runs", str(10**30), "--out", str(tmp_path / "mc")]) == 2
     assert f"runs = {10**30}: expected a whole number from 1 (the nominal included) to 1,000,000" in \
         capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["--version"], ["estimate-soil", "--help"], ["montecarlo", "--help"]])
+def test_help_and_version_import_no_numerical_library(argv):
+    """`rover-cosim --help` answers at once: the parser imports none of NumPy, SciPy, pandas, FMPy,
+    matplotlib or CasADi (each command imports what it needs when it runs)."""
+    script = ("import sys\nfrom rover_cosim.cli import main\n"
+              "try:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
+              "heavy = [m for m in ('numpy', 'scipy', 'pandas', 'fmpy', 'matplotlib', 'casadi') if m in sys.modules]\n"
+              "print('HEAVY', heavy, file=sys.stderr)\n")
+    done = subprocess.run([sys.executable, "-P", "-c", script, *argv], capture_output=True, text=True, check=False)
+    assert "HEAVY []" in done.stderr, done.stderr[-2000:]

@@ -263,3 +263,10 @@ def test_a_failed_figure_leaves_the_previous_results_whole(tmp_path: Path, monke
     with pytest.raises(RuntimeError, match="renderer failed"):
         job.run_estimate_soil(data, out, parameters=["phi", "kx", "n"])
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
+def test_the_command_lines_channel_names_are_the_readers():
+    from rover_cosim.cli import CHANNEL_NAMES
+    from rover_cosim.identification.testbed_data import CHANNELS
+
+    assert CHANNEL_NAMES == tuple(CHANNELS)
