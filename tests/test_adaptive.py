@@ -25,7 +25,7 @@ from rover_cosim.terramechanics import library
 TRUTH = {"c": 430.0, "phi_deg": 32.4, "kphi": 2.5e5, "n": 0.9, "kx": 0.029}
 
 
-def test_the_excitation_is_zero_sum_per_side_and_ends_with_the_calibration():
+def test_the_excitation_is_zero_sum_per_side_and_drives_and_brakes_every_wheel():
     calibration = Calibration(duration=3.0, segment=0.25, amplitude=20.0)
     levels = set()
     for t in np.arange(0.0, 3.0, 0.05):
@@ -33,7 +33,6 @@ def test_the_excitation_is_zero_sum_per_side_and_ends_with_the_calibration():
         assert torques[:3].sum() == pytest.approx(0.0) and torques[3:].sum() == pytest.approx(0.0)
         levels |= set(np.round(torques, 9).tolist())
     assert levels == {-20.0, -10.0, 0.0, 10.0, 20.0}  # full and half amplitude, driving and braking
-    assert not calibration.excitation(3.0).any() and not calibration.excitation(19.0).any()
     # every wheel drives and brakes during the phase
     per_wheel = np.array([calibration.excitation(float(t)) for t in np.arange(0.0, 3.0, 0.25)])
     assert (per_wheel.max(axis=0) > 0).all() and (per_wheel.min(axis=0) < 0).all()
@@ -147,6 +146,29 @@ def test_an_adapted_run_shorter_than_its_calibration_is_refused(fmu_dir, identif
     with pytest.raises(StudyError, match="needs more than its calibration"):
         run_montecarlo(study.adapted(), fmu_dir, identified.files[0].parent / "model.json", tmp_path / "mc")
     assert not (tmp_path / "mc" / "summary.json").exists()
+
+
+def test_a_rover_that_crawls_calibrates_longer_then_keeps_its_model_and_says_why(identified):
+    from rover_cosim.control.adaptive import LONGEST, AdaptiveController
+
+    def adapter(data: TestBedData) -> online.Adaptation:
+        raise AssertionError("no adaptation without samples")
+
+    block = AdaptiveController("ctrl", identified.files[0].parent / "model.json", adapter,
+                               calibration=Calibration(duration=0.5, segment=0.1), step=1e-3)
+    model = block.model
+    u = np.concatenate([[0.0, 0.01], np.full(6, 424.0), np.full(6, 0.01 / 0.355), [0.0]])  # 1 cm/s
+    block.start(0.0, u)
+    t, h = 0.0, 1e-3
+    while t < LONGEST * 0.5 + 0.01:
+        out = block.step(t, h, u)
+        t += h
+        if t < 0.5:
+            assert abs(out[:3].sum() - block.torque[:3].sum()) < 1e-9 and np.ptp(out[:3]) > 0  # excited
+    assert block.calibrated_until == pytest.approx(LONGEST * 0.5, abs=2e-3) and block.switched_at is None
+    assert block.model is model and "the nominal model is kept" in block.report()["not_adapted"]
+    later = block.step(t, h, u)
+    assert np.ptp(later[:3]) == pytest.approx(0.0, abs=1e-9)  # the excitation has stopped
 
 
 def test_sweep_loads_cover_the_rovers_range_with_a_margin():

@@ -15,6 +15,9 @@ Calibration (``Calibration``, documented choices):
   milliseconds): load W [N] (the body model's, as the law itself uses), slip ratio (Eq. 4) from
   the wheel's spin and the body's speed, torque Tx = tau - J domega/dt [N·m], and sinkage [m] only
   with ``sinkage_sensor``;
+- a rover still crawling at the end (slower than MIN_SPEED, no sample: a very soft soil) calibrates
+  on until it has ENOUGH_LEVELS levels, at most LONGEST x ``duration``; with fewer than
+  FEWEST_LEVELS it keeps the nominal model, and its record says so;
 - switch-over: at the first step at or after ``duration`` the block calls its ``adapter`` (the
   estimate and the sweep, :func:`rover_cosim.identification.online.adapt_model`, seconds of wall
   time while the simulated time waits), replaces the law's model and starts its slip filter
@@ -46,6 +49,12 @@ from .longitudinal import LongitudinalInverse
 
 #: m/s: below this body speed no sample is kept (the slip ratio is ill-conditioned near rest).
 MIN_SPEED = 0.05
+#: Levels of samples the estimate wants: a rover still slower than MIN_SPEED at the phase's end
+#: (a very soft soil) keeps calibrating until it has them, up to LONGEST x the phase's duration;
+#: with fewer than FEWEST levels then it keeps the nominal model and its record says why.
+ENOUGH_LEVELS = 4
+FEWEST_LEVELS = 2
+LONGEST = 3.0
 #: Each side's excitation levels in turn: every order of (+1, 0, -1).
 ORDERS = tuple(itertools.permutations((1.0, 0.0, -1.0)))
 
@@ -80,10 +89,8 @@ class Calibration:
         return int(math.floor(t / self.segment + 1e-9))
 
     def excitation(self, t: float) -> np.ndarray:
-        """The torques [N·m] added to the law's at time ``t`` [s]: zero after the phase, and
-        zero-sum on each side during it."""
-        if t >= self.duration:
-            return np.zeros(WHEELS)
+        """The torques [N·m] added to the law's at time ``t`` [s] while the phase lasts: zero-sum
+        on each side."""
         k = self.segment_index(t)
         scale = self.amplitude * (1.0 if (k // len(ORDERS)) % 2 == 0 else 0.5)
         left, right = ORDERS[k % len(ORDERS)], ORDERS[(k + 3) % len(ORDERS)]
@@ -118,7 +125,9 @@ class AdaptiveController(InverseModelController):
         self.h_cog = float(h_cog)
         self.samples: list[np.ndarray] = []     # per level, a row per wheel: t, W, slip, Tx, sinkage (NaN: no sensor)
         self.adaptation: Adaptation | None = None
-        self.switched_at: float | None = None
+        self.calibrated_until: float | None = None  # s, when the phase ended (None: still calibrating)
+        self.switched_at: float | None = None       # s, when the model switched (None: not (yet) adapted)
+        self.not_adapted: str | None = None         # why the phase ended without an adaptation
         self.adapt_wall_seconds: float | None = None
         self._previous: tuple[np.ndarray, float] = (np.zeros(WHEELS), 0.0)  # spins, pitch at the last call
 
@@ -140,8 +149,9 @@ class AdaptiveController(InverseModelController):
         (before, pitch_before), self._previous = self._previous, (omega, pitch)
         level = self.calibration.segment_index(t)
         v = float(u[1])
+        ends_phase = t < self.calibration.duration <= t + h  # the last step of the planned phase
         if self.calibration.segment_index(t - h) != level or v < MIN_SPEED \
-                or (self.calibration.segment_index(t + h) == level and t + h < self.calibration.duration):
+                or (self.calibration.segment_index(t + h) == level and not ends_phase):
             return
         # The hubs' speed from the body's speed and pitch rate (an IMU's), as the body model moves them.
         z_hub = self.x_hub * math.sin(pitch) - self.h_cog * math.cos(pitch)
@@ -162,25 +172,35 @@ class AdaptiveController(InverseModelController):
                            sinkage_m=rows[:, 4] if self.calibration.sinkage_sensor else None,
                            source=f"calibration of block {self.name!r}")
 
-    def _switch(self, t: float) -> None:
+    def _end_phase(self, t: float) -> bool:
+        """Whether the calibration ends at ``t`` [s], and if so: the adaptation done (or why not)."""
+        levels = len(self.samples)
+        longest = LONGEST * self.calibration.duration
+        if t < self.calibration.duration - 1e-12 or (levels < ENOUGH_LEVELS and t < longest - 1e-12):
+            return False
+        self.calibrated_until = t
+        if levels < FEWEST_LEVELS:
+            self.not_adapted = (f"{levels} levels sampled by t = {t:g} s (the rover stayed below {MIN_SPEED} m/s): "
+                                "the nominal model is kept")
+            return True
         started = time.perf_counter()
         self.adaptation = self.adapter(self.calibration_data())
         self.model = self.adaptation.model
         self.inverse = LongitudinalInverse(self.model, WHEELS, self.inverse.wn, self.step_size, self.name)
         self.switched_at, self.adapt_wall_seconds = t, time.perf_counter() - started
+        return True
 
     def _outputs(self, t: float, u: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
-        if self.switched_at is None:
+        if self.calibrated_until is None:
             if advance:
                 self._measure(t, u, step or self.step_size)
-                if t >= self.calibration.duration - 1e-12:
-                    self._switch(t)
-                    advance = False  # the new law starts settled at its targets, as the law does at t = 0
+                if self._end_phase(t):
+                    advance = False  # the law (re)starts settled at its targets, as it does at t = 0
             else:
                 omega, pitch, _ = self._telemetry(u)
                 self._previous = (omega, pitch)
         out = super()._outputs(t, u, advance, step)
-        if self.switched_at is None:
+        if self.calibrated_until is None:
             self.torque = self.torque + self.calibration.excitation(t)
             out[:WHEELS] = self.torque
         return out
@@ -198,7 +218,8 @@ class AdaptiveController(InverseModelController):
     def report(self) -> dict[str, Any]:
         """What the adaptation did, for the run's record."""
         record: dict[str, Any] = {"calibration": asdict(self.calibration), "samples": sum(len(s) for s in self.samples),
-                                  "switched_at_s": self.switched_at, "adapt_wall_s": self.adapt_wall_seconds}
+                                  "calibrated_until_s": self.calibrated_until, "switched_at_s": self.switched_at,
+                                  "adapt_wall_s": self.adapt_wall_seconds, "not_adapted": self.not_adapted}
         if self.adaptation is not None:
             estimate = self.adaptation.estimate
             record.update({"estimated_soil": asdict(estimate.soil), "estimate": estimate.to_dict(),
