@@ -5,7 +5,8 @@ Straight run (the paper's loop; columns of simulate.trajectories):
   rms_Fx_max_N         the largest of the six [N]; the paper's floor is 1 N
   rms_Fx_max_after_calibration_N
                        the same over the run after the calibration phase (t >= its duration, the
-                       study's calibration, also for runs without adaptation: the same window) [N]
+                       study's calibration, also for runs without adaptation; an adapted run's own
+                       phase, which lasts longer on a rover that crawls: see control.adaptive) [N]
   time_to_98_s         first time v >= 0.98 m/s [s]; NaN if never (with the controller's
                        a_max = 0.1 m/s² the rover needs about 10 s: a shorter run never gets there)
   steady_v_error_m_s   mean of v - v_t over the final quarter of the run [m/s] (the final 5 s of

@@ -168,7 +168,11 @@ def simulate_run(spec: RunSpec) -> dict[str, float | bool]:
     system = plant(spec)
     outcome = run(system)
     if spec.scenario in ("straight", "straight_adapted"):
-        row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"), calibration=spec.calibration.duration)
+        window = spec.calibration.duration
+        if spec.scenario == "straight_adapted":  # after its own calibration, longer on a rover that crawls
+            block = next(b.block for b in system.blocks if b.name == "ctrl")
+            window = block.calibrated_until or window  # type: ignore[attr-defined]
+        row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"), calibration=window)
         if spec.scenario == "straight_adapted":
             row.update(adaptation_metrics(system))
     else:
