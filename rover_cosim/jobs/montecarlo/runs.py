@@ -40,7 +40,7 @@ from .metrics import ADAPTED, ESTIMATED, PATH, STRAIGHT, path_metrics, straight_
 from .study import Study, StudyError
 
 #: Bumped when a metric's definition changes: every cached run is then computed again.
-METRICS_VERSION = 2
+METRICS_VERSION = 3
 #: The path scenario of a study: the lane change at 1.0 m/s (the paper's speed).
 PATH_SCENARIO = "lane_change"
 #: The FMU of each scenario (in fmu_dir).
