@@ -61,6 +61,10 @@ def simulated(fmu_dir: Path, identified: IdentificationResult, results_root: Pat
 #: through another fixture, belongs to the full tier only.
 FMU_FIXTURES = {"fmus", "fmu_dir", "identified", "simulated", "typed"}
 
+#: Fixtures that run the pipeline (identification, then the closed loop): ``-m pipeline`` selects
+#: the tests of the pipeline's results, ``-m "fmu and not pipeline"`` the FMU tests without them.
+PIPELINE_FIXTURES = {"identified", "simulated"}
+
 #: Modules that build FMUs, translate the Modelica library or run whole commands of their own (C test
 #: FMUs, zig cross-builds, rumoca, killed processes) without those fixtures.
 FULL_TIER_MODULES = {"test_platforms", "test_killed_commands", "test_fmi_kinds", "test_ssp_foreign",
@@ -73,5 +77,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     (``-m "not fmu and not slow"``) runs the rest in seconds; ``make test`` runs every test."""
     for item in items:
         module = getattr(getattr(item, "module", None), "__name__", "")
-        if FMU_FIXTURES & set(getattr(item, "fixturenames", ())) or module in FULL_TIER_MODULES:
+        fixtures = set(getattr(item, "fixturenames", ()))
+        if FMU_FIXTURES & fixtures or module in FULL_TIER_MODULES:
             item.add_marker(pytest.mark.fmu)
+        if PIPELINE_FIXTURES & fixtures:
+            item.add_marker(pytest.mark.pipeline)
