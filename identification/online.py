@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 from rover_cosim.terramechanics import Soil, Wheel
 
 from .fits import IdentifiedModel, identify, step_table
+from .lateral import LATERAL_SAMPLE_TIME, LATERAL_SLIP_ANGLES_DEG, LateralModel, identify_lateral, lateral_table
 from .soil_estimation import SoilEstimate, estimate_soil
 from .sweep import SweepPlan, run_sweep
 from .testbed_data import TestBedData
@@ -67,6 +68,7 @@ class Adaptation:
         estimate_seconds: wall time of the estimate [s].
         identify_seconds: wall time of the sweep and fits [s].
         runs_computed: sweep runs computed (the others came from the cache).
+        lateral: the lateral model identified on the estimated soil (None: not asked for).
     """
 
     estimate: SoilEstimate
@@ -75,6 +77,7 @@ class Adaptation:
     estimate_seconds: float
     identify_seconds: float
     runs_computed: int
+    lateral: LateralModel | None = None
 
     @property
     def soil(self) -> Soil:
@@ -101,14 +104,33 @@ def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path, 
     return identify(step_table(sweep.at_slip_angle(0.0)), degree, ADAPTED_FIT_TORQUE_MAX), sweep.computed
 
 
+def identify_lateral_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path,
+                             loads: tuple[float, ...]) -> tuple[LateralModel, int]:
+    """The lateral model (the recommended form) identified by the lateral sweep on ``fmu_path``
+    with ``soil`` and ``wheel`` at ``loads`` [N]; (the model, the runs computed)."""
+    plan = SweepPlan(loads=loads, slip_angles_deg=LATERAL_SLIP_ANGLES_DEG, sample_time=LATERAL_SAMPLE_TIME,
+                     soil=soil, wheel=wheel)
+    sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=1)
+    if not sweep.runs:
+        raise RuntimeError(f"every run of the lateral sweep on the estimated soil failed; first error: "
+                           f"{next(iter(sweep.failures.values()))}")
+    return identify_lateral(lateral_table(sweep.runs)), sweep.computed
+
+
 def adapt_model(data: TestBedData, fmu_path: Path, wheel: Wheel, prior: Soil, cache_dir: Path,
-                degree: int) -> Adaptation:
+                degree: int, lateral: bool = False) -> Adaptation:
     """The soil estimated from ``data`` (from ``prior``), and the longitudinal model of ``degree``
-    identified on it with ``fmu_path`` (SingleWheel.fmu); see the module docstring."""
+    identified on it with ``fmu_path`` (SingleWheel.fmu); with ``lateral``, the lateral model too
+    (the soil's lateral moduli, which torques do not show, kept at the prior's); see the module
+    docstring."""
     started = time.perf_counter()
     estimate = estimate_soil(data, wheel, prior)
     estimated = time.perf_counter()
-    plan = SweepPlan(loads=sweep_loads(data.load_N))
-    model, computed = identify_on_soil(fmu_path, estimate.soil, wheel, cache_dir, degree, plan)
+    loads = sweep_loads(data.load_N)
+    model, computed = identify_on_soil(fmu_path, estimate.soil, wheel, cache_dir, degree, SweepPlan(loads=loads))
+    lateral_model = None
+    if lateral:
+        lateral_model, more = identify_lateral_on_soil(fmu_path, estimate.soil, wheel, cache_dir, loads)
+        computed += more
     return Adaptation(estimate, model, len(data.load_N), estimated - started, time.perf_counter() - estimated,
-                      computed)
+                      computed, lateral_model)

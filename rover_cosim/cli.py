@@ -761,9 +761,7 @@ def _montecarlo(args: argparse.Namespace) -> int:
     try:
         study = load_study(args.study, runs=args.runs, seed=args.seed)
         study = study.adapted() if args.adapt else study
-        if set(study.scenarios) & {"straight_adapted"} and not study.stop_time > study.calibration.duration:
-            raise StudyError(f"{study.path}: stop_time = {study.stop_time!r} s: an adapted run needs more than its "
-                             f"calibration ({study.calibration.duration!r} s)")
+        study.check_calibration()
     except StudyError as error:
         print(f"rover-cosim montecarlo: {error}", file=sys.stderr)
         return 2

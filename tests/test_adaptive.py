@@ -208,3 +208,24 @@ def test_simulate_refuses_a_bad_calibration_length(tmp_path):
                           capture_output=True, text=True, check=False)
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "--calibration 25.0: expected a length in (0, 20) s" in done.stderr
+
+
+def test_the_path_controller_learns_the_soil_on_the_first_straight(fmu_dir, identified, tmp_path):
+    from rover_cosim.jobs import path_following
+
+    truth = library.vary(library.choose(), TRUTH, {})
+    system = path_following.adaptive_system(fmu_dir, identified.files[0].parent / "model.json", "lane_change", truth,
+                                            calibration=Calibration(duration=1.5), cache_dir=tmp_path, straight=3.0)
+    system = SystemBuilder.from_system(system, "adaptive path, short").simulation(stop_time=2.0).build()
+    outcome = run(system)
+    block = next(b.block for b in system.blocks if b.name == "ctrl")
+    report = block.report()
+    assert report["switched_at_s"] == pytest.approx(1.5) and report["lateral_identified_again"]
+    assert report["estimated_soil"]["phi"] == pytest.approx(truth.soil.phi, rel=0.02)
+    data = outcome.data.set_index("time")
+    for k, (t, load, slip, torque, _sinkage) in enumerate(np.vstack(block.samples)):
+        near = data.index[np.argmin(np.abs(data.index - t))]
+        i = k % 6 + 1  # the hubs' speeds from the body's velocity, attitude rates and the steering
+        assert load == pytest.approx(data.loc[near, f"rover.Fz[{i}]"], abs=1e-9)
+        assert slip == pytest.approx(data.loc[near, f"rover.slip[{i}]"], abs=2e-5)
+        assert torque == pytest.approx(data.loc[near, f"rover.Tx[{i}]"], abs=0.05)

@@ -38,6 +38,7 @@ import pandas as pd
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.rows import every, steps_between_rows
 from rover_cosim.control import path_figures
+from rover_cosim.control.adaptive import AdaptivePathController, Calibration
 from rover_cosim.control.path import Path as ReferencePath
 from rover_cosim.control.path_controller import PATHS, PathFollowingController
 from rover_cosim.identification.model_set import ModelSet
@@ -50,7 +51,7 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover
-from .simulate import RECORD_INTERVAL, checked_models, models_of
+from .simulate import RECORD_INTERVAL, adapter_for, checked_models, identified_on, models_of
 
 STEP = 1e-3  # s
 WHEELS = range(1, 7)
@@ -119,6 +120,33 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, stee
     _connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
     for i in WHEELS:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
+    return builder.build()
+
+
+def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: Choice | None = None, *,
+                    calibration: Calibration = Calibration(), cache_dir: Path | None = None,
+                    straight: float = STRAIGHT) -> System:
+    """``scenario`` on SteerableRover.fmu with the adaptive path controller: a calibration on the
+    path's first straight, the soil estimated from the rover's telemetry (wheel spins and torques,
+    loads, the body's velocity and attitude), both models identified again on the estimated soil
+    (its lateral moduli kept nominal: a rover measures no lateral force), then the path law."""
+    models = models_of(model)
+    wheel = identified_on(models)[1]
+    speed = SCENARIOS[scenario]
+    builder = _path_run(f"path {scenario} (adaptive)", scenario, straight)
+    start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
+    add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
+    block = AdaptivePathController("ctrl", models, adapter_for(models, fmu_dir, cache_dir, lateral=True),
+                                   radius=wheel.r, inertia=wheel.J, calibration=calibration,
+                                   path=scenario_path(scenario, straight), v_target=speed, step=STEP)
+    builder.add_block("ctrl", block)
+    _connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
+    builder.connect("rover.pitch", "ctrl.pitch").connect("rover.roll", "ctrl.roll")
+    for i in WHEELS:
+        builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
+        builder.connect(f"rover.omega[{i}]", f"ctrl.omega[{i}]")
+        if calibration.sinkage_sensor:
+            builder.connect(f"rover.sinkage[{i}]", f"ctrl.sinkage[{i}]")
     return builder.build()
 
 

@@ -96,6 +96,25 @@ def identified_on(models: ModelSet) -> tuple[Soil, Wheel]:
     return (Soil(**soil) if soil else Soil()), (Wheel(**wheel) if wheel else Wheel())
 
 
+def adapter_for(models: ModelSet, fmu_dir: Path, cache_dir: Path | None,
+                lateral: bool = False) -> Callable[[TestBedData], Adaptation]:
+    """What an adaptive block calls at the end of its calibration: the soil estimated from the data
+    starting from the soil ``models`` were identified on (their wheel: the rover's own), the models
+    identified again on SingleWheel.fmu of ``fmu_dir`` (the sweeps' cache in ``cache_dir``; None: a
+    temporary folder), the lateral one too with ``lateral``."""
+    prior, wheel = identified_on(models)
+    degree = models.model().degree
+    single_wheel = Path(fmu_dir) / "SingleWheel.fmu"
+
+    def adapter(data: TestBedData) -> Adaptation:
+        if cache_dir is not None:
+            return adapt_model(data, single_wheel, wheel, prior, Path(cache_dir), degree, lateral)
+        with tempfile.TemporaryDirectory(prefix="rover-cosim-adapt-") as folder:
+            return adapt_model(data, single_wheel, wheel, prior, Path(folder), degree, lateral)
+
+    return adapter
+
+
 def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, *,
                     calibration: Calibration = Calibration(), cache_dir: Path | None = None,
                     **options: Any) -> System:
@@ -105,16 +124,8 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
     identified again on SingleWheel.fmu (the sweep's cache in ``cache_dir``; None: a temporary
     folder), then the paper's law with it."""
     models = models_of(model)
-    prior, wheel = identified_on(models)
-    degree = models.model().degree
-    single_wheel = Path(fmu_dir) / "SingleWheel.fmu"
-
-    def adapter(data: TestBedData) -> Adaptation:
-        if cache_dir is not None:
-            return adapt_model(data, single_wheel, wheel, prior, Path(cache_dir), degree)
-        with tempfile.TemporaryDirectory(prefix="rover-cosim-adapt-") as folder:
-            return adapt_model(data, single_wheel, wheel, prior, Path(folder), degree)
-
+    wheel = identified_on(models)[1]
+    adapter = adapter_for(models, fmu_dir, cache_dir)
     builder = _closed_loop("closed loop (adaptive)")
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
     block = AdaptiveController("ctrl", models, adapter, radius=wheel.r, inertia=wheel.J,

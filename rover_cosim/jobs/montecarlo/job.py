@@ -34,13 +34,12 @@ from rover_cosim.identification.cache import discard, remove_partial_files
 from rover_cosim.identification.model_set import ModelMismatch, ModelSet
 from rover_cosim.terramechanics.library import Choice, choose, describe
 
-from .. import path_following
 from . import figures
 from .metrics import RMS_FLOOR
 from .runs import EXTRA_FMUS, FMUS, RunSpec, cache_key, compute_run, fingerprint, nominal_values, read_cached, split
 from .sampling import sample_table
 from .sensitivity import OUTPUTS, sensitivity
-from .study import ADAPTED, Study, StudyError
+from .study import ADAPTED, Study
 
 
 @dataclass
@@ -62,9 +61,7 @@ class MonteCarloResult:
 
 
 def _stop_time(study: Study, scenario: str) -> float:
-    if scenario in ("straight", "straight_adapted"):
-        return study.stop_time
-    return study.path_stop_time or path_following.stop_time("lane_change")
+    return study.stop_time_of(scenario)
 
 
 def _specs(study: Study, samples: pd.DataFrame, fmu_dir: Path, models: ModelSet, nominal: Choice, cache: Path,
@@ -246,9 +243,7 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
         for name in (FMUS[scenario], *EXTRA_FMUS.get(scenario, ())):
             if not (fmu_dir / name).is_file():
                 raise FileNotFoundError(f"FMU {fmu_dir / name} not found (build them with `rover-cosim build-fmus`)")
-    if set(study.scenarios) & set(ADAPTED.values()) and not study.stop_time > study.calibration.duration:
-        raise StudyError(f"stop_time = {study.stop_time!r} s: an adapted run needs more than its calibration "
-                         f"({study.calibration.duration!r} s)")
+    study.check_calibration()
     nominal_choice = choose(study.soil, study.wheel)
     models = ModelSet.read(model)
     identified = identified_on(models, nominal_choice)

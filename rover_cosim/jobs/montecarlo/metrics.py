@@ -48,7 +48,9 @@ STRAIGHT = (*(f"rms_Fx_{i}_N" for i in LIMBS), "rms_Fx_max_N", "rms_Fx_max_after
 ESTIMATED = ("c", "phi_deg", "kphi", "n", "kx")
 ADAPTED = (*STRAIGHT, "switched_at_s", "adapt_wall_s", "estimate_rows", *(f"estimated_{n}" for n in ESTIMATED))
 PATH = ("cross_track_rms_m", "cross_track_max_m", "speed_error_max_percent",
-        *(f"rms_Fx_{i}_N" for i in LIMBS), *(f"rms_Fy_{i}_N" for i in LIMBS), "rms_Fx_max_N", "max_slip", "stuck")
+        *(f"rms_Fx_{i}_N" for i in LIMBS), *(f"rms_Fy_{i}_N" for i in LIMBS), "rms_Fx_max_N",
+        "rms_Fx_max_after_calibration_N", "max_slip", "stuck")
+ADAPTED_PATH = (*PATH, "switched_at_s", "adapt_wall_s", "estimate_rows", *(f"estimated_{n}" for n in ESTIMATED))
 
 
 def _final(table: pd.DataFrame) -> pd.DataFrame:
@@ -90,10 +92,12 @@ def straight_metrics(table: pd.DataFrame, v_target: float = TARGET_VELOCITY,
     return row
 
 
-def path_metrics(table: pd.DataFrame, basic: dict[str, float]) -> dict[str, float | bool]:
+def path_metrics(table: pd.DataFrame, basic: dict[str, float], calibration: float = 0.0) -> dict[str, float | bool]:
     """The path run's metrics: ``basic`` (path_following.metrics of the table) with the largest
-    RMS(Fx - Fx_des), the max slip and whether the rover got stuck."""
+    RMS(Fx - Fx_des) (over the run, and from ``calibration`` [s] on), the max slip and whether the
+    rover got stuck."""
     row: dict[str, float | bool] = dict(basic)
     row["rms_Fx_max_N"] = max(float(basic[f"rms_Fx_{i}_N"]) for i in LIMBS)
+    row["rms_Fx_max_after_calibration_N"] = _rms_max(table[table["time"] >= calibration])
     row.update(_slip_and_stuck(table, pd.Series(np.hypot(table["v"], table["vy"]), index=table.index)))
     return row

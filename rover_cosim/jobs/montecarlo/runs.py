@@ -36,18 +36,20 @@ from rover_cosim.orchestrator.model import System
 from rover_cosim.terramechanics.library import DEGREES, Choice, vary
 
 from .. import path_following, simulate
-from .metrics import ADAPTED, ESTIMATED, PATH, STRAIGHT, path_metrics, straight_metrics
+from .metrics import ADAPTED, ADAPTED_PATH, ESTIMATED, PATH, STRAIGHT, path_metrics, straight_metrics
 from .study import Study, StudyError
 
 #: Bumped when a metric's definition changes: every cached run is then computed again.
-METRICS_VERSION = 3
+METRICS_VERSION = 4
 #: The path scenario of a study: the lane change at 1.0 m/s (the paper's speed).
 PATH_SCENARIO = "lane_change"
 #: The FMU of each scenario (in fmu_dir).
-FMUS = {"straight": "Rover.fmu", "path": "SteerableRover.fmu", "straight_adapted": "Rover.fmu"}
-#: FMUs a scenario needs besides its plant: the adaptive controller identifies its model again on SingleWheel.fmu.
-EXTRA_FMUS = {"straight_adapted": ("SingleWheel.fmu",)}
-COLUMNS = {"straight": [*STRAIGHT, "wall_s"], "path": [*PATH, "wall_s"], "straight_adapted": [*ADAPTED, "wall_s"]}
+FMUS = {"straight": "Rover.fmu", "path": "SteerableRover.fmu", "straight_adapted": "Rover.fmu",
+        "path_adapted": "SteerableRover.fmu"}
+#: FMUs a scenario needs besides its plant: the adaptive controllers identify their models again on SingleWheel.fmu.
+EXTRA_FMUS = {"straight_adapted": ("SingleWheel.fmu",), "path_adapted": ("SingleWheel.fmu",)}
+COLUMNS = {"straight": [*STRAIGHT, "wall_s"], "path": [*PATH, "wall_s"], "straight_adapted": [*ADAPTED, "wall_s"],
+           "path_adapted": [*ADAPTED_PATH, "wall_s"]}
 
 
 #: (name, value) pairs of a sample.
@@ -144,6 +146,10 @@ def plant(spec: RunSpec) -> System:
     elif spec.scenario == "straight_adapted":
         system = simulate.adaptive_system(fmu_dir, spec.model, choice, calibration=spec.calibration,
                                           cache_dir=Path(spec.target).parent / "adaptation")
+    elif spec.scenario == "path_adapted":
+        system = path_following.adaptive_system(fmu_dir, spec.model, PATH_SCENARIO, choice,
+                                                calibration=spec.calibration,
+                                                cache_dir=Path(spec.target).parent / "adaptation")
     else:
         system = path_following.monolithic_system(fmu_dir, spec.model, PATH_SCENARIO, "inverse", choice)
     builder = SystemBuilder.from_system(system, f"Monte Carlo sample {spec.sample} ({spec.scenario})")
@@ -167,17 +173,18 @@ def simulate_run(spec: RunSpec) -> dict[str, float | bool]:
     """The run's metrics (raises on a sample the soil library or the FMU refuses)."""
     system = plant(spec)
     outcome = run(system)
-    if spec.scenario in ("straight", "straight_adapted"):
-        window = spec.calibration.duration
-        if spec.scenario == "straight_adapted":  # after its own calibration, longer on a rover that crawls
-            block = next(b.block for b in system.blocks if b.name == "ctrl")
-            window = block.calibrated_until or window  # type: ignore[attr-defined]
+    window = spec.calibration.duration
+    adapted = spec.scenario.endswith("_adapted")
+    if adapted:  # after its own calibration, longer on a rover that crawls
+        block = next(b.block for b in system.blocks if b.name == "ctrl")
+        window = block.calibrated_until or window  # type: ignore[attr-defined]
+    if spec.scenario.startswith("straight"):
         row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"), calibration=window)
-        if spec.scenario == "straight_adapted":
-            row.update(adaptation_metrics(system))
     else:
         table = path_following.trajectories(outcome.data, cosim=False)
-        row = path_metrics(table, path_following.metrics(table, path_following.SCENARIOS[PATH_SCENARIO]))
+        row = path_metrics(table, path_following.metrics(table, path_following.SCENARIOS[PATH_SCENARIO]), window)
+    if adapted:
+        row.update(adaptation_metrics(system))
     row["wall_s"] = outcome.wall_seconds
     return row
 

@@ -5,8 +5,8 @@
     seed = 20251123             # numpy Generator seed: the same seed gives the same samples
     scenarios = ["straight"]    # "straight": the paper's closed loop on Rover.fmu;
                                 # "path": the lane change on SteerableRover.fmu;
-                                # "straight_adapted": the straight run with the adaptive controller
-                                # (calibration, soil estimated, model identified again)
+                                # "straight_adapted", "path_adapted": the same with the adaptive
+                                # controller (calibration, soil estimated, models identified again)
     stop_time = 20.0            # s, of the straight run (the paper's 20 s; shorter for quick looks)
     path_stop_time = 35.363     # s, of the path run (default: until the reference reaches the end)
     soil = "paper"              # the nominal soil and wheel: the ones the model was identified on
@@ -50,10 +50,10 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import DEGREES
 
 #: Scenarios a study can run: "straight" (paper Sec. 4, Rover.fmu), "path" (lane change,
-#: SteerableRover.fmu), "straight_adapted" (the straight run with the adaptive controller).
-SCENARIOS = ("straight", "path", "straight_adapted")
+#: SteerableRover.fmu), and each with the adaptive controller ("straight_adapted", "path_adapted").
+SCENARIOS = ("straight", "path", "straight_adapted", "path_adapted")
 #: The scenario ``--adapt`` adds beside each that has an adaptive variant.
-ADAPTED = {"straight": "straight_adapted"}
+ADAPTED = {"straight": "straight_adapted", "path": "path_adapted"}
 #: Shipped studies (``--study NAME`` or a file).
 STUDIES = Path(__file__).with_name("studies")
 KINDS = {"uniform": ("lower", "upper"), "normal": ("mean", "std"), "lognormal": ("median", "sigma")}
@@ -110,6 +110,21 @@ class Study:
     @property
     def names(self) -> list[str]:
         return [p.name for p in self.parameters]
+
+    def stop_time_of(self, scenario: str) -> float:
+        """s: how long a run of ``scenario`` lasts (the path's: until its reference reaches the end)."""
+        if scenario.startswith("straight"):
+            return self.stop_time
+        from rover_cosim.jobs import path_following
+
+        return self.path_stop_time or path_following.stop_time("lane_change")
+
+    def check_calibration(self) -> None:
+        """StudyError unless every adapted scenario's run lasts longer than its calibration."""
+        for scenario in self.scenarios:
+            if scenario in ADAPTED.values() and not self.stop_time_of(scenario) > self.calibration.duration:
+                raise StudyError(f"{self.path or 'study'}: {scenario}: a run of {self.stop_time_of(scenario)!r} s: "
+                                 f"an adapted run needs more than its calibration ({self.calibration.duration!r} s)")
 
     def adapted(self) -> Study:
         """The study with each scenario's adaptive variant beside it (``--adapt``)."""
