@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -218,7 +219,7 @@ def test_the_path_controller_learns_the_soil_on_the_first_straight(fmu_dir, iden
                                             calibration=Calibration(duration=1.5), cache_dir=tmp_path, straight=3.0)
     system = SystemBuilder.from_system(system, "adaptive path, short").simulation(stop_time=2.0).build()
     outcome = run(system)
-    block = next(b.block for b in system.blocks if b.name == "ctrl")
+    block: Any = next(b.block for b in system.blocks if b.name == "ctrl")
     report = block.report()
     assert report["switched_at_s"] == pytest.approx(1.5) and report["lateral_identified_again"]
     assert report["estimated_soil"]["phi"] == pytest.approx(truth.soil.phi, rel=0.02)
