@@ -72,6 +72,17 @@ FULL_TIER_MODULES = {"test_platforms", "test_killed_commands", "test_fmi_kinds",
                      "test_translate"}
 
 
+def pytest_configure(config: pytest.Config) -> None:
+    """A suite started in the background of a non-interactive shell (``make test &``, nohup) has
+    SIGINT ignored, and the commands the tests start inherit that: the tests that interrupt them
+    with SIGINT would see it ignored. Python's own handler here makes the children start with the
+    default disposition, as they do from a terminal."""
+    import signal
+
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark the tests of the full tier ``fmu`` (they build or run FMUs), so that ``make test-fast``
     (``-m "not fmu and not slow"``) runs the rest in seconds; ``make test`` runs every test."""
