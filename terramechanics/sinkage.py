@@ -15,7 +15,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.interpolate import RegularGridInterpolator
 
 from .checks import check_nodes, checked_array
 from .forces import DEFAULT_NODES, ContactForces, contact_integrals
@@ -106,6 +105,9 @@ def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
     log_h = np.log(h_grid).reshape(GRID_SHAPE)
     correction = log_h - np.log(bekker_sinkage(grid_w, wheel, soil)).reshape(GRID_SHAPE)
     slope = 1.0 / np.asarray(np.gradient(log_h, log_w, axis=0))
+    # Imported here: SciPy takes ~0.4 s to import, and small batches (every command's) never need it.
+    from scipy.interpolate import RegularGridInterpolator
+
     points = np.column_stack([np.log(load), slip])
 
     def interpolate(values: FloatArray) -> FloatArray:
