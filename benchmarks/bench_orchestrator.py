@@ -11,13 +11,22 @@ wall time per step, and our master's overhead per step (wall time minus the time
 the FMU calls, i.e. the Python master's own work). Written to results/bench/orchestrator.json
 by ``make bench``. Not a test: nothing asserts a time; the floor of issue 5 (within 3x of
 libcosim's wall time) is recorded beside the measured ratio.
+
+Beside the runs inside this process, the whole processes a user waits for: ``rover-cosim run`` of
+the same system (written as a system file) from start to exit (imports, unpacking, the run, the
+CSV), and Ecos in a process of its own that imports ecospy and runs the same FMUs
+(``*_process`` variants, their own ratio).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
 import tomllib
 from pathlib import Path
@@ -29,7 +38,7 @@ from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.libcosim import run_libcosim
 from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.native import unavailable_reason
-from rover_cosim.orchestrator.system import system_from_dict
+from rover_cosim.orchestrator.system import system_from_dict, system_to_toml
 
 SYSTEM = example("rover_cosim")
 FLOOR_RATIO = 3.0
@@ -47,7 +56,7 @@ def bench_system(algorithm: str, stop_time: float, step: float, native: bool = T
         else:
             fmu["start"] = {"tau": TORQUE}
     data["simulation"]["order"] = [f["name"] for f in data["fmu"]]
-    return system_from_dict(data, name="bench rover_cosim", base=Path("fmus"), path=SYSTEM)
+    return system_from_dict(data, name="bench rover_cosim", base=Path("fmus").resolve(), path=SYSTEM)
 
 
 def ecospy_missing() -> str | None:
@@ -84,9 +93,65 @@ def run_ecospy(system: Any) -> tuple[float, float]:
     return time.perf_counter() - started, final_v
 
 
+#: Ecos run as a process of its own: the system's FMUs, connections and values from a JSON file.
+ECOSPY_PROCESS = """
+import json, sys
+from ecospy import EcosSimulation, EcosSimulationStructure
+spec = json.load(open(sys.argv[1]))
+with EcosSimulationStructure() as structure:
+    for name, path in spec["fmus"]:
+        structure.add_model(name, path)
+    for source, target in spec["connections"]:
+        structure.make_real_connection(source, target)
+    structure.add_parameter_set("initial", spec["values"])
+    with EcosSimulation(structure=structure, step_size=spec["step"]) as simulation:
+        simulation.init(parameter_set="initial")
+        simulation.step_until(spec["stop_time"])
+        print(simulation.get_real("body::v"))
+        simulation.terminate()
+"""
+
+
+def process_files(folder: Path, stop_time: float, step: float) -> tuple[Path, Path]:
+    """The benchmark's system as a system file (for ``rover-cosim run``) and as Ecos' JSON."""
+    system = bench_system("jacobi", stop_time, step)
+    toml = folder / "bench_rover_cosim.toml"
+    toml.write_text(system_to_toml(system, folder))
+    spec = {"fmus": [(fmu.name, str(fmu.path)) for fmu in system.fmus],
+            "connections": [(f"{c.source.instance}::{c.source.variable}", f"{c.target.instance}::{c.target.variable}")
+                            for c in system.connections],
+            "values": {f"{fmu.name}::{name}": float(value) for fmu in system.fmus
+                       for name, value in {**fmu.parameters, **fmu.start}.items()},
+            "step": system.step, "stop_time": system.stop_time}
+    ecos = folder / "bench_ecos.json"
+    ecos.write_text(json.dumps(spec))
+    return toml, ecos
+
+
+def run_process(name: str, stop_time: float, step: float) -> tuple[float, float | None, float | None]:
+    """One whole process of ``name`` (``ours_jacobi_process`` or ``ecospy_process``): its wall
+    seconds from start to exit, and the body's final velocity [m/s] where it prints one."""
+    with tempfile.TemporaryDirectory(prefix="bench-process-") as folder:
+        toml, ecos = process_files(Path(folder), stop_time, step)
+        if name == "ecospy_process":
+            argv = [sys.executable, "-P", "-c", ECOSPY_PROCESS, str(ecos)]
+        else:
+            argv = [sys.executable, "-P", "-m", "rover_cosim", "run", str(toml), "-q", "-o",
+                    str(Path(folder) / "out.csv")]
+        started = time.perf_counter()
+        done = subprocess.run(argv, capture_output=True, text=True, check=False)
+        wall = time.perf_counter() - started
+        if done.returncode != 0:
+            raise RuntimeError(f"{name}: exit {done.returncode}: {done.stderr[-2000:]}")
+        final = float(done.stdout.split()[-1]) if name == "ecospy_process" else None
+        return wall, None, final
+
+
 def run_variant(name: str, stop_time: float, step: float) -> tuple[float, float | None, float | None]:
     """One run of the variant ``name``: wall seconds, our master's overhead [s] and the body's
     final velocity [m/s] (None where the tool does not give them)."""
+    if name.endswith("_process"):
+        return run_process(name, stop_time, step)
     if name == "ecospy":
         wall, final_v = run_ecospy(bench_system("jacobi", stop_time, step))
         return wall, None, final_v
@@ -139,8 +204,8 @@ def main() -> None:
     native_missing = unavailable_reason()
     if native_missing:
         print(native_missing)
-    names = ("ours_jacobi", "ours_gauss_seidel", "ours_jacobi_python_master", "libcosim") + (
-        () if missing else ("ecospy",))
+    names = ("ours_jacobi", "ours_gauss_seidel", "ours_jacobi_python_master", "libcosim", "ours_jacobi_process") + (
+        () if missing else ("ecospy", "ecospy_process"))
     results = measure(names, args.repeats, args.stop_time, args.step)
     for name, entry in results.items():
         print(f"{name:26s} {entry['wall_seconds_median']:6.2f} s for {steps} steps "
@@ -154,12 +219,17 @@ def main() -> None:
                  if "ecospy" in results else None)
     if to_ecospy:
         print("wall time / ecospy: " + ", ".join(f"{k} {v:.2f}x" for k, v in to_ecospy.items()) + " (goal <= 1)")
+    whole = (results["ours_jacobi_process"]["wall_seconds_median"] / results["ecospy_process"]["wall_seconds_median"]
+             if "ecospy_process" in results else None)
+    if whole is not None:
+        print(f"whole process, rover-cosim run / ecospy: {whole:.2f}x (goal <= 1)")
     record = run_record("make bench", {"repeats": args.repeats, "stop_time_s": args.stop_time, "step_s": args.step,
                                        "torque_N_m": TORQUE, "fmus": 7, "cpus": os.cpu_count()})
     write_all({args.out: json_bytes({**record, "results": results, "ratio_to_libcosim": ratios,
                                      "floor_ratio": FLOOR_RATIO,
                                      "floor_met": all(r <= FLOOR_RATIO for r in ratios.values()),
                                      "ratio_to_ecospy": to_ecospy, "ecospy_skipped": missing,
+                                     "whole_process_ratio_to_ecospy": whole,
                                      "goal_ratio_to_ecospy": 1.0,
                                      "note": "libcosim and Ecos step their slaves on worker threads; ours steps "
                                              "them in threads as well (one per core by default)"})})
