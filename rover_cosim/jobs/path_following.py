@@ -51,7 +51,7 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
 
 from .plants import add_plant_fmu, add_rover
-from .simulate import RECORD_INTERVAL, adapter_for, checked_models, identified_on, models_of
+from .simulate import RECORD_INTERVAL, adapter_for, checked_models, connect_telemetry, models_of, soil_and_wheel_of
 
 STEP = 1e-3  # s
 WHEELS = range(1, 7)
@@ -131,7 +131,7 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice
     loads, the body's velocity and attitude), both models identified again on the estimated soil
     (its lateral moduli kept nominal: a rover measures no lateral force), then the path law."""
     models = models_of(model)
-    wheel = identified_on(models)[1]
+    wheel = soil_and_wheel_of(models)[1]
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} (adaptive)", scenario, straight)
     start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
@@ -141,12 +141,9 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice
                                    path=scenario_path(scenario, straight), v_target=speed, step=STEP)
     builder.add_block("ctrl", block)
     _connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
-    builder.connect("rover.pitch", "ctrl.pitch").connect("rover.roll", "ctrl.roll")
     for i in WHEELS:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
-        builder.connect(f"rover.omega[{i}]", f"ctrl.omega[{i}]")
-        if calibration.sinkage_sensor:
-            builder.connect(f"rover.sinkage[{i}]", f"ctrl.sinkage[{i}]")
+    connect_telemetry(builder, "rover", calibration, ("pitch", "roll"))
     return builder.build()
 
 

@@ -89,7 +89,7 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | No
     return builder.build()
 
 
-def identified_on(models: ModelSet) -> tuple[Soil, Wheel]:
+def soil_and_wheel_of(models: ModelSet) -> tuple[Soil, Wheel]:
     """The soil and wheel the models were identified on (model.json's record; the paper's where it
     records none)."""
     soil, wheel = models.details.get("soil", {}).get("values"), models.details.get("wheel", {}).get("values")
@@ -102,7 +102,7 @@ def adapter_for(models: ModelSet, fmu_dir: Path, cache_dir: Path | None,
     starting from the soil ``models`` were identified on (their wheel: the rover's own), the models
     identified again on SingleWheel.fmu of ``fmu_dir`` (the sweeps' cache in ``cache_dir``; None: a
     temporary folder), the lateral one too with ``lateral``."""
-    prior, wheel = identified_on(models)
+    prior, wheel = soil_and_wheel_of(models)
     degree = models.model().degree
     single_wheel = Path(fmu_dir) / "SingleWheel.fmu"
 
@@ -124,20 +124,29 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
     identified again on SingleWheel.fmu (the sweep's cache in ``cache_dir``; None: a temporary
     folder), then the paper's law with it."""
     models = models_of(model)
-    wheel = identified_on(models)[1]
+    wheel = soil_and_wheel_of(models)[1]
     adapter = adapter_for(models, fmu_dir, cache_dir)
     builder = _closed_loop("closed loop (adaptive)")
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
     block = AdaptiveController("ctrl", models, adapter, radius=wheel.r, inertia=wheel.J,
                                calibration=calibration, **{"step": STEP, **options})
     builder.add_block("ctrl", block)
-    builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v").connect("rover.pitch", "ctrl.pitch")
+    builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
     for i in LIMBS:
         builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
-        builder.connect(f"rover.omega[{i}]", f"ctrl.omega[{i}]")
-        if calibration.sinkage_sensor:
-            builder.connect(f"rover.sinkage[{i}]", f"ctrl.sinkage[{i}]")
+    connect_telemetry(builder, "rover", calibration, ("pitch",))
     return builder.build()
+
+
+def connect_telemetry(builder: SystemBuilder, plant: str, calibration: Calibration, angles: tuple[str, ...]) -> None:
+    """The telemetry of an adaptive controller ``ctrl`` from the monolithic ``plant``: the body's
+    ``angles``, each wheel's spin, and its sinkage where the rover has a sensor."""
+    for angle in angles:
+        builder.connect(f"{plant}.{angle}", f"ctrl.{angle}")
+    for i in LIMBS:
+        builder.connect(f"{plant}.omega[{i}]", f"ctrl.omega[{i}]")
+        if calibration.sinkage_sensor:
+            builder.connect(f"{plant}.sinkage[{i}]", f"ctrl.sinkage[{i}]")
 
 
 def cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
