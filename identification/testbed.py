@@ -24,6 +24,7 @@ import pandas as pd
 from rover_cosim.common.scratch import scratch_prefix
 from rover_cosim.orchestrator.model import FmuEntry, Value
 from rover_cosim.orchestrator.participants import FmuParticipant
+from rover_cosim.orchestrator.unpacking import unpack
 
 #: What every run records besides time and torque (SingleWheel outputs, SI units).
 RECORDED = ("slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v", "Fy", "beta")
@@ -67,7 +68,8 @@ class WheelTestBed:
         if missing:
             raise ValueError(f"{self.path}: not a SingleWheel FMU (no variables {missing})")
         self.names = names
-        self.fmu = FmuParticipant(FmuEntry("testbed", self.path, {}, {}, self.description), Path(self._folder.name))
+        entry = FmuEntry("testbed", self.path, {}, {}, self.description)
+        self.fmu = FmuParticipant(entry, unpack(entry, Path(self._folder.name)))
         self.fmu.configure([], list(RECORDED))  # inputs are set by name when they change; RECORDED read each step
         self._fresh = True
         #: FMU parameters set before every run (e.g. a soil and wheel: terramechanics.library.fmu_parameters)

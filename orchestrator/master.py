@@ -12,6 +12,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
+from pathlib import Path
 
 import numpy as np
 
@@ -33,7 +34,7 @@ from .observers import (
 )
 from .participants import BlockParticipant, Participant, RunError, Terminated
 from .recorder import Recorder, RunResult, communication_points
-from .unpacking import UNZIP_PREFIX, remove_stale_folders, run_folder
+from .unpacking import UNZIP_PREFIX, remove_stale_folders, run_folder, unpack
 from .wiring import Wiring, wire
 
 #: Passes of the initial-output exchange among participants with an iterative start (FMUs in
@@ -80,8 +81,9 @@ def participants_of(system: System, wiring: Wiring,
     with ExitStack() as stack:
         unzip_root = stack.enter_context(run_folder())
         by_name: dict[str, Participant] = {}
+        unpacked: dict[Path, Path] = {}
         for entry in system.fmus:
-            fmu = make_fmu_participant(entry, unzip_root, strings, system.relative_tolerance)
+            fmu = make_fmu_participant(entry, unpack(entry, unzip_root, unpacked), strings, system.relative_tolerance)
             stack.callback(fmu.close)
             ports = wiring.participants[entry.name]
             fmu.configure(ports.inputs, ports.outputs)
@@ -168,7 +170,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
                 observer.fail(error)
             raise
         execution.close()
-        result = RunResult(recorder.frame(), time.perf_counter() - started, steps, execution.step_seconds, stopped)
+        result = RunResult(recorder.table(), time.perf_counter() - started, steps, execution.step_seconds, stopped)
     for observer in observers:
         observer.finish(result)
     return result

@@ -72,9 +72,9 @@ class _Solver(CVodeSolver):
 class ModelExchangeParticipant(FmuParticipant):
     """An FMU run through its Model Exchange interface, integrated by CVode over each step."""
 
-    def __init__(self, entry: FmuEntry, unzip_root: Path, strings: StringTable | None = None,
+    def __init__(self, entry: FmuEntry, folder: Path, strings: StringTable | None = None,
                  relative_tolerance: float = 1e-6):
-        super().__init__(entry, unzip_root, strings)
+        super().__init__(entry, folder, strings)
         md = entry.description
         self.nx = int(md.numberOfContinuousStates or 0)
         self.nz = int(md.numberOfEventIndicators or 0)
@@ -237,9 +237,10 @@ class ModelExchangeParticipant(FmuParticipant):
         self.solver, self.next_event, self._fresh = None, math.inf, False
 
 
-def make_fmu_participant(entry: FmuEntry, unzip_root: Path, strings: StringTable,
+def make_fmu_participant(entry: FmuEntry, folder: Path, strings: StringTable,
                          relative_tolerance: float = 1e-6) -> FmuParticipant:
-    """The participant running ``entry`` through the interface it names (Co-Simulation or Model Exchange)."""
+    """The participant running ``entry`` (unpacked in ``folder``) through the interface it names
+    (Co-Simulation or Model Exchange)."""
     if entry.interface == "model-exchange":
-        return ModelExchangeParticipant(entry, unzip_root, strings, relative_tolerance)
-    return FmuParticipant(entry, unzip_root, strings)
+        return ModelExchangeParticipant(entry, folder, strings, relative_tolerance)
+    return FmuParticipant(entry, folder, strings)

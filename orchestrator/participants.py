@@ -22,7 +22,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Protocol, TypeVar
 
-import fmpy
 import numpy as np
 from fmpy.fmi2 import (
     FMU2Model,
@@ -191,18 +190,17 @@ class BlockParticipant:
 class FmuParticipant:
     """An FMU instance run through its Co-Simulation interface (FMI 2.0 or 3.0); ``inputs`` are
     its connected inputs, ``outputs`` the variables read from it (connected or recorded), both
-    fixed by :meth:`configure`. ``strings``: the run's String table (``fmi_access``)."""
+    fixed by :meth:`configure`. ``folder``: where the FMU is unpacked (``unpacking.unpack``);
+    ``strings``: the run's String table (``fmi_access``)."""
 
     iterative_start = True
 
-    def __init__(self, entry: FmuEntry, unzip_root: Path, strings: StringTable | None = None):
+    def __init__(self, entry: FmuEntry, folder: Path, strings: StringTable | None = None):
         self.name = entry.name
         self.entry = entry
         self.version = entry.fmi_version
         self.strings = strings if strings is not None else StringTable()
         self.messages: list[str] = []
-        folder = unzip_root / entry.name
-        fmpy.extract(str(entry.path), str(folder))
         md = entry.description
         self.refs = {v.name: v.valueReference for v in md.modelVariables}
         self.types = {v.name: str(v.type) for v in md.modelVariables}
@@ -438,12 +436,18 @@ class FmuParticipant:
             self._call("fmi3FreeFMUState", lambda: self.fmu.freeFMUState(state))
 
     def close(self) -> None:
-        for what, action in (("terminate", self.fmu.terminate), ("freeInstance", self.fmu.freeInstance)):
-            try:
-                action()
-            except Exception:  # noqa: BLE001 - closing after a failure must not mask it
-                if what == "freeInstance":
-                    break
+        """Terminate and free the instance. FMPy's freeInstance unloads the library as well (one
+        dlclose per load): it is unloaded here only when freeInstance did not get that far, since
+        a second dlclose would unload the library under another instance sharing it."""
+        try:
+            self.fmu.terminate()
+        except Exception:  # noqa: BLE001 - closing after a failure must not mask it
+            pass
+        try:
+            self.fmu.freeInstance()
+            return
+        except Exception:  # noqa: BLE001 - closing after a failure must not mask it
+            pass
         try:
             self.fmu.freeLibrary()
         except Exception as error:  # noqa: BLE001 - unloading is best effort

@@ -8,12 +8,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 
 from .model import System
 from .observers import Observer
 from .participants import RunError
-from .recorder import RunResult
+from .recorder import RunResult, Table
 
 
 def system_record(system: System) -> dict[str, Any]:
@@ -46,7 +48,7 @@ def sidecar(system: System, result: RunResult, command: str,
         "wall_seconds": result.wall_seconds,
         "participant_seconds": result.step_seconds,
         "master_overhead_seconds": result.master_overhead_seconds,
-        "columns": list(result.data.columns),
+        "columns": list(result.columns),
         **(extra or {}),
     }
 
@@ -65,14 +67,18 @@ def sidecar_path(csv_path: Path) -> Path:
 
 
 def table_bytes(data: Any, path: Path) -> bytes:
-    """``data`` (a DataFrame) as the bytes of ``path``'s format: CSV at full precision (the
-    shortest text of each float that reads back equal; Arrow's writer, ~10x pandas' speed; Booleans
-    as true/false, Strings quoted), or Parquet (pyarrow; every column keeps its type)."""
+    """``data`` (a recorder's :class:`Table`, or a DataFrame) as the bytes of ``path``'s format:
+    CSV at full precision (the shortest text of each float that reads back equal; Arrow's writer,
+    ~10x pandas' speed; Booleans as true/false, Strings quoted), or Parquet (pyarrow; every column
+    keeps its type)."""
     import io
 
     import pyarrow as pa
 
-    table = pa.Table.from_pandas(data, preserve_index=False)
+    if isinstance(data, Table):
+        table = pa.Table.from_arrays([arrow_column(column) for column in data.columns], names=list(data.names))
+    else:
+        table = pa.Table.from_pandas(data, preserve_index=False)
     buffer = io.BytesIO()
     if Path(path).suffix.lower() == ".parquet":
         import pyarrow.parquet as pq
@@ -84,10 +90,28 @@ def table_bytes(data: Any, path: Path) -> bytes:
     import pyarrow.csv as pc
 
     header = io.StringIO()
-    csv.writer(header, lineterminator="\n").writerow([str(c) for c in data.columns])
+    csv.writer(header, lineterminator="\n").writerow([str(c) for c in table.column_names])
     buffer.write(header.getvalue().encode())
     pc.write_csv(table, buffer, pc.WriteOptions(include_header=False, quoting_style="needed"))
     return buffer.getvalue()
+
+
+def arrow_column(values: np.ndarray) -> Any:
+    """A recorded column as an Arrow array over the same memory, built from its buffers: pyarrow's
+    converters (``pa.array``) import pandas (0.15-0.25 s) to ask whether the values are a Series."""
+    import pyarrow as pa
+
+    n = len(values)
+    if values.dtype == bool:
+        return pa.Array.from_buffers(pa.bool_(), n, [None, pa.py_buffer(np.packbits(values, bitorder="little"))])
+    if values.dtype == object:  # text
+        encoded = [str(v).encode() for v in values]
+        offsets = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum([len(e) for e in encoded], out=offsets[1:])
+        return pa.Array.from_buffers(pa.large_string(), n, [None, pa.py_buffer(offsets),
+                                                            pa.py_buffer(b"".join(encoded))])
+    values = np.ascontiguousarray(values)
+    return pa.Array.from_buffers(pa.from_numpy_dtype(values.dtype), n, [None, pa.py_buffer(values)])
 
 
 def partial_path(csv_path: Path) -> Path:
@@ -117,7 +141,7 @@ def write_run(system: System, result: RunResult, csv_path: Path, command: str = 
     csv_path = Path(csv_path)
     json_path = sidecar_path(csv_path)
     record = sidecar(system, result, command, extra)
-    write_all({csv_path: table_bytes(result.data, csv_path), json_path: json_bytes(record)})
+    write_all({csv_path: table_bytes(result.table, csv_path), json_path: json_bytes(record)})
     return [csv_path, json_path]
 
 

@@ -131,7 +131,7 @@ def test_a_signal_ends_a_run_with_one_line_and_no_leftovers(fmu_dir, fmus, tmp_p
                                 str(fmu_dir), "--stop-time", "600", "-o", str(tmp_path / "out.csv"), "--quiet"],
                                stderr=subprocess.PIPE, text=True, env=env)
     deadline = time.time() + 180  # a busy machine: start-up and unpacking take their time
-    while not list(tmp_path.glob(f"{UNZIP_PREFIX}*/wheel6")) and time.time() < deadline and process.poll() is None:
+    while not list(tmp_path.glob(f"{UNZIP_PREFIX}*/wheel1")) and time.time() < deadline and process.poll() is None:
         time.sleep(0.1)
     if not list(tmp_path.glob(f"{UNZIP_PREFIX}*")):
         process.kill()
