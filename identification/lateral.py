@@ -75,6 +75,26 @@ class LateralForm:
             return [s / (np.abs(beta) + s) ** 2 for s in scales]
         return [np.exp(-np.abs(beta) / s) / s for s in scales]
 
+    def angle_terms(self, beta: float) -> tuple[list[float], list[float]]:
+        """(phi_i(beta), d phi_i / d beta [1/rad]) at one slip angle [rad] in plain floats, in the
+        order of operations the path controller's C twin (``path_controller.c``) repeats; the
+        same values as angle_basis and angle_basis_slope up to round-off."""
+        scales = self.scales_rad
+        if self.basis == "polynomial":
+            return ([beta ** (2 * i + 1) for i in range(len(scales))],
+                    [(2 * i + 1) * beta ** (2 * i) for i in range(len(scales))])
+        magnitude = abs(beta)
+        if self.basis == "rational":
+            return ([beta / (magnitude + s) for s in scales],
+                    [s / ((magnitude + s) * (magnitude + s)) for s in scales])
+        sign = 1.0 if beta > 0 else -1.0 if beta < 0 else beta  # np.sign: 0 and NaN kept
+        return ([sign * -math.expm1(-magnitude / s) for s in scales], [math.exp(-magnitude / s) / s for s in scales])
+
+    @property
+    def scales_rad(self) -> list[float]:
+        """beta_i [rad]."""
+        return np.radians(self.scales_deg).tolist()
+
     def columns(self, load: np.ndarray, beta: np.ndarray, slip: np.ndarray, *, with_load: bool = True) -> np.ndarray:
         """The regression matrix: phi_i(beta) slip^k W^j, ordered [i, k, j] (j only with_load)."""
         load, slip = np.asarray(load, float), np.asarray(slip, float)
@@ -130,6 +150,31 @@ class LateralModel:
         phi = np.array(self.form.angle_basis(slip_angle))        # (terms, n)
         slope = np.array(self.form.angle_basis_slope(slip_angle))
         return (coefficients * phi.T).sum(axis=1), (coefficients * slope.T).sum(axis=1)
+
+    def angle_coefficients_at(self, load: float, slip: float) -> list[float]:
+        """angle_coefficients at one load [N] and slip in plain floats (c[i, k, j] slip^k W^j
+        summed over k, then j, from 0), as the path controller's C twin sums them."""
+        table = np.asarray(self.coefficients, float).tolist()
+        terms, slips, loads = self.form.shape()
+        slip_powers = [slip ** k for k in range(slips)]
+        load_powers = [load ** j for j in range(loads)]
+        result = []
+        for i in range(terms):
+            total = 0.0
+            for k in range(slips):
+                for j in range(loads):
+                    total += table[i][k][j] * slip_powers[k] * load_powers[j]
+            result.append(total)
+        return result
+
+    def fy_and_slope_at(self, coefficients: list[float], slip_angle: float) -> tuple[float, float]:
+        """fy_and_slope at one slip angle [rad] in plain floats: (Fy [N], dFy/dbeta [N/rad])."""
+        phi, slope = self.form.angle_terms(slip_angle)
+        fy = dfy = 0.0
+        for a, p, q in zip(coefficients, phi, slope):
+            fy += a * p
+            dfy += a * q
+        return fy, dfy
 
     def coefficient_at(self, load: float | np.ndarray, term: int, slip_power: int) -> np.ndarray:
         """c_ik(W) [N]: the polynomial in W of one term."""

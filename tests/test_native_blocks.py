@@ -1,6 +1,7 @@
 """Blocks stepped by the native stepper (orchestrator.native.NativeBlock): the closed-loop
 controller's C twin (control/inverse_controller.c) gives the Python block's outputs bit for bit,
-alone on random inputs and in the paper's closed loop on both plants; its failures are named as
+alone on random inputs and in the paper's closed loop on both plants, and so does the path controller's
+(control/path_controller.c) on the steerable rover; failures are named as
 the Python block's; without a compiler the block steps in Python."""
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import pytest
 from scipy.linalg import expm
 
 from rover_cosim.control.controller import InverseModelController
+from rover_cosim.control.path_controller import PathFollowingController
 from rover_cosim.jobs.simulate import cosim_system, monolithic_system
 from rover_cosim.orchestrator import native
 from rover_cosim.orchestrator.builder import replace_settings
@@ -148,4 +150,100 @@ def test_without_a_compiler_the_controller_steps_in_python(fmu_dir, model, tmp_p
         assert len(run(system).data) == 51
     finally:
         monkeypatch.undo()
+        native.load_library.cache_clear()
+
+
+# --- the path-following controller's C twin (path_controller.c) -----------------------------------
+
+class PathTwin(Twin):
+    """The C twin of a PathFollowingController, called as the stepper calls it."""
+
+    def __init__(self, block: PathFollowingController):  # noqa: D107 - as Twin's, with the path twin's names
+        made = block.native()
+        assert made is not None
+        self.made, self.library = made, made.library
+        pointer = ctypes.c_void_p
+        for name in ("set_real", "get_real"):
+            getattr(self.library, f"path_{name}").argtypes = [pointer, pointer, ctypes.c_size_t, pointer]
+        self.library.path_do_step.argtypes = [pointer, ctypes.c_double, ctypes.c_double, ctypes.c_int]
+        self.inputs = (ctypes.c_uint * len(block.inputs))(*range(len(block.inputs)))
+        self.outputs = (ctypes.c_uint * len(block.outputs))(*range(len(block.outputs)))
+        self.values = np.zeros(len(block.outputs))
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        u = np.ascontiguousarray(u, dtype=float)
+        self.library.path_set_real(self.made.component, self.inputs, u.size, u.ctypes.data)
+        if self.library.path_do_step(self.made.component, t, h, 1) != 0:
+            raise ValueError(self.made.message())
+        self.library.path_get_real(self.made.component, self.outputs, self.values.size, self.values.ctypes.data)
+        return self.values.copy()
+
+
+def near_the_path(block: PathFollowingController, s: float, rng: np.random.Generator) -> np.ndarray:
+    """Inputs of a rover near arc length ``s`` of the block's path: off it by centimetres, its
+    heading by degrees, speed, loads and slip angles spread (some loads below the 1 N floor)."""
+    x, y, heading, _ = (float(v) for v in block.path.at(s))
+    return np.array([x + rng.normal(0, 0.05), y + rng.normal(0, 0.05), heading + rng.normal(0, 0.05),
+                     0.5 + rng.normal(0, 0.2), rng.normal(0, 0.02), rng.normal(0, 0.05),
+                     *rng.uniform(-20.0, 900.0, 6), *rng.normal(0, 0.08, 6)])
+
+
+@pytest.mark.parametrize("path", ["turn", "lane_change"])
+@pytest.mark.parametrize("steering", ["inverse", "kinematic"])
+def test_the_path_controllers_c_twin_gives_the_python_blocks_outputs_bit_for_bit(model, steering, path):
+    rng = np.random.default_rng(34)
+    block = PathFollowingController("ctrl", str(model), path=path, steering=steering)
+    block.start(0.0, near_the_path(block, 0.0, rng))
+    twin = PathTwin(block)
+    t = 0.0
+    for k in range(1, 2500):
+        h = 4e-4 if k == 1200 else 1e-3  # one shorter step: the filter discretised for it
+        u = near_the_path(block, 0.01 * k, rng)  # 10 m/s along the path: the search window moves on
+        expected, got = block.step(t, h, u), twin.step(t, h, u)
+        assert np.array_equal(expected, got), f"step {k}: outputs {np.flatnonzero(expected != got)} differ"
+        t += h
+    with pytest.raises(ValueError, match=r"communication step 0.002 s: expected at most its step = 0.001 s"):
+        twin.step(t, 2e-3, u)
+    twin.made.close()
+
+
+@pytest.mark.parametrize("plant", ["monolithic", "cosim"])
+def test_path_following_with_the_c_twin_is_the_python_path_following(fmu_dir, model, plant):
+    from rover_cosim.jobs import path_following
+
+    def system(native_stepping: bool) -> System:
+        made = (path_following.monolithic_system(fmu_dir, model, "lane_change", straight=1.0) if plant == "monolithic"
+                else path_following.cosim_system(fmu_dir, model, "lane_change", straight=1.0))
+        return short(made, 0.3, native=native_stepping)
+
+    python = run(system(False))
+    ours = system(True)
+    wiring = wire(ours)
+    with participants_of(ours, wiring) as participants:
+        master = make_master(ours, participants, wiring)
+        assert master.all_native  # the path controller is stepped by the stepper as well
+        master.close()
+    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+
+
+def test_a_change_of_an_included_header_compiles_the_twin_again(tmp_path, monkeypatch):
+    """The cache's digest covers the headers a twin includes (inverse_law.h): an edited law is
+    never served from a library built before the edit."""
+    from rover_cosim.control import path_controller
+
+    monkeypatch.setenv("ROVER_COSIM_CACHE", str(tmp_path / "cache"))
+    source = tmp_path / "twin.c"
+    source.write_text('#include "law.h"\nint twin_value(void) { return VALUE; }\n')
+    (tmp_path / "law.h").write_text("#define VALUE 1\n")
+    assert native.local_headers(path_controller.C_SOURCE) == [path_controller.C_SOURCE.with_name("inverse_law.h")]
+    native.load_library.cache_clear()
+    try:
+        first = native.load_library(source, ("twin_value",))
+        assert not isinstance(first, str) and first.twin_value() == 1
+        (tmp_path / "law.h").write_text("#define VALUE 2\n")
+        native.load_library.cache_clear()
+        second = native.load_library(source, ("twin_value",))
+        assert not isinstance(second, str) and second.twin_value() == 2
+        assert len(list((tmp_path / "cache").glob("twin-*.so"))) == 2
+    finally:
         native.load_library.cache_clear()

@@ -13,8 +13,8 @@ numbered 0, 1, ... in the block's order), which the stepper calls as it calls an
 
 ``stepper.c`` (and a native block's source) is compiled on first use with the C compiler (``$CC``
 or ``cc``) into the user's cache folder (``$ROVER_COSIM_CACHE`` or ``~/.cache/rover-cosim``), named
-by a digest of the source, written atomically so that parallel workers may race. Where no
-compiler works the masters stay in Python: :func:`unavailable_reason` says why.
+by a digest of the source and the headers beside it that it includes, written atomically so
+that parallel workers may race. Where no compiler works the masters stay in Python: :func:`unavailable_reason` says why.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -108,12 +109,19 @@ def _write_checksum(target: Path) -> None:
     os.replace(temporary, _checksum(target))
 
 
+def local_headers(source: Path) -> list[Path]:
+    """The headers beside ``source`` that it includes with quotes (``#include "name.h"``), which
+    the cached library's digest covers as well."""
+    names = re.findall(r'^\s*#\s*include\s+"([^"]+)"', source.read_text(), flags=re.MULTILINE)
+    return [source.parent / name for name in names if (source.parent / name).is_file()]
+
+
 @cache
 def load_library(source: Path, symbols: tuple[str, ...] = ()) -> ctypes.CDLL | str:
     """The C file ``source`` compiled into a shared library (cached by its digest, with a
     checksum beside it) and loaded, or why that failed. A cached library that is not whole or
     not ours is named in one line on stderr and compiled again; ``symbols``: functions it must have."""
-    digest = hashlib.sha256(source.read_bytes()).hexdigest()[:16]
+    digest = hashlib.sha256(b"".join(path.read_bytes() for path in (source, *local_headers(source)))).hexdigest()[:16]
     target = cache_folder() / f"{source.stem}-{digest}.so"
     try:
         problem = _cache_problem(target) if target.exists() else "absent"

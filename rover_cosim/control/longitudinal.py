@@ -126,6 +126,11 @@ class LongitudinalInverse:
             result[i] = self._torque_for(settled, slip + constant * rate)
         return result
 
+    def slip_for_force(self, load: float, force: float) -> float:
+        """The slip at which the Fx(W, slip) model gives ``force`` [N] at ``load`` [N] (for the
+        quadratic model, the root nearest the linear solution): the law's first step."""
+        return self._slip_for_force(load, force)
+
     def _slip_for_force(self, load: float, force: float) -> float:
         """The slip at which the Fx(W, slip) model gives ``force`` at ``load``."""
         c = [row[0] + row[1] * load + row[2] * load * load for row in self._coefficients]

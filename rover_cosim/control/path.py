@@ -9,6 +9,7 @@ heading and curvature there.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass
 
@@ -74,6 +75,8 @@ class Path:
         self.curvature = np.concatenate(curvatures)
         self.curvature[0] = self.curvature[1] if len(self.curvature) > 1 else 0.0
         self.length = float(self.s[-1])
+        # Plain floats for locate (one point at a time; its C twin reads the same tables).
+        self._tables = [column.tolist() for column in (self.s, self.x, self.y, self.heading, self.curvature)]
 
     def at(self, s: float | np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(x, y, heading, curvature) at arc length s, interpolated between samples."""
@@ -85,7 +88,8 @@ class Path:
     def locate(self, x: float, y: float, hint: int | None = None, window: float = 2.0) -> Location:
         """The nearest point of the path to (x, y); with ``hint`` (the last index) only within
         ``window`` [m] of arc length around it, so a path that comes back near itself is followed
-        in order."""
+        in order. Plain floats after the search, in the order its C twin (``path_controller.c``)
+        repeats."""
         if hint is None:
             low, high = 0, len(self.s)
         else:
@@ -95,13 +99,29 @@ class Path:
         i = low + int(np.argmin(distance))
         # Refine on the segment to the better neighbour: the foot of the perpendicular.
         j = i + 1 if i + 1 < len(self.s) else i - 1
-        a, b = np.array([self.x[i], self.y[i]]), np.array([self.x[j], self.y[j]])
-        direction = (b - a) / np.linalg.norm(b - a)
-        along = float(np.dot(np.array([x, y]) - a, direction)) * (1 if j > i else -1)
-        s = float(np.clip(self.s[i] + np.clip(along, -self.spacing, self.spacing), 0.0, self.length))
-        px, py, heading, curvature = (float(v) for v in self.at(s))
+        arc, xs, ys = self._tables[0], self._tables[1], self._tables[2]
+        dx, dy = xs[j] - xs[i], ys[j] - ys[i]
+        norm = math.sqrt(dx * dx + dy * dy)
+        along = ((x - xs[i]) * (dx / norm) + (y - ys[i]) * (dy / norm)) * (1.0 if j > i else -1.0)
+        reach_s = self.spacing
+        s = arc[i] + min(max(along, -reach_s), reach_s)
+        s = min(max(s, 0.0), self.length)
+        px, py, heading, curvature = (interpolate(arc, table, s) for table in self._tables[1:])
         cross = -math.sin(heading) * (x - px) + math.cos(heading) * (y - py)
         return Location(s, cross, heading, curvature, i)
+
+
+def interpolate(xp: list[float], fp: list[float], x: float) -> float:
+    """np.interp at one point, in plain floats: fp linear in x between the samples xp
+    (increasing), held beyond them."""
+    if not x > xp[0]:
+        return fp[0] if x == x else x
+    if x >= xp[-1]:
+        return fp[-1]
+    j = bisect.bisect_right(xp, x) - 1
+    if xp[j] == x:
+        return fp[j]
+    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
 
 
 def _sample(segment: Line | Arc | LaneChange, start: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:

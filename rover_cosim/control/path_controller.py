@@ -27,13 +27,17 @@ as an orchestrator block for the steerable rover.
 
 from __future__ import annotations
 
+import ctypes
 import math
+from collections.abc import Iterable
+from pathlib import Path as FilePath
 
 import numpy as np
 
 from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.orchestrator import native as native_code
 
-from .allocation import allocate, allocation_matrix
+from .allocation import allocation_matrix, share
 from .longitudinal import LongitudinalInverse, read_model
 from .path import Path, lane_change_path, turn_path
 
@@ -42,6 +46,15 @@ PATHS = {"turn": turn_path, "lane_change": lane_change_path}
 MAX_STEER = math.radians(45.0)    # rad: steering range
 MAX_SLIP_ANGLE = math.radians(30.0)  # rad: the lateral model's identified range
 NEWTON_STEPS = 2
+WINDOW = 2.0  # m of arc length around the last nearest point searched for the next (Path.locate's default)
+#: The block's C twin (same arithmetic, same results), for the native stepper.
+C_SOURCE = FilePath(__file__).with_name("path_controller.c")
+
+
+def _clip(value: float, low: float, high: float) -> float:
+    """np.clip of one value: min(max(value, low), high), NaN kept (as the C twin's)."""
+    value = low if low > value else value
+    return high if value > high else value
 
 
 def _names(stem: str) -> list[str]:
@@ -81,6 +94,7 @@ class PathFollowingController:
         self.x_hub = np.array([*x_limb, *x_limb], float)
         self.y_hub = np.array([y_limb] * 3 + [-y_limb] * 3, float)
         self.matrix = allocation_matrix(self.x_hub, self.y_hub)
+        self._rows = self.matrix.tolist()
         self.steer = np.zeros(WHEELS)
         self.hint: int | None = None
         self.inputs = ("x", "y", "yaw", "v", "vy", "yawRate", *_names("W"), *_names("slipAngle"))
@@ -93,71 +107,78 @@ class PathFollowingController:
                       **{n: "N.m" for n in _names("tau")}}
 
     # --- 1. tracking ----------------------------------------------------------------------------
-    def _tracking(self, t: float, u: np.ndarray) -> tuple[np.ndarray, float, dict[str, float], tuple[float, float]]:
-        """(force demand (F_x, F_y, M_z) in the heading frame, path speed, signals, (kappa, error
-        of heading))."""
-        x, y, yaw, v, vy, r = (float(value) for value in u[:6])
-        where = self.path.locate(x, y, self.hint)
+    def _tracking(self, t: float, u: list[float]) -> tuple[list[float], float, list[float], tuple[float, float]]:
+        """(force demand (F_x, F_y, M_z) in the heading frame, path speed, signals (s, s_ref,
+        cross_track, heading_error), (kappa, error of heading))."""
+        x, y, yaw, v, vy, r = u[:6]
+        where = self.path.locate(x, y, self.hint, WINDOW)
         self.hint = where.index
         offset = yaw - where.heading
-        along, across = v * math.cos(offset) - vy * math.sin(offset), v * math.sin(offset) + vy * math.cos(offset)
+        cos, sin = math.cos(offset), math.sin(offset)
+        along, across = v * cos - vy * sin, v * sin + vy * cos
         g = self.gains
         s_ref = self.v_target * t
-        a_t = float(np.clip(g["kv"] * (self.v_target - along) + g["kp"] * (s_ref - where.s), -g["a_max"], g["a_max"]))
-        a_n = float(np.clip(along**2 * where.curvature - g["k_e"] * where.cross_track - g["k_de"] * across,
-                            -g["a_n_max"], g["a_n_max"]))
-        alpha = float(np.clip(g["k_psi"] * -offset + g["k_r"] * (along * where.curvature - r),
-                              -g["alpha_max"], g["alpha_max"]))
-        demand = np.array([self.mass * (a_t * math.cos(offset) + a_n * math.sin(offset)),
-                           self.mass * (-a_t * math.sin(offset) + a_n * math.cos(offset)),
-                           self.yaw_inertia * alpha])
-        signals = {"s": where.s, "s_ref": s_ref, "cross_track": where.cross_track, "heading_error": offset}
-        return demand, along, signals, (where.curvature, offset)
+        a_t = _clip(g["kv"] * (self.v_target - along) + g["kp"] * (s_ref - where.s), -g["a_max"], g["a_max"])
+        a_n = _clip(along * along * where.curvature - g["k_e"] * where.cross_track - g["k_de"] * across,
+                    -g["a_n_max"], g["a_n_max"])
+        alpha = _clip(g["k_psi"] * -offset + g["k_r"] * (along * where.curvature - r), -g["alpha_max"],
+                      g["alpha_max"])
+        demand = [self.mass * (a_t * cos + a_n * sin), self.mass * (-a_t * sin + a_n * cos), self.yaw_inertia * alpha]
+        return demand, along, [where.s, s_ref, where.cross_track, offset], (where.curvature, offset)
 
     # --- 3. per wheel -----------------------------------------------------------------------------
-    def _inverse_steering(self, loads: np.ndarray, gamma: np.ndarray, fx: np.ndarray,
-                          fy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _inverse_steering(self, loads: Iterable[float], gamma: Iterable[float], fx: Iterable[float],
+                          fy: Iterable[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(steer, Fx_des, Fy_des): Newton on delta for Fy_model(W, gamma - delta, slip) = Fy_des(delta),
         from the last step's delta (two steps reach the solve's tolerance: delta changes by
         micro-radians per step); the slip is the one for Fx_des at the last step's delta."""
-        delta = self.steer.copy()
-        slips = self.inverse.slips_for_forces(loads, fx * np.cos(delta) + fy * np.sin(delta))
-        coefficients = self.lateral.angle_coefficients(loads, slips)
-        low = np.maximum(gamma - MAX_SLIP_ANGLE, -MAX_STEER)
-        high = np.minimum(gamma + MAX_SLIP_ANGLE, MAX_STEER)
-        for _ in range(NEWTON_STEPS):
-            cos, sin = np.cos(delta), np.sin(delta)
-            model_fy, slope = self.lateral.fy_and_slope(coefficients, gamma - delta)
-            residual = model_fy - (fy * cos - fx * sin)
-            derivative = -slope + fx * cos + fy * sin  # d/d delta of the residual
-            delta = np.clip(delta - residual / np.where(np.abs(derivative) > 1e-9, derivative, 1e-9), low, high)
-        return delta, fx * np.cos(delta) + fy * np.sin(delta), fy * np.cos(delta) - fx * np.sin(delta)
+        steer, fx_des, fy_des = [], [], []
+        for load, angle, f_x, f_y, delta in zip(map(float, loads), map(float, gamma), map(float, fx), map(float, fy),
+                                                map(float, self.steer)):
+            slip = self.inverse.slip_for_force(load, f_x * math.cos(delta) + f_y * math.sin(delta))
+            coefficients = self.lateral.angle_coefficients_at(load, slip)
+            low, high = _clip(angle - MAX_SLIP_ANGLE, -MAX_STEER, math.inf), _clip(angle + MAX_SLIP_ANGLE, -math.inf,
+                                                                                   MAX_STEER)
+            for _ in range(NEWTON_STEPS):
+                cos, sin = math.cos(delta), math.sin(delta)
+                model_fy, slope = self.lateral.fy_and_slope_at(coefficients, angle - delta)
+                residual = model_fy - (f_y * cos - f_x * sin)
+                derivative = -slope + f_x * cos + f_y * sin  # d/d delta of the residual
+                delta = _clip(delta - residual / (derivative if abs(derivative) > 1e-9 else 1e-9), low, high)
+            cos, sin = math.cos(delta), math.sin(delta)
+            steer.append(delta)
+            fx_des.append(f_x * cos + f_y * sin)
+            fy_des.append(f_y * cos - f_x * sin)
+        return np.array(steer), np.array(fx_des), np.array(fy_des)
 
     def _kinematic_steering(self, v: float, curvature: float, offset: float, cross_track: float,
-                            loads: np.ndarray, force_t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                            loads: list[float], force_t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The ablation: wheels along the hub velocities of the commanded motion; Fy_des = 0."""
         g = self.gains
         rate = v * curvature - g["k_psi"] / g["k_r"] * offset - g["k_e"] / g["k_de"] * cross_track
-        speed = max(v, 1e-3)
-        delta = np.clip(np.arctan2(rate * self.x_hub, speed - rate * self.y_hub), -MAX_STEER, MAX_STEER)
-        share = force_t * loads / loads.sum()
-        return delta, share, np.zeros(WHEELS)
+        speed = 1e-3 if 1e-3 > v else v
+        steer = [_clip(math.atan2(rate * x, speed - rate * y), -MAX_STEER, MAX_STEER)
+                 for x, y in zip(self.x_hub.tolist(), self.y_hub.tolist())]
+        total = 0.0
+        for load in loads:
+            total += load
+        return np.array(steer), np.array([force_t * load / total for load in loads]), np.zeros(WHEELS)
 
     # --- the block interface ----------------------------------------------------------------------
     def _outputs(self, t: float, u: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
-        loads = np.clip(np.asarray(u[6:6 + WHEELS], float), 1.0, None)
-        slip_angles = np.asarray(u[6 + WHEELS:6 + 2 * WHEELS], float)
-        demand, along, signals, (curvature, offset) = self._tracking(t, u)
+        values = np.asarray(u, float).tolist()
+        loads = [1.0 if 1.0 > w else w for w in values[6:6 + WHEELS]]  # np.clip(W, 1, None), NaN kept
+        slip_angles = values[6 + WHEELS:6 + 2 * WHEELS]
+        demand, along, signals, (curvature, offset) = self._tracking(t, values)
         if self.steering == "kinematic":
-            steer, fx_des, fy_des = self._kinematic_steering(along, curvature, offset, signals["cross_track"], loads,
-                                                             demand[0])
+            steer, fx_des, fy_des = self._kinematic_steering(along, curvature, offset, signals[2], loads, demand[0])
         else:
-            fx, fy = allocate(demand, self.matrix, loads)
-            steer, fx_des, fy_des = self._inverse_steering(loads, slip_angles + self.steer, fx, fy)
+            fx, fy = share(demand, self._rows, loads)
+            gamma = [a + d for a, d in zip(slip_angles, self.steer.tolist())]
+            steer, fx_des, fy_des = self._inverse_steering(loads, gamma, fx, fy)
         self.steer = steer
-        torque = self.inverse.torques(loads, fx_des, advance, step)
-        return np.concatenate([torque, steer, fx_des, fy_des,
-                               [signals["s"], signals["s_ref"], signals["cross_track"], signals["heading_error"]]])
+        torque = self.inverse.torques(np.array(loads), fx_des, advance, step)
+        return np.concatenate([torque, steer, fx_des, fy_des, signals])
 
     def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
         return self._outputs(t0, u0, advance=False)
@@ -168,6 +189,46 @@ class PathFollowingController:
 
     def set_state(self, state: tuple[np.ndarray, np.ndarray, int | None]) -> None:
         self.inverse.filter_state, self.steer, self.hint = state[0].copy(), state[1].copy(), state[2]
+
+    def native(self) -> native_code.NativeBlock | None:
+        """The block's C twin (path_controller.c) from its state now, for the native stepper; None
+        where it cannot be compiled or does not cover the models (the block then steps in Python).
+        The twin keeps its own state: a run stepped by it leaves this block's state as it was."""
+        library = native_code.load_library(C_SOURCE)
+        if isinstance(library, str) or self.inverse.model.degree not in (1, 2):
+            return None
+        terms, slips, loads_ = self.lateral.form.shape()
+        if terms > 16:
+            return None
+        real, pointer = ctypes.c_double, ctypes.c_void_p
+
+        def doubles(values: object) -> ctypes.Array:
+            flat = np.ascontiguousarray(values, dtype=float).ravel()
+            return (real * max(1, flat.size))(*flat.tolist())
+
+        library.path_new.restype = pointer
+        library.path_new.argtypes = ([pointer] + [ctypes.c_int] * 3 + [pointer] * 6 + [ctypes.c_int, pointer]
+                                     + [ctypes.c_int] * 2 + [pointer] * 5)
+        g = self.gains
+        settings = [self.mass, self.yaw_inertia, self.v_target, g["kv"], g["kp"], g["a_max"], g["k_e"], g["k_de"],
+                    g["a_n_max"], g["k_psi"], g["k_r"], g["alpha_max"], self.step_size, self.inverse.wn,
+                    1.0 if self.steering == "kinematic" else 0.0, MAX_STEER, MAX_SLIP_ANGLE, self.path.spacing,
+                    self.path.length, WINDOW]
+        table_loads, torques, settled, log_t, coefficients = self.inverse.tables()
+        path = self.path
+        bases = {"rational": 0, "exponential": 1, "polynomial": 2}
+        component = library.path_new(
+            doubles(settings), len(table_loads), len(torques), self.inverse.model.degree, doubles(table_loads),
+            doubles(torques), doubles(settled), doubles(log_t), doubles(coefficients),
+            doubles(self.inverse.filter_state), len(path.s),
+            doubles([path.s, path.x, path.y, path.heading, path.curvature]), -1 if self.hint is None else self.hint,
+            bases[self.lateral.form.basis], (ctypes.c_int * 3)(terms, slips, loads_),
+            doubles(self.lateral.form.scales_rad), doubles(self.lateral.coefficients),
+            doubles([self.x_hub, self.y_hub]), doubles(self.steer))
+        if not component:
+            raise MemoryError(f"block {self.name!r}: its C twin could not be made (tables of {len(table_loads)} loads "
+                              f"x {len(torques)} torques: expected >= 2 each; or out of memory)")
+        return native_code.NativeBlock(library, component, "path")
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         if not 0 < h <= self.step_size * (1 + 1e-9):

@@ -1,0 +1,337 @@
+/* The C twin of PathFollowingController (path_controller.py, path.py, allocation.py,
+ * identification/lateral.py, longitudinal.py) for the native stepper
+ * (rover_cosim.orchestrator.native): the same arithmetic in the same order, so that it gives the
+ * Python block's outputs bit for bit (compiled with -ffp-contract=off; checked by the tests).
+ *
+ * Inputs (value references 0 ..): x, y [m], yaw [rad], v, vy [m/s], yawRate [rad/s], W[1..6] [N],
+ * slipAngle[1..6] [rad]. Outputs: tau[1..6] [N.m], steer[1..6] [rad], Fx_des[1..6], Fy_des[1..6]
+ * [N], s, s_ref, cross_track [m], heading_error [rad]. The functions follow fmi2SetReal,
+ * fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the error's text from path_message).
+ *
+ * Per step: the nearest point of the path (Path.locate), the body's force and yaw-moment demand
+ * in the heading frame (_tracking), and per wheel either the steering and wheel-frame forces by
+ * the identified lateral and longitudinal models (allocation, then Newton on the steering,
+ * _inverse_steering) or the kinematic ablation (_kinematic_steering); the torques by the inverse
+ * longitudinal law (inverse_law.h). */
+#include "inverse_law.h"
+
+#define WHEELS 6
+#define N_INPUTS (6 + 2 * WHEELS)
+#define N_OUTPUTS (4 * WHEELS + 4)
+#define NEWTON_STEPS 2
+
+enum { MASS, YAW_INERTIA, V_TARGET, KV, KP, A_MAX, K_E, K_DE, A_N_MAX, K_PSI, K_R, ALPHA_MAX, STEP, WN, KINEMATIC,
+       MAX_STEER, MAX_SLIP_ANGLE, SPACING, LENGTH, WINDOW, N_SETTINGS };
+enum { RATIONAL, EXPONENTIAL, POLYNOMIAL };
+
+typedef struct {
+    double settings[N_SETTINGS];
+    Law law;
+    int n_path;                     /* samples of the path */
+    double *arc, *px, *py, *heading, *curvature;   /* per sample: s [m], x, y [m], heading [rad], curvature [1/m] */
+    int hint;                       /* the last nearest sample, -1: none yet */
+    int basis, terms, n_slip, n_load;
+    double *scales;                 /* beta_i [rad] */
+    double *lateral;                /* c[i][k][j], terms x n_slip x n_load */
+    double x_hub[WHEELS], y_hub[WHEELS];
+    double rows[3][2 * WHEELS];     /* the allocation matrix */
+    double steer[WHEELS];           /* the last steering [rad] */
+    double in[N_INPUTS], out[N_OUTPUTS];
+    char message[256];
+} PathController;
+
+/* _clip: min(max(value, low), high), NaN kept. */
+static double clip(double value, double low, double high) {
+    value = low > value ? low : value;
+    return value > high ? high : value;
+}
+
+/* path.interpolate: np.interp at one point. */
+static double interpolate(const double *xp, const double *fp, int n, double x) {
+    if (!(x > xp[0])) return x == x ? fp[0] : x;
+    if (x >= xp[n - 1]) return fp[n - 1];
+    int j = bisect_right(xp, n, x) - 1;
+    if (xp[j] == x) return fp[j];
+    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j];
+}
+
+typedef struct { double s, cross_track, heading, curvature; } Location;
+
+/* Path.locate: the nearest point of the path to (x, y), searched within the window around the hint. */
+static Location locate(PathController *c, double x, double y) {
+    const double *s = c->settings;
+    int n = c->n_path, low = 0, high = n;
+    if (c->hint >= 0) {
+        int reach = (int)(s[WINDOW] / s[SPACING]) + 1;
+        low = c->hint - reach > 0 ? c->hint - reach : 0;
+        high = c->hint + reach + 1 < n ? c->hint + reach + 1 : n;
+    }
+    int i = low;
+    double best = 0.0;
+    for (int k = low; k < high; k++) {  /* np.argmin: the first smallest, or the first NaN */
+        double dx = c->px[k] - x, dy = c->py[k] - y, distance = dx * dx + dy * dy;
+        if (distance != distance) { i = k; break; }
+        if (k == low || distance < best) { best = distance; i = k; }
+    }
+    c->hint = i;
+    int j = i + 1 < n ? i + 1 : i - 1;
+    double dx = c->px[j] - c->px[i], dy = c->py[j] - c->py[i];
+    double norm = sqrt(dx * dx + dy * dy);
+    double along = ((x - c->px[i]) * (dx / norm) + (y - c->py[i]) * (dy / norm)) * (j > i ? 1.0 : -1.0);
+    double at = c->arc[i] + clip(along, -s[SPACING], s[SPACING]);
+    at = clip(at, 0.0, s[LENGTH]);
+    Location where;
+    where.s = at;
+    double px = interpolate(c->arc, c->px, n, at), py = interpolate(c->arc, c->py, n, at);
+    where.heading = interpolate(c->arc, c->heading, n, at);
+    where.curvature = interpolate(c->arc, c->curvature, n, at);
+    where.cross_track = -sin(where.heading) * (x - px) + cos(where.heading) * (y - py);
+    return where;
+}
+
+/* allocation.solve3: Gaussian elimination with partial pivoting; ERROR for a singular matrix. */
+static int solve3(double a[3][4], double *z) {
+    for (int k = 0; k < 3; k++) {
+        int p = k;
+        for (int i = k + 1; i < 3; i++)
+            if (fabs(a[i][k]) > fabs(a[p][k])) p = i;
+        if (a[p][k] == 0.0) return ERROR;
+        for (int j = 0; j < 4; j++) { double t = a[k][j]; a[k][j] = a[p][j]; a[p][j] = t; }
+        for (int i = k + 1; i < 3; i++) {
+            double factor = a[i][k] / a[k][k];
+            for (int j = k; j < 4; j++) a[i][j] -= factor * a[k][j];
+        }
+    }
+    z[2] = a[2][3] / a[2][2];
+    z[1] = (a[1][3] - a[1][2] * z[2]) / a[1][1];
+    z[0] = (a[0][3] - a[0][1] * z[1] - a[0][2] * z[2]) / a[0][0];
+    return OK;
+}
+
+/* allocation.share: each wheel's (f_x, f_y) in the heading frame for the demand. */
+static int share(PathController *c, const double *demand, const double *loads, double *fx, double *fy) {
+    double d[2 * WHEELS], scaled[3][2 * WHEELS], a[3][4], z[3];
+    int carrying = 0;
+    for (int i = 0; i < WHEELS; i++) {
+        double w = 0.0 > loads[i] ? 0.0 : loads[i];
+        d[i] = d[WHEELS + i] = w;
+        carrying += w != 0.0;
+    }
+    if (carrying < 2) {
+        snprintf(c->message, sizeof c->message, "loads: at least two wheels must carry load to allocate a yaw moment");
+        return ERROR;
+    }
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 2 * WHEELS; k++) scaled[p][k] = c->rows[p][k] * d[k];
+    for (int p = 0; p < 3; p++) {
+        for (int q = 0; q < 3; q++) {
+            double total = 0.0;
+            for (int k = 0; k < 2 * WHEELS; k++) total += scaled[p][k] * c->rows[q][k];
+            a[p][q] = total;
+        }
+        a[p][3] = demand[p];
+    }
+    if (solve3(a, z) != OK) {
+        snprintf(c->message, sizeof c->message, "the allocation's matrix is singular");
+        return ERROR;
+    }
+    for (int k = 0; k < 2 * WHEELS; k++) {
+        double force = scaled[0][k] * z[0] + scaled[1][k] * z[1] + scaled[2][k] * z[2];
+        if (k < WHEELS) fx[k] = force; else fy[k - WHEELS] = force;
+    }
+    return OK;
+}
+
+/* LateralModel.angle_coefficients_at: a_i(W, slip) = sum_k sum_j c[i][k][j] slip^k W^j. */
+static void angle_coefficients(const PathController *c, double load, double slip, double *a) {
+    for (int i = 0; i < c->terms; i++) {
+        double total = 0.0;
+        for (int k = 0; k < c->n_slip; k++)
+            for (int j = 0; j < c->n_load; j++)
+                total += c->lateral[(i * c->n_slip + k) * c->n_load + j] * pow(slip, (double)k) * pow(load, (double)j);
+        a[i] = total;
+    }
+}
+
+/* LateralModel.fy_and_slope_at (LateralForm.angle_terms): Fy [N] and dFy/dbeta [N/rad]. */
+static void fy_and_slope(const PathController *c, const double *a, double beta, double *fy, double *slope) {
+    double magnitude = fabs(beta);
+    double sign = beta > 0 ? 1.0 : beta < 0 ? -1.0 : beta;
+    *fy = 0.0;
+    *slope = 0.0;
+    for (int i = 0; i < c->terms; i++) {
+        double s = c->scales[i], phi, dphi;
+        if (c->basis == POLYNOMIAL) {
+            phi = pow(beta, (double)(2 * i + 1));
+            dphi = (double)(2 * i + 1) * pow(beta, (double)(2 * i));
+        } else if (c->basis == RATIONAL) {
+            phi = beta / (magnitude + s);
+            dphi = s / ((magnitude + s) * (magnitude + s));
+        } else {
+            phi = sign * -expm1(-magnitude / s);
+            dphi = exp(-magnitude / s) / s;
+        }
+        *fy += a[i] * phi;
+        *slope += a[i] * dphi;
+    }
+}
+
+/* The outputs at time t from the inputs; ``advance``: the filter moves on by h. As
+ * PathFollowingController._outputs. */
+static int outputs(PathController *c, double t, int advance, double h) {
+    const double *g = c->settings;
+    double loads[WHEELS], steer[WHEELS], fx_des[WHEELS], fy_des[WHEELS];
+    for (int i = 0; i < WHEELS; i++) loads[i] = 1.0 > c->in[6 + i] ? 1.0 : c->in[6 + i];
+    /* 1. tracking */
+    double x = c->in[0], y = c->in[1], yaw = c->in[2], v = c->in[3], vy = c->in[4], r = c->in[5];
+    Location where = locate(c, x, y);
+    double offset = yaw - where.heading;
+    double cs = cos(offset), sn = sin(offset);
+    double along = v * cs - vy * sn, across = v * sn + vy * cs;
+    double s_ref = g[V_TARGET] * t;
+    double a_t = clip(g[KV] * (g[V_TARGET] - along) + g[KP] * (s_ref - where.s), -g[A_MAX], g[A_MAX]);
+    double a_n = clip(along * along * where.curvature - g[K_E] * where.cross_track - g[K_DE] * across, -g[A_N_MAX],
+                      g[A_N_MAX]);
+    double alpha = clip(g[K_PSI] * -offset + g[K_R] * (along * where.curvature - r), -g[ALPHA_MAX], g[ALPHA_MAX]);
+    double demand[3] = {g[MASS] * (a_t * cs + a_n * sn), g[MASS] * (-a_t * sn + a_n * cs), g[YAW_INERTIA] * alpha};
+    if (g[KINEMATIC] != 0) {
+        double rate = along * where.curvature - g[K_PSI] / g[K_R] * offset - g[K_E] / g[K_DE] * where.cross_track;
+        double speed = 1e-3 > along ? 1e-3 : along;
+        double total = 0.0;
+        for (int i = 0; i < WHEELS; i++) total += loads[i];
+        for (int i = 0; i < WHEELS; i++) {
+            steer[i] = clip(atan2(rate * c->x_hub[i], speed - rate * c->y_hub[i]), -g[MAX_STEER], g[MAX_STEER]);
+            fx_des[i] = demand[0] * loads[i] / total;
+            fy_des[i] = 0.0;
+        }
+    } else {
+        double fx[WHEELS], fy[WHEELS], coefficients[16];
+        if (c->terms > 16) return ERROR;
+        if (share(c, demand, loads, fx, fy) != OK) return ERROR;
+        for (int i = 0; i < WHEELS; i++) {
+            double delta = c->steer[i], angle = c->in[6 + WHEELS + i] + c->steer[i], slip;
+            if (slip_for_force(&c->law, loads[i], fx[i] * cos(delta) + fy[i] * sin(delta), &slip) != OK) return ERROR;
+            angle_coefficients(c, loads[i], slip, coefficients);
+            double low = clip(angle - g[MAX_SLIP_ANGLE], -g[MAX_STEER], INFINITY);
+            double high = clip(angle + g[MAX_SLIP_ANGLE], -INFINITY, g[MAX_STEER]);
+            for (int k = 0; k < NEWTON_STEPS; k++) {
+                double cd = cos(delta), sd = sin(delta), model_fy, slope;
+                fy_and_slope(c, coefficients, angle - delta, &model_fy, &slope);
+                double residual = model_fy - (fy[i] * cd - fx[i] * sd);
+                double derivative = -slope + fx[i] * cd + fy[i] * sd;
+                delta = clip(delta - residual / (fabs(derivative) > 1e-9 ? derivative : 1e-9), low, high);
+            }
+            double cd = cos(delta), sd = sin(delta);
+            steer[i] = delta;
+            fx_des[i] = fx[i] * cd + fy[i] * sd;
+            fy_des[i] = fy[i] * cd - fx[i] * sd;
+        }
+    }
+    double ad[4], bd[2];
+    law_discretisation(&c->law, advance, h, ad, bd);
+    for (int i = 0; i < WHEELS; i++) {
+        c->steer[i] = steer[i];
+        if (law_torque(&c->law, i, loads[i], fx_des[i], advance, ad, bd, &c->out[i]) != OK) return ERROR;
+        c->out[WHEELS + i] = steer[i];
+        c->out[2 * WHEELS + i] = fx_des[i];
+        c->out[3 * WHEELS + i] = fy_des[i];
+    }
+    c->out[4 * WHEELS] = where.s;
+    c->out[4 * WHEELS + 1] = s_ref;
+    c->out[4 * WHEELS + 2] = where.cross_track;
+    c->out[4 * WHEELS + 3] = offset;
+    return OK;
+}
+
+int path_set_real(void *component, const unsigned int *vr, size_t n, const double *value) {
+    PathController *c = component;
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] >= N_INPUTS) {
+            snprintf(c->message, sizeof c->message, "set_real: no such input");
+            return ERROR;
+        }
+        c->in[vr[k]] = value[k];
+    }
+    return OK;
+}
+
+int path_get_real(void *component, const unsigned int *vr, size_t n, double *value) {
+    PathController *c = component;
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] >= N_OUTPUTS) {
+            snprintf(c->message, sizeof c->message, "get_real: no such output");
+            return ERROR;
+        }
+        value[k] = c->out[vr[k]];
+    }
+    return OK;
+}
+
+int path_do_step(void *component, double t, double h, int no_prior_state) {
+    PathController *c = component;
+    (void)no_prior_state;
+    double step = c->settings[STEP];
+    if (!(0 < h && h <= step * (1 + 1e-9))) {
+        snprintf(c->message, sizeof c->message,
+                 "communication step %.15g s: expected at most its step = %.15g s (a shorter last step is fine)",
+                 h, step);
+        return ERROR;
+    }
+    return outputs(c, t + h, 1, h);
+}
+
+const char *path_message(void *component) { return ((PathController *)component)->message; }
+
+void path_free(void *component) {
+    PathController *c = component;
+    if (!c) return;
+    law_free(&c->law);
+    double *arrays[] = {c->arc, c->px, c->py, c->heading, c->curvature, c->scales, c->lateral};
+    for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) free(arrays[k]);
+    free(c);
+}
+
+/* A path controller: ``settings`` as the enum above; the law's tables as controller_new's
+ * (inverse_controller.c) with the filter state of the six wheels; the path's ``n_path`` samples
+ * (``path``: s, x, y, heading, curvature, each n_path long, one after the other) and the last
+ * nearest sample ``hint`` (-1: none); the lateral model (``basis``: 0 rational, 1 exponential,
+ * 2 polynomial; ``shape``: terms, slip powers, load powers; ``scales`` [rad]; ``lateral``: its
+ * coefficients c[i][k][j]); the hubs (``hubs``: x[6], then y[6] [m]) and the last ``steer``
+ * [rad]. All arrays are copied. NULL for bad sizes or out of memory. */
+void *path_new(const double *settings, int n_loads, int n_torques, int degree, const double *inverse,
+               const double *torques, const double *settled, const double *log_t, const double *coefficients,
+               const double *filter, int n_path, const double *path, int hint, int basis, const int *shape,
+               const double *scales, const double *lateral, const double *hubs, const double *steer) {
+    if (n_path < 2 || basis < RATIONAL || basis > POLYNOMIAL || shape[0] < 1 || shape[0] > 16 || shape[1] < 1
+        || shape[2] < 1)
+        return NULL;
+    PathController *c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    memcpy(c->settings, settings, sizeof c->settings);
+    size_t n = (size_t)n_path, size = (size_t)(shape[0] * shape[1] * shape[2]);
+    c->n_path = n_path;
+    c->hint = hint;
+    c->basis = basis; c->terms = shape[0]; c->n_slip = shape[1]; c->n_load = shape[2];
+    c->arc = law_copy(path, n);
+    c->px = law_copy(path + n, n);
+    c->py = law_copy(path + 2 * n, n);
+    c->heading = law_copy(path + 3 * n, n);
+    c->curvature = law_copy(path + 4 * n, n);
+    c->scales = law_copy(scales, (size_t)shape[0]);
+    c->lateral = law_copy(lateral, size);
+    if (law_init(&c->law, WHEELS, n_loads, n_torques, degree, settings[WN], settings[STEP], inverse, torques, settled,
+                 log_t, coefficients, filter, c->message) != 0
+        || !c->arc || !c->px || !c->py || !c->heading || !c->curvature || !c->scales || !c->lateral) {
+        path_free(c);
+        return NULL;
+    }
+    for (int i = 0; i < WHEELS; i++) {
+        c->x_hub[i] = hubs[i];
+        c->y_hub[i] = hubs[WHEELS + i];
+        c->steer[i] = steer[i];
+        c->rows[0][i] = 1.0; c->rows[0][WHEELS + i] = 0.0;
+        c->rows[1][i] = 0.0; c->rows[1][WHEELS + i] = 1.0;
+        c->rows[2][i] = -c->y_hub[i]; c->rows[2][WHEELS + i] = c->x_hub[i];
+    }
+    return c;
+}
