@@ -33,7 +33,7 @@ from typing import Any
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
-from rover_cosim.common.rows import every, steps_between_rows
+from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.identification import figures, lateral_figures
 from rover_cosim.identification.fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
 from rover_cosim.identification.lateral import (
@@ -193,7 +193,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
                    "wall_seconds": time.perf_counter() - started, "cache_folder": str(sweep.cache_folder)})
     out = Path(out_dir)
     files = {
-        out / "runs.csv": long.to_csv(index=False, float_format="%.10g").encode(),
+        out / "runs.csv": csv_bytes(long, "%.10g"),
         out / "steps.csv": table.to_csv(index=False, float_format="%.10g").encode(),
         out / "model.json": model_set.to_json(),
         out / "fit_table.csv":

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
-from rover_cosim.common.rows import every, steps_between_rows
+from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.control import path_figures
 from rover_cosim.control.adaptive import AdaptivePathController, Calibration
 from rover_cosim.control.path import Path as ReferencePath
@@ -250,8 +250,8 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
                    "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
     out = Path(out_dir)
     suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic"}
-    files = {out / f"path_{s}{suffix[label]}.csv": every(table, record_interval, STEP).to_csv(
-        index=False, float_format="%.8g").encode() for (s, label), table in tables.items()}
+    files = {out / f"path_{s}{suffix[label]}.csv": csv_bytes(every(table, record_interval, STEP), "%.8g")
+             for (s, label), table in tables.items()}
     files.update({
         out / "path_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "path_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),

@@ -24,7 +24,7 @@ import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
-from rover_cosim.common.rows import every, steps_between_rows
+from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.control.adaptive import AdaptiveController, Calibration
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
@@ -267,10 +267,8 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
         record["adaptation"] = adaptation
     out = Path(out_dir)
     files = {
-        out / "trajectories.csv": every(tables["monolithic"], record_interval, STEP).to_csv(
-            index=False, float_format="%.8g").encode(),
-        out / "trajectories_cosim.csv": every(tables["cosim"], record_interval, STEP).to_csv(
-            index=False, float_format="%.8g").encode(),
+        out / "trajectories.csv": csv_bytes(every(tables["monolithic"], record_interval, STEP), "%.8g"),
+        out / "trajectories_cosim.csv": csv_bytes(every(tables["cosim"], record_interval, STEP), "%.8g"),
         out / "rms.csv": rms_mono.to_csv(index=False, float_format="%.4f").encode(),
         out / "rms_cosim.csv": rms_cosim.to_csv(index=False, float_format="%.4f").encode(),
         out / "ablation_fixed_load.csv": ablation_table.to_csv(index=False, float_format="%.4f").encode(),
@@ -280,8 +278,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
         out / "simulation.json": json_bytes(record),
     }
     if adapt is not None:
-        files[out / "trajectories_adaptive.csv"] = every(tables["adaptive"], record_interval, STEP).to_csv(
-            index=False, float_format="%.8g").encode()
+        files[out / "trajectories_adaptive.csv"] = csv_bytes(every(tables["adaptive"], record_interval, STEP), "%.8g")
         files[out / "rms_adaptive.csv"] = rms(tables["adaptive"]).to_csv(index=False, float_format="%.4f").encode()
         files[out / "fig10_closed_loop_adaptive.png"] = fig10(tables["adaptive"], "Rover.fmu, adaptive controller")
     write_all(files, folder=out, stale=("fig10_*", "fig_tracking.*", "*_adaptive.*"))  # path following's stay
