@@ -34,7 +34,9 @@ class Execution:
         self.slot_names = [names.get(slot, f"slot {slot}") for slot in range(wiring.size)]
         self.output_names = {p.name: wiring.participants[p.name].outputs for p in participants}
         self.stages = algorithm.stages(self.participants, self.inputs, self.outputs, threads)
-        self.native = self._native(threads) if algorithm.explicit and use_native else None
+        #: Whether participants may be stepped from C at all (explicit algorithm, native stepping on).
+        self.native_enabled = algorithm.explicit and use_native
+        self.native = self._native(threads) if self.native_enabled else None
         self.natively: frozenset[int] = self.native.members if self.native is not None else frozenset()
         self.python: PythonExecutor
         if algorithm.explicit and threads > 1 and self.native is None:

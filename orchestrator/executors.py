@@ -115,7 +115,8 @@ class NativeExecutor:
     def close(self, step_seconds: dict[str, float]) -> None:
         """Free the stepper, adding the time inside each unit to ``step_seconds``."""
         if self.stepper is not None:
-            step_seconds.update(self.stepper.seconds())
+            for name, seconds in self.stepper.seconds().items():
+                step_seconds[name] = step_seconds.get(name, 0.0) + seconds
             self.stepper.close()
             self.stepper = None
 

@@ -21,6 +21,7 @@ from .execution import Execution, make_execution
 from .fmi_access import StringTable
 from .model import FmuEntry, Port, System
 from .model_exchange import make_fmu_participant
+from .native import unavailable_reason
 from .observers import (
     FiniteCheck,
     Observer,
@@ -155,12 +156,15 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
             watchers.append(Progress(progress, n_steps))
         try:
             stopped = _sample(watchers, 0, system.start_time, values)
-            if stopped is not None:
-                steps = 0
-            elif execution.all_native and not any(map(watches_every_step, observers)):
-                steps = _run_stretches(execution, values, times, recorder, watchers)
-            else:
-                steps, stopped = _run_steps(execution, values, times, watchers)
+            steps, every_step = 0, any(map(watches_every_step, observers))
+            while stopped is None and steps < n_steps:
+                if execution.all_native and not every_step:
+                    steps = _run_stretches(execution, values, times, recorder, watchers, steps)
+                    break
+                steps, stopped, late = _run_steps(execution, values, times, watchers, steps)
+                if late:  # a block now offers its C twin: the run goes on with a new execution
+                    execution = _handed_over(system, participants, wiring, execution, watchers)
+                    stack.callback(execution.close)
         except Terminated as end:  # an FMU ended the simulation: a clean end at the start of that step
             _last_row(participants, execution, values, times, recorder, end)
             steps, stopped = recorder.filled - 1, str(end)
@@ -200,24 +204,50 @@ def _sample(watchers: list[Watcher], k: int, t: float, values: np.ndarray) -> st
     return stop
 
 
-def _run_steps(execution: Execution, values: np.ndarray, times: np.ndarray,
-               watchers: list[Watcher]) -> tuple[int, str | None]:
-    """Step by step to the end, or until an observer stops the run: (steps run, why it stopped)."""
+def native_stepping_available() -> bool:
+    return unavailable_reason() is None
+
+
+def _run_steps(execution: Execution, values: np.ndarray, times: np.ndarray, watchers: list[Watcher],
+               first: int = 0) -> tuple[int, str | None, bool]:
+    """Step by step from step ``first`` to the end, until an observer stops the run, or until a
+    block stepped in Python offers its C twin: (steps run in all, why it stopped, handed over)."""
     n_steps = len(times) - 1
-    for k in range(n_steps):
+    python_stepped = (execution.participants[i] for i in execution.checked_in_python)
+    late = [p for p in python_stepped if isinstance(p, BlockParticipant) and hasattr(p.block, "native_ready")
+            and execution.native_enabled and native_stepping_available()]
+    for k in range(first, n_steps):
         execution.step(values, float(times[k]), float(times[k + 1] - times[k]))
         reason = _sample(watchers, k + 1, float(times[k + 1]), values)
         if reason is not None:
-            return k + 1, reason
-    return n_steps, None
+            return k + 1, reason, False
+        if late and any(block.ready_for_native() for block in late):
+            return k + 1, None, True
+    return n_steps, None, False
+
+
+def _handed_over(system: System, participants: list[Participant], wiring: Wiring, execution: Execution,
+                 watchers: list[Watcher]) -> Execution:
+    """A new execution of the same participants, now that a block offers its C twin (made from
+    the block's state at this step); the time inside each participant carries over."""
+    seconds = execution.step_seconds
+    execution.close()
+    after = make_execution(system, participants, wiring)
+    for name, spent in seconds.items():
+        after.step_seconds[name] += spent
+    for watcher in watchers:
+        if isinstance(watcher, FiniteCheck):
+            watcher.execution, watcher.checked = after, after.checked_in_python
+    return after
 
 
 def _run_stretches(execution: Execution, values: np.ndarray, times: np.ndarray, recorder: Recorder,
-                   watchers: list[Watcher]) -> int:
-    """A system stepped natively throughout: stretches of steps in one native call each, recorded in place."""
+                   watchers: list[Watcher], start: int = 0) -> int:
+    """A system stepped natively throughout: from step ``start``, stretches of steps in one native
+    call each, recorded in place."""
     n_steps = len(times) - 1
     record = np.ascontiguousarray(recorder.slots, dtype=np.int64)
-    for first in range(0, n_steps, NATIVE_STRETCH):
+    for first in range(start, n_steps, NATIVE_STRETCH):
         last = min(first + NATIVE_STRETCH, n_steps)
         try:
             reached, failed = execution.run_stretch(values, times, first, last, record, recorder.rows)

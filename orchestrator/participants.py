@@ -101,7 +101,17 @@ class BlockParticipant:
         self.outputs = list(block.outputs)
         self.last = np.zeros(len(self.outputs))
         self.native: NativeBlock | None = None
-        self._asked = False
+        self._asked = self._asked_again = False
+
+    def ready_for_native(self) -> bool:
+        """Whether a block stepped in Python now offers its C twin: its ``native_ready()`` (an
+        optional method; e.g. an adaptive controller once it has switched to the law its twin
+        steps) says so; :meth:`make_native` then asks it again."""
+        ready = getattr(self.block, "native_ready", None)
+        if self.native is not None or self._asked_again or ready is None or not ready():
+            return False
+        self._asked, self._asked_again = False, True  # asked again once: a block that then has none stays in Python
+        return True
 
     def make_native(self) -> bool:
         """Ask the block once for its C twin (``native()``, made from the block's state now, after

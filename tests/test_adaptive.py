@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from rover_cosim.control.adaptive import Calibration
@@ -230,3 +231,43 @@ def test_the_path_controller_learns_the_soil_on_the_first_straight(fmu_dir, iden
         assert load == pytest.approx(data.loc[near, f"rover.Fz[{i}]"], abs=1e-9)
         assert slip == pytest.approx(data.loc[near, f"rover.slip[{i}]"], abs=2e-5)
         assert torque == pytest.approx(data.loc[near, f"rover.Tx[{i}]"], abs=0.05)
+
+
+@pytest.mark.parametrize("scenario", ["straight", "path"])
+def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identified, tmp_path, monkeypatch, scenario):
+    """Once calibrated, an adaptive block steps its law alone and offers that law's C twin: the
+    engine hands the block over to the native stepper at that step (once), and the run equals
+    the one stepped in Python throughout, to the bit."""
+    from rover_cosim.jobs import path_following
+    from rover_cosim.orchestrator import master
+    from rover_cosim.orchestrator.builder import replace_settings
+
+    model = identified.files[0].parent / "model.json"
+    truth = library.vary(library.choose(), TRUTH, {})
+
+    def system(native: bool) -> Any:
+        made = (simulate.adaptive_system(fmu_dir, model, truth, calibration=Calibration(duration=1.0, segment=0.25),
+                                         cache_dir=tmp_path) if scenario == "straight" else
+                path_following.adaptive_system(fmu_dir, model, "lane_change", truth,
+                                               calibration=Calibration(duration=1.0, segment=0.25), cache_dir=tmp_path,
+                                               straight=3.0))
+        return replace_settings(made, stop_time=2.0, native=native)
+
+    handovers: list[float] = []
+    original = master._handed_over
+
+    def counted(*args: Any) -> Any:
+        after = original(*args)
+        handovers.append(1.0)
+        assert after.all_native  # the FMU and the controller both stepped from C from here on
+        return after
+
+    monkeypatch.setattr(master, "_handed_over", counted)
+    python = run(system(False))
+    assert not handovers  # native stepping off: nothing to hand over
+    ours = system(True)
+    native = run(ours)
+    block: Any = next(b.block for b in ours.blocks if b.name == "ctrl")
+    assert block.switched_at is not None and block.switched_at < 1.9 and len(handovers) == 1  # (a crawling rover
+    # calibrates a little longer)
+    pd.testing.assert_frame_equal(python.data, native.data, check_exact=True)

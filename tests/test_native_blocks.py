@@ -247,3 +247,52 @@ def test_a_change_of_an_included_header_compiles_the_twin_again(tmp_path, monkey
         assert len(list((tmp_path / "cache").glob("twin-*.so"))) == 2
     finally:
         native.load_library.cache_clear()
+
+
+class _LateWithoutTwin:
+    """A torque source that says it is ready for the native stepper after 0.05 s but then has no
+    C twin: the engine asks it once more, and it steps in Python to the end."""
+
+    name = "late"
+    inputs: tuple[str, ...] = ()
+    outputs: tuple[str, ...] = ("y",)
+    units = {"y": "N.m"}
+
+    def __init__(self) -> None:
+        self.t, self.asked = 0.0, 0
+
+    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+        return np.array([20.0])
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        self.t = t + h
+        return np.array([20.0])
+
+    def native_ready(self) -> bool:
+        return self.t >= 0.05
+
+    def native(self) -> None:
+        self.asked += 1
+        return None
+
+
+def test_a_block_ready_for_a_twin_it_then_lacks_is_asked_once_and_steps_on_in_python(fmu_dir, monkeypatch):
+    from rover_cosim.orchestrator import master
+    from rover_cosim.orchestrator.builder import SystemBuilder
+
+    handovers: list[int] = []
+    original = master._handed_over
+
+    def counted(*args: Any) -> Any:
+        handovers.append(1)
+        return original(*args)
+
+    monkeypatch.setattr(master, "_handed_over", counted)
+    block = _LateWithoutTwin()
+    builder = SystemBuilder("late").simulation(stop_time=0.2, step=1e-3, algorithm="gauss-seidel")
+    builder.add_fmu("wheel", fmu_dir / "Wheel.fmu", start={"W": 424.0, "v_hub": 0.0})
+    builder.add_block("late", block).connect("late.y", "wheel.tau")
+    result = run(builder.build())
+    assert len(result.data) == 201 and result.steps == 200
+    assert block.asked == 2 and handovers == [1]  # at the start, and once when it said it was ready
+    assert result.step_seconds["late"] > 0  # stepped in Python to the end

@@ -34,6 +34,7 @@ switched and what it cost.
 
 from __future__ import annotations
 
+import ctypes
 import itertools
 import math
 import time
@@ -126,7 +127,29 @@ class Calibrating:
         self._spins: np.ndarray | None = None        # the wheel spins at the last call [rad/s]
 
     def native(self) -> native_code.NativeBlock | None:
-        return None  # the calibration and the switch-over are Python: the block steps in Python
+        """None while calibrating (the calibration and the switch-over are Python); afterwards the
+        C twin of the law the block then steps alone (``_law_twin``), made from its state now."""
+        if self.calibrated_until is None:
+            return None
+        return self._law_twin()
+
+    def native_ready(self) -> bool:
+        """Whether the engine may ask again for a C twin: the calibration has ended (adapted or
+        not, the block now steps its law alone, which its twin repeats bit for bit)."""
+        return self.calibrated_until is not None
+
+    def _law_twin(self) -> native_code.NativeBlock | None:
+        raise NotImplementedError
+
+    @staticmethod
+    def _ignoring(twin: native_code.NativeBlock | None, function: str, count: int) -> native_code.NativeBlock | None:
+        """``twin``, told to accept and ignore the ``count`` inputs after its law's (the telemetry)."""
+        if twin is not None:
+            ignore = getattr(twin.library, function)
+            ignore.argtypes = [ctypes.c_void_p, ctypes.c_int]
+            ignore.restype = None
+            ignore(twin.component, count)
+        return twin
 
     def _apply(self, adaptation: Adaptation) -> None:
         raise NotImplementedError
@@ -241,6 +264,10 @@ class AdaptiveController(Calibrating, InverseModelController):
         self.model = adaptation.model
         self.inverse = LongitudinalInverse(self.model, WHEELS, self.inverse.wn, self.step_size, self.name)
 
+    def _law_twin(self) -> native_code.NativeBlock | None:
+        return self._ignoring(InverseModelController.native(self), "controller_ignore_inputs",
+                              len(self.inputs) - (2 + WHEELS))
+
     def _outputs(self, t: float, u: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
         if self.calibrated_until is None:
             h = (step or self.step_size) if advance else None
@@ -301,6 +328,10 @@ class AdaptivePathController(Calibrating, PathFollowingController):
         self.inverse = LongitudinalInverse(adaptation.model, WHEELS, self.inverse.wn, self.step_size, self.name)
         if adaptation.lateral is not None:
             self.lateral = adaptation.lateral
+
+    def _law_twin(self) -> native_code.NativeBlock | None:
+        return self._ignoring(PathFollowingController.native(self), "path_ignore_inputs",
+                              len(self.inputs) - (6 + 2 * WHEELS))
 
     def _hub_speeds(self, u: np.ndarray, pitch: float, roll: float, pitch_rate: float, roll_rate: float) -> np.ndarray:
         """The hubs' velocities along the wheels [m/s] (SteerableChassis' kinematics)."""

@@ -16,6 +16,7 @@ enum { MASS, V_TARGET, KV, KP, A_MAX, WN, STEP, FIXED_LOAD, N_SETTINGS };
 
 typedef struct {
     int wheels;
+    int ignored;                    /* inputs after the law's that are accepted and not read */
     double settings[N_SETTINGS];
     Law law;                        /* the inverse model (inverse_law.h) */
     double *in, *out;
@@ -50,8 +51,8 @@ static int outputs(Controller *c, double t, int advance, double h) {
 int controller_set_real(void *component, const unsigned int *vr, size_t n, const double *value) {
     Controller *c = component;
     for (size_t k = 0; k < n; k++) {
-        if (vr[k] >= (unsigned int)(2 + c->wheels)) return fail(c, "set_real: no such input");
-        c->in[vr[k]] = value[k];
+        if (vr[k] >= (unsigned int)(2 + c->wheels + c->ignored)) return fail(c, "set_real: no such input");
+        if (vr[k] < (unsigned int)(2 + c->wheels)) c->in[vr[k]] = value[k];
     }
     return OK;
 }
@@ -77,6 +78,10 @@ int controller_do_step(void *component, double t, double h, int no_prior_state) 
     }
     return outputs(c, t + h, 1, h);
 }
+
+/* Accept ``count`` inputs after the law's (value references 2 + wheels ..) and ignore them: the
+ * inputs of a block that steps this law after a phase of its own (the adaptive controller). */
+void controller_ignore_inputs(void *component, int count) { ((Controller *)component)->ignored = count > 0 ? count : 0; }
 
 const char *controller_message(void *component) { return ((Controller *)component)->message; }
 

@@ -30,6 +30,7 @@ typedef struct {
     int n_path;                     /* samples of the path */
     double *arc, *px, *py, *heading, *curvature;   /* per sample: s [m], x, y [m], heading [rad], curvature [1/m] */
     int hint;                       /* the last nearest sample, -1: none yet */
+    int ignored;                    /* inputs after the law's that are accepted and not read */
     int basis, terms, n_slip, n_load;
     double *scales;                 /* beta_i [rad] */
     double *lateral;                /* c[i][k][j], terms x n_slip x n_load */
@@ -246,11 +247,11 @@ static int outputs(PathController *c, double t, int advance, double h) {
 int path_set_real(void *component, const unsigned int *vr, size_t n, const double *value) {
     PathController *c = component;
     for (size_t k = 0; k < n; k++) {
-        if (vr[k] >= N_INPUTS) {
+        if (vr[k] >= (unsigned int)(N_INPUTS + c->ignored)) {
             snprintf(c->message, sizeof c->message, "set_real: no such input");
             return ERROR;
         }
-        c->in[vr[k]] = value[k];
+        if (vr[k] < N_INPUTS) c->in[vr[k]] = value[k];
     }
     return OK;
 }
@@ -279,6 +280,9 @@ int path_do_step(void *component, double t, double h, int no_prior_state) {
     }
     return outputs(c, t + h, 1, h);
 }
+
+/* Accept ``count`` inputs after the law's and ignore them (the adaptive path controller's telemetry). */
+void path_ignore_inputs(void *component, int count) { ((PathController *)component)->ignored = count > 0 ? count : 0; }
 
 const char *path_message(void *component) { return ((PathController *)component)->message; }
 
