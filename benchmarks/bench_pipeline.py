@@ -72,10 +72,13 @@ def monte_carlo_runs(folder: Path) -> int | None:
     return max(0, len(path.read_text().splitlines()) - 1)
 
 
-def time_stage(name: str, arguments: list[str], folder: Path) -> dict[str, Any]:
+def time_stage(name: str, arguments: list[str], folder: Path, code: Path | None = None) -> dict[str, Any]:
+    """One stage as a whole process; ``code``: a checkout whose ``rover_cosim`` to run instead."""
     quiet = [] if arguments[0] in ("fig3", "report") else ["--quiet"]  # commands with progress bars
     argv = [sys.executable, "-P", "-m", "rover_cosim", *arguments, *quiet]
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}  # as installed
+    if code is not None:
+        env["PYTHONPATH"] = str(code)
     started = time.perf_counter()
     done = subprocess.run(argv, capture_output=True, text=True, check=False, env=env)
     wall = time.perf_counter() - started
@@ -99,27 +102,41 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--out", type=Path, default=Path("results/bench/pipeline.json"))
     parser.add_argument("--runs", type=int, default=200, help="Monte Carlo samples (default 200)")
-    parser.add_argument("--only", nargs="*", default=None, help="stage names to time (default: all; the ones a "
-                        "stage needs are run first, untimed)")
+    parser.add_argument("--only", nargs="*", default=None, help="stage names to record (default: all; every stage "
+                        "runs, since each may need what the ones before it wrote)")
+    parser.add_argument("--baseline", type=Path, default=None, help="a checkout of another commit: every stage also "
+                        "runs with its code, right after ours, into a folder of its own (ratios side by side)")
     args = parser.parse_args()
     if args.runs < 2:
         parser.error(f"--runs={args.runs}: expected an integer >= 2")
     results: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="bench-pipeline-") as scratch:
-        folder = Path(scratch)
-        for name, arguments in stages(folder, args.runs):
+        folder, other = Path(scratch) / "ours", Path(scratch) / "baseline"
+        pairs = zip(stages(folder, args.runs), stages(other, args.runs))
+        for (name, arguments), (_, baseline_arguments) in pairs:
             entry = time_stage(name, arguments, folder)
+            if args.baseline is not None:
+                entry["baseline"] = time_stage(name, baseline_arguments, other, args.baseline)
+                entry["ratio_to_baseline"] = entry["wall_seconds"] / entry["baseline"]["wall_seconds"]
             timed = args.only is None or name in args.only
             print(f"{name:24s} {entry['wall_seconds']:8.1f} s  exit {entry['exit_code']}"
                   + (f"  {entry['runs_per_minute']:.0f} runs/min" if "runs_per_minute" in entry else "")
                   + (f"  {entry['real_time_factor']:.1f}x real time" if "real_time_factor" in entry else "")
+                  + (f"  (baseline {entry['baseline']['wall_seconds']:.1f} s: {entry['ratio_to_baseline']:.2f}x)"
+                     if "baseline" in entry else "")
                   + ("" if timed else "  (not recorded)"))
-            if entry["exit_code"] != 0:
-                print(entry["stderr"], file=sys.stderr)
+            for run in (entry, entry.get("baseline", {})):
+                if run.get("exit_code", 0) != 0:
+                    print(run["stderr"], file=sys.stderr)
             if timed:
                 results[name] = entry
-    record = run_record("make bench", {"monte_carlo_runs": args.runs, "cpus": os.cpu_count()})
-    write_all({args.out: json_bytes({**record, "stages": results,
+    baseline = None
+    if args.baseline is not None:
+        done = subprocess.run(["git", "-C", str(args.baseline), "rev-parse", "HEAD"], capture_output=True, text=True,
+                              check=False)
+        baseline = {"path": str(args.baseline), "git_commit": done.stdout.strip() or None}
+    record = run_record("make bench", {"monte_carlo_runs": args.runs, "cpus": os.cpu_count(), "baseline": baseline})
+    write_all({args.out: json_bytes({**record, "results": results,
                                      "note": "each stage a whole rover-cosim process, one after the other, into "
                                              "a fresh scratch folder (no caches from earlier runs)"})})
     print(f"wrote {args.out}")
