@@ -12,7 +12,6 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
-from pathlib import Path
 
 import numpy as np
 
@@ -35,7 +34,7 @@ from .observers import (
 )
 from .participants import BlockParticipant, Participant, RunError, Terminated
 from .recorder import Recorder, RunResult, communication_points
-from .unpacking import UNZIP_PREFIX, remove_stale_folders, run_folder, unpack
+from .unpacking import UNZIP_PREFIX, once_per_process, remove_stale_folders, run_folder, unpack
 from .wiring import Wiring, wire
 
 #: Passes of the initial-output exchange among participants with an iterative start (FMUs in
@@ -75,16 +74,16 @@ def initialize(participants: list[Participant], wiring: Wiring, values: np.ndarr
 @contextmanager
 def participants_of(system: System, wiring: Wiring,
                     strings: StringTable | None = None) -> Iterator[list[Participant]]:
-    """The participants of ``system`` in its order, FMUs unpacked into this run's temporary
-    folder (``unpacking``); every FMU is terminated and freed on leaving, whatever happened.
+    """The participants of ``system`` in its order, FMUs unpacked once per process (``unpacking``);
+    every FMU is terminated and freed on leaving, whatever happened.
     ``strings``: the run's String table (the recorder reads the recorded Strings from it)."""
     strings = strings if strings is not None else StringTable()
     with ExitStack() as stack:
-        unzip_root = stack.enter_context(run_folder())
+        own = any(map(once_per_process, system.fmus))  # FMUs that need a copy per instance
+        unzip_root = stack.enter_context(run_folder()) if own else None
         by_name: dict[str, Participant] = {}
-        unpacked: dict[Path, Path] = {}
         for entry in system.fmus:
-            fmu = make_fmu_participant(entry, unpack(entry, unzip_root, unpacked), strings, system.relative_tolerance)
+            fmu = make_fmu_participant(entry, unpack(entry, unzip_root), strings, system.relative_tolerance)
             stack.callback(fmu.close)
             ports = wiring.participants[entry.name]
             fmu.configure(ports.inputs, ports.outputs)

@@ -1,17 +1,22 @@
-"""Where a run's FMUs are unpacked: one temporary folder per run,
-``<tmp>/rover-cosim-run-<pid>-<random>``, removed when the run ends whatever happened; folders
-left by processes that were killed (SIGKILL, where no clean-up runs) are removed by the next run
-(``common.scratch``).
+"""Where runs' FMUs are unpacked: one temporary folder per process,
+``<tmp>/rover-cosim-run-<pid>-<random>``, made at the first run and removed when the process
+exits; folders left by processes that were killed (SIGKILL, where no clean-up runs) are removed
+by the next command (``common.scratch``).
 
-Instances of one FMU file share one unpacked copy, and so the library loaded from it (six wheels
-of one Wheel.fmu: one copy, one library), as FMI allows unless the FMU says
-``canBeInstantiatedOnlyOncePerProcess``: such an FMU gets a copy per instance, each loaded as a
-library of its own.
+An FMU file is unpacked once per process, by its path, size and modification time: the runs of a
+Monte Carlo worker or of a script reuse the copy (an FMU file that changes is unpacked again).
+Instances of one FMU file share that copy, and so the library loaded from it (six wheels of one
+Wheel.fmu: one copy, one library), as FMI allows unless the FMU says
+``canBeInstantiatedOnlyOncePerProcess``: such an FMU gets a copy per instance in a folder of the
+run (``run_folder``), each loaded as a library of its own.
 """
 
 from __future__ import annotations
 
+import atexit
+import shutil
 import tempfile
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -22,31 +27,68 @@ from rover_cosim.common.scratch import PREFIX, remove_stale_folders, scratch_pre
 
 from .model import FmuEntry
 
-#: The temporary folder of a run's unpacked FMUs: ``<tmp>/rover-cosim-run-<pid>-<random>``.
+#: The temporary folder of a process's unpacked FMUs: ``<tmp>/rover-cosim-run-<pid>-<random>``.
 UNZIP_PREFIX = f"{PREFIX}run-"
+
+
+class _ProcessCopies:
+    """This process's unpacked FMU files, by (path, size, modification time)."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.root: Path | None = None
+        self.folders: dict[tuple[str, int, int], Path] = {}
+
+    def folder(self, path: Path) -> Path:
+        stat = path.stat()
+        key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+        with self.lock:
+            found = self.folders.get(key)
+            if found is not None and (found / "modelDescription.xml").is_file():
+                return found
+            target = Path(tempfile.mkdtemp(prefix="fmu-", dir=self._root()))
+            fmpy.extract(str(path), str(target))
+            self.folders[key] = target
+            return target
+
+    def _root(self) -> Path:
+        if self.root is None or not self.root.is_dir():
+            remove_stale_folders()
+            self.root = Path(tempfile.mkdtemp(prefix=scratch_prefix("run")))
+            self.folders.clear()
+            atexit.register(shutil.rmtree, self.root, True)
+        return self.root
+
+
+_COPIES = _ProcessCopies()
 
 
 @contextmanager
 def run_folder() -> Iterator[Path]:
-    """A new temporary folder for this run's FMUs (stale ones removed first), removed on leaving."""
+    """A new temporary folder for one run's own copies (FMUs instantiated once per process),
+    removed on leaving."""
     remove_stale_folders()
     with tempfile.TemporaryDirectory(prefix=scratch_prefix("run")) as folder:
         yield Path(folder)
 
 
-def unpack(entry: FmuEntry, root: Path, shared: dict[Path, Path] | None = None) -> Path:
-    """The folder under ``root`` holding ``entry``'s FMU unpacked: ``shared`` (file -> folder, kept
-    by the caller for one run) gives the copy an earlier instance of the same file made, unless
-    the FMU can be instantiated only once per process."""
-    once = bool(getattr(entry.capabilities, "canBeInstantiatedOnlyOncePerProcess", False))
-    key = Path(entry.path).resolve()
-    if shared is not None and not once and key in shared:
-        return shared[key]
-    folder = root / entry.name
-    fmpy.extract(str(entry.path), str(folder))
-    if shared is not None and not once:
-        shared[key] = folder
-    return folder
+def once_per_process(entry: FmuEntry) -> bool:
+    """Whether ``entry``'s FMU says it can be instantiated only once per process."""
+    return bool(getattr(entry.capabilities, "canBeInstantiatedOnlyOncePerProcess", False))
 
 
-__all__ = ["UNZIP_PREFIX", "remove_stale_folders", "run_folder", "unpack"]
+def unpack(entry: FmuEntry, root: Path | None = None) -> Path:
+    """The folder holding ``entry``'s FMU unpacked: the process's copy of its file, or, for an FMU
+    that can be instantiated only once per process, a copy of its own under ``root`` (a
+    ``run_folder``)."""
+    if once_per_process(entry):
+        if root is None:
+            raise ValueError(f"{entry.name}: {Path(entry.path).name} can be instantiated only once per process: "
+                             "expected a run folder for its own copy")
+        folder = root / entry.name
+        fmpy.extract(str(entry.path), str(folder))
+        return folder
+    return _COPIES.folder(Path(entry.path))
+
+
+__all__ = ["UNZIP_PREFIX", "once_per_process", "remove_stale_folders", "run_folder", "unpack"]

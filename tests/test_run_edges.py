@@ -4,6 +4,7 @@ values, partial results, algebraic loops, the temporary folder of unpacked FMUs,
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -11,8 +12,10 @@ import tempfile
 import time
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from rover_cosim.cli import EXAMPLES, main
@@ -131,7 +134,8 @@ def test_a_signal_ends_a_run_with_one_line_and_no_leftovers(fmu_dir, fmus, tmp_p
                                 str(fmu_dir), "--stop-time", "600", "-o", str(tmp_path / "out.csv"), "--quiet"],
                                stderr=subprocess.PIPE, text=True, env=env)
     deadline = time.time() + 180  # a busy machine: start-up and unpacking take their time
-    while not list(tmp_path.glob(f"{UNZIP_PREFIX}*/wheel1")) and time.time() < deadline and process.poll() is None:
+    unpacked = f"{UNZIP_PREFIX}*/fmu-*/modelDescription.xml"
+    while not list(tmp_path.glob(unpacked)) and time.time() < deadline and process.poll() is None:
         time.sleep(0.1)
     if not list(tmp_path.glob(f"{UNZIP_PREFIX}*")):
         process.kill()
@@ -222,3 +226,31 @@ def test_outputs_do_not_replace_what_the_command_did_not_write(fmu_dir, fmus, tm
     (tmp_path / "other.ssp").write_text("not mine")
     assert main([*export, str(tmp_path / "other.ssp")]) == 2
     assert (tmp_path / "other.ssp").read_text() == "not mine"
+
+
+def test_a_process_unpacks_an_fmu_file_once_and_again_when_it_changes(fmu_dir, fmus, tmp_path):
+    """Runs in one process share one unpacked copy of each FMU file (a Monte Carlo worker's runs,
+    a script's), and so do the instances of one run; a file that changed (its modification time)
+    is unpacked anew."""
+    from rover_cosim.orchestrator.builder import SystemBuilder
+    from rover_cosim.orchestrator.unpacking import unpack
+
+    copy = tmp_path / "Wheel.fmu"
+    shutil.copyfile(fmus["Wheel"], copy)
+
+    def system() -> Any:
+        builder = SystemBuilder("two wheels").simulation(stop_time=0.01, step=1e-3)
+        for name in ("a", "b"):
+            builder.add_fmu(name, copy, start={"W": 424.0, "v_hub": 0.0, "tau": 20.0})
+        return builder.build()
+
+    first = run(system())
+    entry = system().fmus[0]
+    folder = unpack(entry)
+    assert unpack(system().fmus[1]) == folder and (folder / "modelDescription.xml").is_file()
+    second = run(system())
+    pd.testing.assert_frame_equal(first.data, second.data, check_exact=True)
+    assert unpack(entry) == folder  # the same copy, run after run
+    os.utime(copy, ns=(copy.stat().st_atime_ns, copy.stat().st_mtime_ns + 10**9))  # the file changed
+    changed = system().fmus[0]
+    assert unpack(changed) != folder and run(system()).data.equals(first.data)
