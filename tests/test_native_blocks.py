@@ -35,27 +35,29 @@ def model(identified, results_root) -> Path:
 
 
 class Twin:
-    """The C twin of a block, called as the stepper calls it."""
+    """The C twin of a block (its functions ``<prefix>_...``), called as the stepper calls it."""
 
-    def __init__(self, block: InverseModelController):
+    def __init__(self, block: InverseModelController | PathFollowingController, prefix: str = "controller"):
         made = block.native()
         assert made is not None
-        self.made, self.library = made, made.library
+        self.made, self.library, self.prefix = made, made.library, prefix
         pointer = ctypes.c_void_p
         for name in ("set_real", "get_real"):
-            getattr(self.library, f"controller_{name}").argtypes = [pointer, pointer, ctypes.c_size_t, pointer]
-        self.library.controller_do_step.argtypes = [pointer, ctypes.c_double, ctypes.c_double, ctypes.c_int]
+            getattr(self.library, f"{prefix}_{name}").argtypes = [pointer, pointer, ctypes.c_size_t, pointer]
+        getattr(self.library, f"{prefix}_do_step").argtypes = [pointer, ctypes.c_double, ctypes.c_double, ctypes.c_int]
         self.inputs = (ctypes.c_uint * len(block.inputs))(*range(len(block.inputs)))
         self.outputs = (ctypes.c_uint * len(block.outputs))(*range(len(block.outputs)))
         self.values = np.zeros(len(block.outputs))
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         u = np.ascontiguousarray(u, dtype=float)
-        self.library.controller_set_real(self.made.component, self.inputs, u.size, u.ctypes.data)
-        status = self.library.controller_do_step(self.made.component, t, h, 1)
-        if status != 0:
+        def call(name: str, *args: object) -> int:
+            return int(getattr(self.library, f"{self.prefix}_{name}")(self.made.component, *args))
+
+        call("set_real", self.inputs, u.size, u.ctypes.data)
+        if call("do_step", t, h, 1) != 0:
             raise ValueError(self.made.message())
-        self.library.controller_get_real(self.made.component, self.outputs, self.values.size, self.values.ctypes.data)
+        call("get_real", self.outputs, self.values.size, self.values.ctypes.data)
         return self.values.copy()
 
 
@@ -155,30 +157,6 @@ def test_without_a_compiler_the_controller_steps_in_python(fmu_dir, model, tmp_p
 
 # --- the path-following controller's C twin (path_controller.c) -----------------------------------
 
-class PathTwin(Twin):
-    """The C twin of a PathFollowingController, called as the stepper calls it."""
-
-    def __init__(self, block: PathFollowingController):  # noqa: D107 - as Twin's, with the path twin's names
-        made = block.native()
-        assert made is not None
-        self.made, self.library = made, made.library
-        pointer = ctypes.c_void_p
-        for name in ("set_real", "get_real"):
-            getattr(self.library, f"path_{name}").argtypes = [pointer, pointer, ctypes.c_size_t, pointer]
-        self.library.path_do_step.argtypes = [pointer, ctypes.c_double, ctypes.c_double, ctypes.c_int]
-        self.inputs = (ctypes.c_uint * len(block.inputs))(*range(len(block.inputs)))
-        self.outputs = (ctypes.c_uint * len(block.outputs))(*range(len(block.outputs)))
-        self.values = np.zeros(len(block.outputs))
-
-    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
-        u = np.ascontiguousarray(u, dtype=float)
-        self.library.path_set_real(self.made.component, self.inputs, u.size, u.ctypes.data)
-        if self.library.path_do_step(self.made.component, t, h, 1) != 0:
-            raise ValueError(self.made.message())
-        self.library.path_get_real(self.made.component, self.outputs, self.values.size, self.values.ctypes.data)
-        return self.values.copy()
-
-
 def near_the_path(block: PathFollowingController, s: float, rng: np.random.Generator) -> np.ndarray:
     """Inputs of a rover near arc length ``s`` of the block's path: off it by centimetres, its
     heading by degrees, speed, loads and slip angles spread (some loads below the 1 N floor)."""
@@ -194,7 +172,7 @@ def test_the_path_controllers_c_twin_gives_the_python_blocks_outputs_bit_for_bit
     rng = np.random.default_rng(34)
     block = PathFollowingController("ctrl", str(model), path=path, steering=steering)
     block.start(0.0, near_the_path(block, 0.0, rng))
-    twin = PathTwin(block)
+    twin = Twin(block, "path")
     t = 0.0
     for k in range(1, 2500):
         h = 4e-4 if k == 1200 else 1e-3  # one shorter step: the filter discretised for it

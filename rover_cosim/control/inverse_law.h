@@ -134,6 +134,15 @@ static int law_torque(Law *c, int i, double load, double force, int advance, con
     return OK;
 }
 
+/* A twin's communication step h [s] against the step it was made for: at most that (a shorter
+ * last step is fine); ERROR with the message in ``message`` (256 bytes) otherwise. */
+static int law_step_allowed(char *message, double h, double step) {
+    if (0 < h && h <= step * (1 + 1e-9)) return OK;
+    snprintf(message, 256, "communication step %.15g s: expected at most its step = %.15g s (a shorter last step is fine)",
+             h, step);
+    return ERROR;
+}
+
 /* The filter's discretisation for a step of h [s] (the law's own unless h differs from it). */
 static void law_discretisation(const Law *c, int advance, double h, double *ad, double *bd) {
     memcpy(ad, c->ad, 4 * sizeof *ad);

@@ -271,13 +271,7 @@ int path_get_real(void *component, const unsigned int *vr, size_t n, double *val
 int path_do_step(void *component, double t, double h, int no_prior_state) {
     PathController *c = component;
     (void)no_prior_state;
-    double step = c->settings[STEP];
-    if (!(0 < h && h <= step * (1 + 1e-9))) {
-        snprintf(c->message, sizeof c->message,
-                 "communication step %.15g s: expected at most its step = %.15g s (a shorter last step is fine)",
-                 h, step);
-        return ERROR;
-    }
+    if (law_step_allowed(c->message, h, c->settings[STEP]) != OK) return ERROR;
     return outputs(c, t + h, 1, h);
 }
 
