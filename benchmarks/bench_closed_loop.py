@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -30,6 +29,7 @@ import pandas as pd
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.fmubuild import build
+from rover_cosim.jobs.identify import model_file
 from rover_cosim.jobs.simulate import STEP, STOP_TIME, cosim_system, monolithic_system
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
@@ -37,16 +37,6 @@ from rover_cosim.orchestrator.master import run
 GOALS_S = {"monolithic": 1.0, "cosim": 2.0}  # wall seconds for 20 s simulated (issue 18)
 STATISTICS = ("evaluations", "reusedEvaluations", "jacobians", "steps", "rejectedSteps")
 BUILDERS = {"monolithic": monolithic_system, "cosim": cosim_system}
-
-
-def model_file(given: Path, fmu_dir: Path) -> Path:
-    if given.is_file():
-        return given
-    from rover_cosim.jobs.identify import run_identification
-
-    folder = Path(tempfile.mkdtemp(prefix="bench-closed-loop-"))
-    run_identification(fmu_dir / "SingleWheel.fmu", folder, workers=2)
-    return folder / "model.json"
 
 
 def system(plant: str, fmu_dir: Path, model: Path, stop_time: float, record: list[str] | None = None) -> Any:

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import tempfile
 from pathlib import Path
 from typing import Any
 from unittest import mock
@@ -23,20 +22,11 @@ from rover_cosim.common.outputs import json_bytes, run_record, write_all
 from rover_cosim.control.path_controller import PathFollowingController
 from rover_cosim.fmubuild import build
 from rover_cosim.jobs import path_following
+from rover_cosim.jobs.identify import model_file
 from rover_cosim.orchestrator.master import run
 
 GOAL_REAL_TIME = 20.0
 PLANTS = ("inverse", "kinematic", "cosim")
-
-
-def model_file(given: Path, fmu_dir: Path) -> Path:
-    if given.is_file():
-        return given
-    from rover_cosim.jobs.identify import run_identification
-
-    folder = Path(tempfile.mkdtemp(prefix="bench-path-"))
-    run_identification(fmu_dir / "SingleWheel.fmu", folder, workers=2)
-    return folder / "model.json"
 
 
 def system(plant: str, scenario: str, fmu_dir: Path, model: Path) -> Any:

@@ -218,3 +218,15 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     write_all(files, folder=out, stale=("*.png", "*.pdf", "*.svg"))  # its figures: all written anew
     return IdentificationResult(sorted(files), validation.fit, sweep, record, json.loads(files[out / "model.json"]),
                                 lateral_sweep, lateral_fit)
+
+
+def model_file(given: Path, fmu_dir: Path, workers: int = 2) -> Path:
+    """``given`` where it is a file; else a model identified now on ``fmu_dir``'s SingleWheel.fmu
+    into a temporary folder (what a benchmark uses when `make identify` has not run)."""
+    if Path(given).is_file():
+        return Path(given)
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="rover-cosim-model-"))
+    run_identification(Path(fmu_dir) / "SingleWheel.fmu", folder, workers=workers)
+    return folder / "model.json"
