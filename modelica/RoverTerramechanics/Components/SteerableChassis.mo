@@ -2,9 +2,10 @@ within RoverTerramechanics.Components;
 model SteerableChassis "Rover body moving in the plane (x, y, yaw) with heave, pitch and roll on six compliant limbs, every wheel steered, cut at the wheel hubs"
   extends RoverTerramechanics.Interfaces.SteerableBodyHubs;
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
-  output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity, world x";
-  output Real y(unit="m", start=0, fixed=true) "Position of the centre of gravity, world y";
-  output Real yaw(unit="rad", start=0, fixed=true) "Heading of the body against world x, positive to the left";
+  parameter RoverTerramechanics.Parameters.TerrainParameters terrain "Ground plane: slope and downhill direction (default level)";
+  output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity along the ground's x axis (world x on level ground)";
+  output Real y(unit="m", start=0, fixed=true) "Position of the centre of gravity along the ground's y axis (world y on level ground)";
+  output Real yaw(unit="rad", start=0, fixed=true) "Heading of the body against the ground's x axis, about the ground's normal, positive to the left";
   output Real v(unit="m/s", start=0, fixed=true) "Forward velocity of the centre of gravity, along the heading";
   output Real vy(unit="m/s", start=0, fixed=true) "Lateral velocity of the centre of gravity, to the left of the heading";
   output Real yawRate(unit="rad/s", start=0, fixed=true) "Yaw rate";
@@ -24,11 +25,16 @@ model SteerableChassis "Rover body moving in the plane (x, y, yaw) with heave, p
   Real vyHub[6](each unit="m/s") "Hub velocity to the left of the heading";
   Real FxBody[6](each unit="N") "Hub force along the heading";
   Real FyBody[6](each unit="N") "Hub force to the left of the heading";
+  Real gAlong(unit="m/s2") "Gravity's component along the heading, in the ground plane (TerrainParameters)";
+  Real gLateral(unit="m/s2") "Gravity's component to the left of the heading, in the ground plane (TerrainParameters)";
 protected
   parameter Real xHub[6](each unit="m") = {rover.xLimb[1], rover.xLimb[2], rover.xLimb[3], rover.xLimb[1], rover.xLimb[2], rover.xLimb[3]} "Hub positions ahead of the centre of gravity; limbs 4-6 mirror 1-3";
   parameter Real yHub[6](each unit="m") = {rover.yLimb, rover.yLimb, rover.yLimb, -rover.yLimb, -rover.yLimb, -rover.yLimb} "Hub positions to the left: limbs 1-3 left, 4-6 right";
-  parameter Real staticDeflection(unit="m") = rover.M*rover.g/(6*rover.kLimb) "Limb compression at rest";
+  parameter Real gNormal(unit="m/s2") = rover.g*cos(terrain.slope) "Gravity's component into the ground, along its normal";
+  parameter Real staticDeflection(unit="m") = rover.M*gNormal/(6*rover.kLimb) "Limb compression at rest";
 equation
+  gAlong = rover.g*sin(terrain.slope)*cos(terrain.downhill - yaw);
+  gLateral = rover.g*sin(terrain.slope)*sin(terrain.downhill - yaw);
   der(x) = v*cos(yaw) - vy*sin(yaw);
   der(y) = v*sin(yaw) + vy*cos(yaw);
   der(yaw) = yawRate;
@@ -50,10 +56,10 @@ equation
     FxBody[i] = Fx[i]*cos(steer[i]) - Fy[i]*sin(steer[i]);
     FyBody[i] = Fx[i]*sin(steer[i]) + Fy[i]*cos(steer[i]);
   end for;
-  rover.M*(der(v) - yawRate*vy) = sum(FxBody);
-  rover.M*(der(vy) + yawRate*v) = sum(FyBody);
+  rover.M*(der(v) - yawRate*vy) = sum(FxBody) + rover.M*gAlong;
+  rover.M*(der(vy) + yawRate*v) = sum(FyBody) + rover.M*gLateral;
   rover.Izz*der(yawRate) = sum(xHubWorld[i]*FyBody[i] - yRolled[i]*FxBody[i] for i in 1:6);
-  rover.M*der(w) = sum(W) - rover.M*rover.g;
+  rover.M*der(w) = sum(W) - rover.M*gNormal;
   rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*FxBody[i] + tau[i]*cos(steer[i]) for i in 1:6);
   rover.Ixx*der(p) = sum(yRolled[i]*W[i] - zHubWorld[i]*FyBody[i] + tau[i]*sin(steer[i]) for i in 1:6);
   assert(rover.M > 0, "rover.M: the mass must be > 0 kg");
@@ -63,6 +69,8 @@ equation
   assert(rover.Izz > 0, "rover.Izz: the yaw inertia must be > 0 kg.m2");
   assert(rover.yLimb > 0, "rover.yLimb: the half track width must be > 0 m");
   assert(rover.hCoG >= 0, "rover.hCoG: the centre of gravity must be at or above the hubs, hCoG >= 0 m");
+  assert(terrain.slope >= 0 and terrain.slope < 1.5707963267948966, "terrain.slope: the inclination of the ground must be in [0, pi/2) rad");
+  assert(abs(terrain.downhill) < 1e6, "terrain.downhill: the downhill direction must be a finite angle in rad");
   assert(rover.kLimb > 0, "rover.kLimb: the limb stiffness must be > 0 N/m");
   assert(rover.dLimb >= 0, "rover.dLimb: the limb damping must be >= 0 N.s/m");
   annotation (Documentation(info="<html>
@@ -73,12 +81,15 @@ at y = +yLimb, 4-6 on the right). Each wheel is steered by <code>steer[i]</code>
 vertical axis. In the heading frame (x forward, y left, z up), with the hub at
 p<sub>i</sub> = R<sub>pitch</sub> R<sub>roll</sub> (x<sub>i</sub>, y<sub>i</sub>, -h<sub>CoG</sub>):</p>
 <ul>
-<li>M (dv/dt - r v<sub>y</sub>) = &Sigma; F<sub>x,i</sub><sup>body</sup>,
-M (dv<sub>y</sub>/dt + r v) = &Sigma; F<sub>y,i</sub><sup>body</sup>, with the wheel-frame
-forces turned by the steering: F<sup>body</sup> = R(steer) (F<sub>x</sub>, F<sub>y</sub>);</li>
+<li>M (dv/dt - r v<sub>y</sub>) = &Sigma; F<sub>x,i</sub><sup>body</sup> + M g<sub>x</sub>,
+M (dv<sub>y</sub>/dt + r v) = &Sigma; F<sub>y,i</sub><sup>body</sup> + M g<sub>y</sub>, with the wheel-frame
+forces turned by the steering: F<sup>body</sup> = R(steer) (F<sub>x</sub>, F<sub>y</sub>), and
+gravity's components in the ground plane g<sub>x</sub> = g sin &theta; cos(&psi;<sub>d</sub> - yaw),
+g<sub>y</sub> = g sin &theta; sin(&psi;<sub>d</sub> - yaw) (<code>Parameters.TerrainParameters</code>:
+slope &theta;, downhill direction &psi;<sub>d</sub>);</li>
 <li>Izz dr/dt = &Sigma; (p<sub>x,i</sub> F<sub>y,i</sub><sup>body</sup> - p<sub>y,i</sub>
 F<sub>x,i</sub><sup>body</sup>);</li>
-<li>M dw/dt = &Sigma; W<sub>i</sub> - M g; Iyy dq/dt = &Sigma; (p<sub>x,i</sub> W<sub>i</sub> -
+<li>M dw/dt = &Sigma; W<sub>i</sub> - M g cos &theta;; Iyy dq/dt = &Sigma; (p<sub>x,i</sub> W<sub>i</sub> -
 p<sub>z,i</sub> F<sub>x,i</sub><sup>body</sup> + &tau;<sub>i</sub> cos steer<sub>i</sub>);
 Ixx dp/dt = &Sigma; (p<sub>y,i</sub> W<sub>i</sub> - p<sub>z,i</sub> F<sub>y,i</sub><sup>body</sup> +
 &tau;<sub>i</sub> sin steer<sub>i</sub>): the loads, the hub forces below the centre of gravity
@@ -87,6 +98,12 @@ and the reaction of the wheel motors about their steered axles;</li>
 frame (<code>v_hub</code> along, <code>v_lat</code> to its left), which sets its slip and slip
 angle.</li>
 </ul>
+<p>The ground is the plane of <code>terrain</code>: x, y, yaw are measured in it, the limbs and
+the loads W<sub>i</sub> act along its normal, the wheel frames (slip, slip angle) lie in it, and
+heave, pitch and roll are relative to it; gravity acts at the centre of gravity, so it has no
+moment about it: on a side slope the wheels' lateral forces, acting at the hubs h<sub>CoG</sub>
+below, roll the body and load the downhill wheels. On level ground (slope 0) the gravity terms
+are exactly 0 and g cos 0 = g: the equations and their arithmetic are those of the level rover.</p>
 <p>Pitch and roll stay small (a few degrees): their rates are taken as body rates and the
 gyroscopic coupling of yaw with pitch and roll is neglected. Turning and braking move the loads:
 a lateral acceleration rolls the body and loads the outer limbs. With every steering angle

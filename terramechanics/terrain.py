@@ -1,0 +1,93 @@
+"""The ground under the steerable rover: a plane of any inclination (issue 35).
+
+The same law as the Modelica record ``Parameters.TerrainParameters`` (and the chassis that uses
+it): a plane of inclination ``slope`` θ [rad] whose direction of steepest descent makes the angle
+``downhill`` ψd [rad] with the ground's x axis (positive to the left). Positions (x, y) [m] and
+headings ψ [rad] are measured in the plane. Then
+
+    z_ground(x, y) = -sin θ (x cos ψd + y sin ψd)                [m, world height]
+    g_along   = g sin θ cos(ψd - ψ)                              [m/s², along the heading]
+    g_lateral = g sin θ sin(ψd - ψ)                              [m/s², to the left]
+    g_normal  = g cos θ                                          [m/s², into the ground]
+
+A plane of world gradients G_x = dz/dx, G_y = dz/dy is θ = atan(hypot(G_x, G_y)),
+ψd = atan2(-G_y, -G_x) (``PlaneTerrain.from_gradients``). Source of the setting: Ishigami, Miwa,
+Nagatani, Yoshida, J. Field Robotics 24(3), 2007 (steering on slopes of loose soil).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+def _angle(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+        raise ValueError(f"{name} = {value!r}: expected a finite angle in rad")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class PlaneTerrain:
+    """A ground plane: ``slope`` θ [rad], 0 <= θ < π/2, and ``downhill`` ψd [rad], the direction of
+    steepest descent against the ground's x axis, positive to the left (-π/2: the valley to the
+    right of a path along x). ``PlaneTerrain()`` is level ground."""
+
+    slope: float = 0.0
+    downhill: float = 0.0
+
+    def __post_init__(self) -> None:
+        slope, downhill = _angle("slope", self.slope), _angle("downhill", self.downhill)
+        if not 0.0 <= slope < math.pi / 2:
+            raise ValueError(f"slope = {self.slope!r} rad ({math.degrees(slope):.4g} deg): expected an inclination "
+                             "0 <= slope < pi/2 rad (0 to 90 deg, 90 excluded)")
+        object.__setattr__(self, "slope", slope)
+        object.__setattr__(self, "downhill", downhill)
+
+    @classmethod
+    def side_slope(cls, degrees: float, valley: str = "right") -> PlaneTerrain:
+        """A side slope of ``degrees`` [deg] for a path along +x, the valley to its ``valley``."""
+        if valley not in ("right", "left"):
+            raise ValueError(f"valley = {valley!r}: expected 'right' or 'left'")
+        angle = _angle("degrees", degrees)
+        if not 0.0 <= angle < 90.0:
+            raise ValueError(f"side slope = {degrees!r} deg: expected 0 <= slope < 90 deg")
+        return cls(math.radians(angle), -math.pi / 2 if valley == "right" else math.pi / 2)
+
+    @classmethod
+    def from_gradients(cls, gx: float, gy: float) -> PlaneTerrain:
+        """The plane z = gx x + gy y of world gradients ``gx`` = dz/dx, ``gy`` = dz/dy [m/m]."""
+        gx, gy = _angle("gx", gx), _angle("gy", gy)
+        return cls(math.atan(math.hypot(gx, gy)), math.atan2(-gy, -gx) if (gx or gy) else 0.0)
+
+    @property
+    def level(self) -> bool:
+        return self.slope == 0.0
+
+    def height(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
+        """World height z_ground [m] of the ground point (x, y) [m] (0 at the origin)."""
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        return -math.sin(self.slope) * (x * math.cos(self.downhill) + y * math.sin(self.downhill))
+
+    def gravity(self, heading: ArrayLike, g: float) -> tuple[FloatArray, FloatArray, float]:
+        """Gravity ``g`` [m/s²] in the heading frame of a body with heading ``heading`` [rad]:
+        (along the heading, to its left, into the ground) [m/s²]."""
+        heading = np.asarray(heading, float)
+        tangential = g * math.sin(self.slope)
+        return (tangential * np.cos(self.downhill - heading), tangential * np.sin(self.downhill - heading),
+                g * math.cos(self.slope))
+
+    def fmu_parameters(self) -> dict[str, float]:
+        """The plane as the steerable rover FMUs' parameters (``terrain.slope``, ``terrain.downhill``)."""
+        return {"terrain.slope": self.slope, "terrain.downhill": self.downhill}
+
+    def label(self) -> str:
+        if self.level:
+            return "level ground"
+        return f"{math.degrees(self.slope):.3g} deg slope, downhill at {math.degrees(self.downhill):.3g} deg"
