@@ -1,0 +1,225 @@
+"""``make simulate`` (after the path scenarios): the steerable rover on sloped ground (issue 35).
+
+Scenario ``slope_traverse``: a straight traverse along +x across a side slope (the valley to the
+right, ``PlaneTerrain.side_slope``) of 10 and 20 deg at 0.3 m/s on the paper's soil, started
+rolling on the path, with
+
+- ``inverse``: the identified longitudinal and lateral models, the downhill pull M g sin(slope)
+  compensated as a feed-forward lateral force (``PathFollowingController(terrain=...)``), on
+  SteerableRover.fmu;
+- ``cosim``: the same controller on SteerableRoverBody + 6 Wheel (the body given the same ground);
+- ``kinematic``: kinematic steering (the ablation): the wheels along their hubs' commanded
+  velocities, the downhill pull left to the cross-track feedback.
+
+results/simulation/
+  terrain_<scenario>.csv, terrain_<scenario>_cosim.csv, terrain_<scenario>_kinematic.csv
+                        the columns of path_*.csv (``path_following.trajectories``) and the
+                        ground height under the centre of gravity, z_ground [m]
+  terrain_metrics.csv   per scenario and run: cross-track RMS and max [m], heading error RMS and max
+                        [rad], speed error [%], per wheel the means over the run's second half of
+                        slip [-], slip angle [rad], sinkage [m], load [N], and the motors' energy
+                        per metre of path [J/m]
+  terrain_agreement.csv per scenario: monolithic against co-simulated (speed, loads, path)
+  terrain_xy.png        the paths over the terrain's height contours, cross-track error
+  terrain_wheels_<scenario>.png  per wheel: slip, slip angle, sinkage, load (compensated and not)
+  terrain.json          parameters, FMU hashes, versions, wall times, metrics
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
+from rover_cosim.common.rows import every, steps_between_rows
+from rover_cosim.control.path import Line
+from rover_cosim.control.path import Path as ReferencePath
+from rover_cosim.control.path_controller import PathFollowingController
+from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.orchestrator.builder import SystemBuilder
+from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.model import System
+from rover_cosim.orchestrator.runs import system_record
+from rover_cosim.progress import Stages
+from rover_cosim.terramechanics import PlaneTerrain, Soil, Wheel
+from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
+
+from . import terrain_figures
+from .path_following import BODY, STEP, WHEELS, agreement, connect_controller, trajectories
+from .path_following import metrics as path_metrics
+from .plants import add_plant_fmu, add_rover
+from .simulate import RECORD_INTERVAL, checked_models, models_of
+
+SPEED = 0.3          # m/s, the traverse's target speed
+TRAVERSE = 6.0       # m, the traverse's length (20 s at 0.3 m/s: the ablation settles in about 15 s)
+SLOPES = {"slope_traverse_10": 10.0, "slope_traverse_20": 20.0}  # scenario -> side slope [deg]
+RUNS = ("inverse", "cosim", "kinematic")
+FMUS = ("SteerableRover", "SteerableRoverBody", "Wheel")
+G = 1.62             # m/s², the rover's gravity (RoverParameters.g, the FMUs' default)
+MASS = 1570.0        # kg, RoverParameters.M
+
+
+@dataclass
+class TerrainResult:
+    """What ``run_terrain`` wrote and measured."""
+
+    files: list[Path]
+    tables: dict[tuple[str, str], pd.DataFrame]   # (scenario, run) -> terrain_*.csv columns
+    metrics: pd.DataFrame                        # terrain_metrics.csv
+    agreement: pd.DataFrame                      # terrain_agreement.csv
+    record: dict[str, Any]
+
+    def __repr__(self) -> str:
+        return summary_repr("TerrainResult", self.files, runs=len(self.tables))
+
+
+def terrain_of(scenario: str) -> PlaneTerrain:
+    """The ground of ``scenario``: a side slope, the valley to the right of the path along +x."""
+    if scenario not in SLOPES:
+        raise ValueError(f"scenario = {scenario!r}: expected one of {sorted(SLOPES)}")
+    return PlaneTerrain.side_slope(SLOPES[scenario], valley="right")
+
+
+def traverse_path(length: float = TRAVERSE) -> ReferencePath:
+    """The straight traverse of ``length`` [m] along +x from the origin."""
+    if not (math.isfinite(length) and length > 0):
+        raise ValueError(f"length = {length!r} m: expected a traverse length > 0")
+    return ReferencePath((Line(length),))
+
+
+def stop_time(length: float = TRAVERSE) -> float:
+    """s: until the reference point reaches the end of the traverse (to the step)."""
+    return float(np.floor(traverse_path(length).length / SPEED / STEP) * STEP)
+
+
+def _radius(choice: Choice | None) -> float:
+    return (choice.wheel if choice else Wheel()).r
+
+
+def traverse_system(fmu_dir: Path, model: ModelSet | Path, terrain: PlaneTerrain, run_: str = "inverse",
+                    choice: Choice | None = None, length: float = TRAVERSE) -> System:
+    """The traverse on ``terrain``: ``run_`` "inverse" or "kinematic" on SteerableRover.fmu,
+    "cosim" on SteerableRoverBody + 6 Wheel (the controller first in the Gauss-Seidel order)."""
+    if run_ not in RUNS:
+        raise ValueError(f"run = {run_!r}: expected one of {RUNS}")
+    if not isinstance(terrain, PlaneTerrain):
+        raise TypeError(f"terrain = {terrain!r}: expected a PlaneTerrain")
+    builder = SystemBuilder(f"traverse {terrain.label()} ({run_})").simulation(
+        stop_time=stop_time(length), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
+    spin = SPEED / _radius(choice)
+    block = PathFollowingController("ctrl", models_of(model), path=traverse_path(length), v_target=SPEED,
+                                    steering="kinematic" if run_ == "kinematic" else "inverse", step=STEP,
+                                    terrain=terrain, g=G, mass=MASS)
+    if run_ == "cosim":
+        wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu",
+                           len(WHEELS), choice, lateral=True, body_start={"v": SPEED}, wheel_start={"omega": spin})
+        builder.set_parameters("body", terrain.fmu_parameters())
+        builder.add_block("ctrl", block)
+        connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
+        for i, wheel in zip(WHEELS, wheels):
+            builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
+            builder.connect(f"ctrl.steer[{i}]", f"body.steer[{i}]")
+        return builder.simulation(order=["ctrl", "body", *wheels]).build()
+    add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice,
+                  {"v": SPEED, **{f"omega[{i}]": spin for i in WHEELS}})
+    builder.set_parameters("rover", terrain.fmu_parameters())
+    builder.add_block("ctrl", block)
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
+    for i in WHEELS:
+        builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
+    return builder.build()
+
+
+def motor_energy(table: pd.DataFrame) -> float:
+    """J: the motors' work on the wheels, the time integral of sum_i tau_i omega_i (trapezoid)."""
+    power = sum(table[f"tau_{i}"].to_numpy() * table[f"omega_{i}"].to_numpy() for i in WHEELS)
+    return float(np.trapezoid(power, table["time"].to_numpy()))
+
+
+def metrics(table: pd.DataFrame) -> dict[str, float]:
+    """The path metrics (``path_following.metrics``), the heading error RMS and max [rad], per wheel
+    the means over the second half of the run (the steady traverse) of slip [-], slip angle [rad],
+    sinkage [m] and load [N], and the motors' energy per metre of path [J/m]."""
+    row = path_metrics(table, SPEED)
+    row["heading_error_rms_rad"] = float(np.sqrt(np.mean(table["heading_error"] ** 2)))
+    row["heading_error_max_rad"] = float(np.abs(table["heading_error"]).max())
+    steady = table[table["time"] >= table["time"].iloc[-1] / 2]
+    for name, unit in (("slip", "1"), ("slipAngle", "rad"), ("sinkage", "m"), ("Fz", "N")):
+        for i in WHEELS:
+            row[f"mean_{name}_{i}_{unit}"] = float(steady[f"{name}_{i}"].mean())
+    distance = float(table["s"].iloc[-1] - table["s"].iloc[0])
+    row["energy_per_metre_J_m"] = motor_energy(table) / distance if distance > 0 else math.nan
+    return row
+
+
+def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SLOPES),
+                choice: Choice | Soil | Wheel | None = None, *, allow_model_mismatch: bool = False,
+                progress: Callable[[float], None] | None = None, record_interval: float = RECORD_INTERVAL,
+                length: float = TRAVERSE, runs: tuple[str, ...] = RUNS) -> TerrainResult:
+    """Every scenario with every run of ``runs`` (``inverse`` and ``cosim`` with compensation,
+    ``kinematic`` the ablation) on the soil and wheel of ``choice`` (default: the paper's); writes
+    every file (all or none). ``length`` [m]: the traverse (6 m; the tests run shorter ones)."""
+    started = time.perf_counter()
+    choice = as_choice(choice)
+    steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
+    traverse_path(length)
+    unknown = [s for s in scenarios if s not in SLOPES] + [r for r in runs if r not in RUNS]
+    if unknown or not scenarios or "inverse" not in runs:
+        raise ValueError(f"scenarios {scenarios!r}, runs {runs!r}: expected scenarios of {sorted(SLOPES)} and runs "
+                         f"of {RUNS} with 'inverse' among them")
+    fmu_dir = Path(fmu_dir).resolve()
+    models, mismatch = checked_models(model, choice, allow_model_mismatch)
+    stages = Stages(progress, len(scenarios) * len(runs))
+    tables: dict[tuple[str, str], pd.DataFrame] = {}
+    walls: dict[str, float] = {}
+    systems: dict[str, Any] = {}
+    for i, scenario in enumerate(scenarios):
+        terrain = terrain_of(scenario)
+        for j, label in enumerate(runs):
+            system = traverse_system(fmu_dir, models, terrain, label, choice, length)
+            systems[f"{scenario}/{label}"] = system_record(system)
+            outcome = run(system, progress=stages.stage(i * len(runs) + j))
+            table = trajectories(outcome.data, cosim=label == "cosim")
+            table["z_ground"] = terrain.height(table["x"], table["y"])
+            tables[scenario, label] = table
+            walls[f"{scenario}/{label}"] = outcome.wall_seconds
+    metric_table = pd.DataFrame([{"scenario": s, "run": label, "side_slope_deg": SLOPES[s], "target_speed_m_s": SPEED,
+                                  **metrics(tables[s, label])} for s in scenarios for label in runs])
+    agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"], SPEED)}
+                                    for s in scenarios if "cosim" in runs])
+    record = run_record("rover-cosim simulate (terrain)",
+                        {"scenarios": {s: {"terrain": vars(terrain_of(s)), "side_slope_deg": SLOPES[s]}
+                                       for s in scenarios}, "target_speed_m_s": SPEED, "length_m": length,
+                         "stop_time_s": stop_time(length), "step_s": STEP, "model": str(model), "runs": list(runs),
+                         "algorithm": "gauss-seidel", "record_interval_s": record_interval})
+    record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
+                   "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
+                   "model_mismatch": mismatch, "systems": systems, "wall_seconds": time.perf_counter() - started,
+                   "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
+    out = Path(out_dir)
+    suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic"}
+    files = {out / f"terrain_{s}{suffix[label]}.csv": every(table, record_interval, STEP).to_csv(
+        index=False, float_format="%.8g").encode() for (s, label), table in tables.items()}
+    files.update({
+        out / "terrain_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
+        out / "terrain_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),
+        out / "terrain_xy.png": terrain_figures.paths_over_terrain(
+            {s: (traverse_path(length), terrain_of(s)) for s in scenarios}, tables),
+        out / "terrain.json": json_bytes(record),
+    })
+    for s in scenarios:
+        files[out / f"terrain_wheels_{s}.png"] = terrain_figures.wheels(
+            {label: tables[s, label] for label in runs if label != "cosim"}, s)
+    write_all(files, folder=out, stale=("terrain_*",))  # the straight run's and the paths' files stay
+    return TerrainResult(sorted(files), tables, metric_table, agreement_table, record)
+
+
+__all__ = ["BODY", "RUNS", "SLOPES", "SPEED", "TRAVERSE", "TerrainResult", "metrics", "motor_energy", "run_terrain",
+           "stop_time", "terrain_of", "traverse_path", "traverse_system"]
