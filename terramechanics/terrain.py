@@ -13,6 +13,9 @@ headings ψ [rad] are measured in the plane. Then
 A plane of world gradients G_x = dz/dx, G_y = dz/dy is θ = atan(hypot(G_x, G_y)),
 ψd = atan2(-G_y, -G_x) (``PlaneTerrain.from_gradients``). Source of the setting: Ishigami, Miwa,
 Nagatani, Yoshida, J. Field Robotics 24(3), 2007 (steering on slopes of loose soil).
+
+``static_hold`` and ``critical_slope``: a rover at rest on the plane by the reference wheel's
+static regime (``regimes``): whether the soil holds it, the holding torques, the creep.
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from .parameters import Soil, Wheel
 
 FloatArray = NDArray[np.float64]
 
@@ -91,3 +96,62 @@ class PlaneTerrain:
         if self.level:
             return "level ground"
         return f"{math.degrees(self.slope):.3g} deg slope, downhill at {math.degrees(self.downhill):.3g} deg"
+
+
+@dataclass(frozen=True)
+class StaticHold:
+    """A rover at rest on a ``PlaneTerrain``, by the reference wheel (``regimes``' static regime).
+
+    Attributes:
+        pull: gravity's pull in the ground plane, M g sin θ [N].
+        strength: what the soils under the wheels hold at most, sum of the patches' Mohr-Coulomb
+            strength c b L + W tan φ [N] at the static loads (equal shares of M g cos θ).
+        holding_torque: the drive torque of each wheel [N·m] that holds the component of the pull
+            along the heading (r M g_along / n, against it); the lateral component is held by the
+            wheels' lateral shear alone.
+        creep_speed: the speed [m/s] at which the static regime's regularised shear
+            F_max tanh(v / v_stick) carries the pull: a rover that holds creeps at it.
+    """
+
+    pull: float
+    strength: float
+    holding_torque: float
+    creep_speed: float
+
+    @property
+    def holds(self) -> bool:
+        return self.pull < self.strength
+
+
+def static_hold(terrain: PlaneTerrain, heading: float, mass: float, g: float, wheel: Wheel | None = None,
+                soil: Soil | None = None, wheels: int = 6, v_stick: float = 1e-4) -> StaticHold:
+    """The rover of ``mass`` [kg] at rest with heading ``heading`` [rad] on ``terrain`` under gravity
+    ``g`` [m/s²] on ``wheels`` wheels (see ``StaticHold``)."""
+    from .regimes import shear_strength
+    from .sinkage import wheel_state
+
+    wheel, soil = wheel or Wheel(), soil or Soil()
+    if not (mass > 0 and g > 0 and wheels >= 1 and v_stick > 0):
+        raise ValueError(f"mass = {mass!r} kg, g = {g!r} m/s², wheels = {wheels!r}, v_stick = {v_stick!r} m/s: "
+                         "expected mass > 0, g > 0, wheels >= 1, v_stick > 0")
+    along, _, normal = terrain.gravity(heading, g)
+    load = mass * normal / wheels
+    sinkage = float(wheel_state(load, 0.0, wheel, soil).sinkage)
+    strength = wheels * float(shear_strength(load, sinkage, wheel, soil))
+    pull = mass * g * math.sin(terrain.slope)
+    creep = v_stick * math.atanh(pull / strength) if pull < strength else math.inf
+    return StaticHold(pull, strength, -wheel.r * mass * float(along) / wheels, creep)
+
+
+def critical_slope(mass: float, g: float, wheel: Wheel | None = None, soil: Soil | None = None,
+                   wheels: int = 6) -> float:
+    """The steepest slope [rad] the soil holds the rover at rest on (``static_hold``'s pull equal to
+    its strength), by bisection to 1e-6 rad."""
+    low, high = 0.0, math.pi / 2 - 1e-6
+    while high - low > 1e-6:
+        middle = (low + high) / 2
+        if static_hold(PlaneTerrain(middle), 0.0, mass, g, wheel, soil, wheels).holds:
+            low = middle
+        else:
+            high = middle
+    return low
