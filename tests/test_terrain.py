@@ -94,6 +94,38 @@ def simulate(fmu, terrain: PlaneTerrain | None, torque: float, steer: dict[int, 
                         output=list(outputs), fmi_type="CoSimulation", start_values=start)
 
 
+@pytest.mark.parametrize("model", ["SteerableRover", "SteerableRoverBody"])
+@pytest.mark.parametrize(("values", "named"), [({"terrain.slope": math.radians(95.0)}, "terrain.slope"),
+                                               ({"terrain.slope": -0.1}, "terrain.slope"),
+                                               ({"terrain.downhill": 1e300}, "terrain.downhill")])
+def test_the_fmus_refuse_a_bad_ground_naming_the_parameter_and_value(fmus, model: str, values: dict, named: str):
+    from test_fmu_regimes import logged_messages
+
+    text = logged_messages(fmus[model], values)
+    value = next(iter(values.values()))
+    assert named in text and f"{value:.10g}" in text and "must" in text, text
+
+
+def test_the_fmus_refuse_a_nan_ground_when_it_is_set(fmus):
+    import fmpy
+    from fmpy import fmi2
+
+    messages: list[str] = []
+    callbacks = fmi2.fmi2CallbackFunctions()
+    callbacks.logger = fmi2.fmi2CallbackLoggerTYPE(lambda c, i, s, cat, m: messages.append(m.decode()))
+    callbacks.allocateMemory = fmi2.defaultCallbacks.allocateMemory
+    callbacks.freeMemory = fmi2.defaultCallbacks.freeMemory
+    md = fmpy.read_model_description(fmus["SteerableRover"])
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    fmu = fmi2.FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(fmus["SteerableRover"]),
+                         modelIdentifier=md.coSimulation.modelIdentifier, instanceName="nan")
+    fmu.instantiate(callbacks=callbacks, loggingOn=False)
+    with pytest.raises(fmpy.fmi1.FMICallException):
+        fmu.setReal([refs["terrain.slope"]], [math.nan])
+    fmu.freeInstance()
+    assert any("terrain.slope = nan" in m and "finite" in m for m in messages), messages
+
+
 STRAIGHT = dict.fromkeys(WHEELS, 0.0)
 TURN = {1: 0.05, 2: 0.0, 3: -0.05, 4: 0.05, 5: 0.0, 6: -0.05}
 
