@@ -1,5 +1,6 @@
 within RoverTerramechanics.FMUs;
 model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every wheel driven and steered, with six terramechanics wheels (monolithic)"
+  extends RoverTerramechanics.Interfaces.GroundContacts;
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
@@ -39,6 +40,10 @@ equation
     body.Fy[i] = wheels[i].Fy;
     body.tau[i] = tau[i];
     body.steer[i] = steer[i];
+    body.groundHeight[i] = groundHeight[i];
+    body.groundHeightRate[i] = groundHeightRate[i];
+    body.groundGradientAlong[i] = groundGradientAlong[i];
+    body.groundGradientLateral[i] = groundGradientLateral[i];
     Fz[i] = wheels[i].Fz;
     Fx[i] = wheels[i].Fx;
     Fy[i] = wheels[i].Fy;
@@ -67,7 +72,9 @@ Fy (Ishigami et al. 2007) and Fz. Inputs <code>tau[1..6]</code> and <code>steer[
 limbs 1-3 front, middle, rear on the left, 4-6 on the right. With every steering angle zero it
 is <code>Rover</code> on level ground. The ground is the plane of <code>terrain</code>
 (<code>Parameters.TerrainParameters</code>: slope and downhill direction; level by default):
-the loads act along its normal and the wheels' frames lie in it. The states <code>x</code>, <code>y</code>,
+the loads act along its normal and the wheels' frames lie in it. A height map over the plane comes
+in hub by hub (<code>Interfaces.GroundContacts</code>: height, its rate, gradients; 0 by default)
+from a terrain participant. The states <code>x</code>, <code>y</code>,
 <code>yaw</code>, <code>v</code>, <code>vy</code>, <code>yawRate</code> and <code>omega[i]</code>
 take start values, so a run can start in motion.</p>
 </html>"));
