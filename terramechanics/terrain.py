@@ -14,8 +14,10 @@ A plane of world gradients G_x = dz/dx, G_y = dz/dy is θ = atan(hypot(G_x, G_y)
 ψd = atan2(-G_y, -G_x) (``PlaneTerrain.from_gradients``). Source of the setting: Ishigami, Miwa,
 Nagatani, Yoshida, J. Field Robotics 24(3), 2007 (steering on slopes of loose soil).
 
-``static_hold`` and ``critical_slope``: a rover at rest on the plane by the reference wheel's
-static regime (``regimes``): whether the soil holds it, the holding torques, the creep.
+``HeightMap`` (a grid file, bicubic spline) and ``crater``: a height map over the plane, given to
+the rover hub by hub (``Interfaces.GroundContacts``). ``static_hold`` and ``critical_slope``: a
+rover at rest on the plane by the reference wheel's static regime (``regimes``): whether the soil
+holds it, the holding torques, the creep.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -95,7 +98,7 @@ class PlaneTerrain:
     def label(self) -> str:
         if self.level:
             return "level ground"
-        return f"{math.degrees(self.slope):.3g} deg slope, downhill at {math.degrees(self.downhill):.3g} deg"
+        return f"{math.degrees(self.slope):.3g}° slope, downhill at {math.degrees(self.downhill):.3g}°"
 
 
 @dataclass(frozen=True)
@@ -155,3 +158,94 @@ def critical_slope(mass: float, g: float, wheel: Wheel | None = None, soil: Soil
         else:
             high = middle
     return low
+
+
+class HeightMap:
+    """A height map over the ground plane: heights ``heights[j, i]`` [m] above the plane at the grid
+    points (``x[i]``, ``y[j]``) [m] (strictly increasing, at least 4 each), interpolated by a bicubic
+    spline (continuous height, gradient and curvature: smooth for the integrator). Outside the grid
+    the edge's height continues flat (gradient 0): give a grid whose edges are level.
+
+    The file (``read``, ``write``): CSV, the first row ``y\\x`` and the x values, then one row per y:
+    the y value and the heights along x."""
+
+    def __init__(self, x: ArrayLike, y: ArrayLike, heights: ArrayLike, source: str = "height map"):
+        from scipy.interpolate import RectBivariateSpline
+
+        self.x, self.y = np.asarray(x, float), np.asarray(y, float)
+        self.heights = np.asarray(heights, float)
+        self.source = source
+        for name, axis in (("x", self.x), ("y", self.y)):
+            if axis.ndim != 1 or axis.size < 4 or not np.isfinite(axis).all() or not (np.diff(axis) > 0).all():
+                raise ValueError(f"{source}: the grid's {name} = {axis!r} m: expected at least 4 finite, "
+                                 "strictly increasing values")
+        if self.heights.shape != (self.y.size, self.x.size):
+            raise ValueError(f"{source}: heights of shape {self.heights.shape}: expected (len(y), len(x)) = "
+                             f"({self.y.size}, {self.x.size})")
+        bad = np.argwhere(~np.isfinite(self.heights))
+        if bad.size:
+            j, i = bad[0]
+            raise ValueError(f"{source}: height at x = {self.x[i]:g} m, y = {self.y[j]:g} m is "
+                             f"{self.heights[j, i]!r}: expected a finite height in m")
+        self._spline = RectBivariateSpline(self.y, self.x, self.heights, kx=3, ky=3)
+
+    def _clamped(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        cx, cy = np.clip(x, self.x[0], self.x[-1]), np.clip(y, self.y[0], self.y[-1])
+        inside = ((cx == x) & (cy == y)).astype(float)
+        return cx, cy, inside
+
+    def height(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
+        """Height [m] of the ground above the plane at (x, y) [m]."""
+        cx, cy, _ = self._clamped(x, y)
+        return np.asarray(self._spline.ev(cy, cx), float)
+
+    def gradient(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(dh/dx, dh/dy) [1] at (x, y) [m] (0 outside the grid)."""
+        cx, cy, inside = self._clamped(x, y)
+        return (np.asarray(self._spline.ev(cy, cx, dy=1), float) * inside,
+                np.asarray(self._spline.ev(cy, cx, dx=1), float) * inside)
+
+    @classmethod
+    def read(cls, path: str | Path) -> HeightMap:
+        """The height map of the CSV file ``path`` (see the class); ValueError naming the file."""
+        path = Path(path)
+        try:
+            rows = np.loadtxt(path, delimiter=",", skiprows=0, dtype=str)
+            x = rows[0, 1:].astype(float)
+            y = rows[1:, 0].astype(float)
+            heights = rows[1:, 1:].astype(float)
+        except (OSError, ValueError, IndexError) as error:
+            raise ValueError(f"height map {path}: {error} (expected CSV: a row 'y\\\\x' and the x values, "
+                             "then rows of y and the heights)") from error
+        return cls(x, y, heights, source=f"height map {path}")
+
+    def write(self, path: str | Path) -> bytes:
+        """The CSV text of the map (written to ``path`` unless it is empty)."""
+        lines = ["y\\x," + ",".join(f"{v:.10g}" for v in self.x)]
+        lines += [f"{yj:.10g}," + ",".join(f"{h:.10g}" for h in row) for yj, row in zip(self.y, self.heights)]
+        text = ("\n".join(lines) + "\n").encode()
+        if str(path):
+            Path(path).write_bytes(text)
+        return text
+
+
+def crater(centre: tuple[float, float] = (6.0, -2.0), depth: float = 0.2, radius: float = 3.0,
+           rim: float = 0.1, spacing: float = 0.25, margin: float = 4.0) -> HeightMap:
+    """A crater-like depression [m]: a Gaussian bowl of ``depth`` and ``radius`` (its standard
+    deviation) with a raised ``rim`` of height ``rim`` at 1.5 ``radius``, centred at ``centre``,
+    sampled every ``spacing`` [m] over a square reaching ``margin`` radii from the centre (its edges
+    level to within micrometres)."""
+    for name, value in (("depth", depth), ("radius", radius), ("spacing", spacing), ("margin", margin)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"crater {name} = {value!r} m: expected > 0")
+    if not (math.isfinite(rim) and rim >= 0):
+        raise ValueError(f"crater rim = {rim!r} m: expected >= 0")
+    reach = margin * radius
+    x = np.arange(centre[0] - reach, centre[0] + reach + spacing / 2, spacing)
+    y = np.arange(centre[1] - reach, centre[1] + reach + spacing / 2, spacing)
+    gx, gy = np.meshgrid(x, y)
+    r = np.hypot(gx - centre[0], gy - centre[1])
+    bowl = -depth * np.exp(-0.5 * (r / radius) ** 2)
+    heights = bowl + rim * np.exp(-0.5 * ((r - 1.5 * radius) / (0.4 * radius)) ** 2)
+    return HeightMap(x, y, heights, source="crater")

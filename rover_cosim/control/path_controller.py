@@ -15,7 +15,10 @@ as an orchestrator block for the steerable rover.
    On sloped ground (``terrain``, a ``PlaneTerrain``) the wheels must also hold the body against
    gravity's pull in the ground plane: the demand is M (a_t, a_n) - M (g_along, g_lateral), with
    gravity's components in the heading frame of ``PlaneTerrain.gravity`` (the downhill pull as a
-   feed-forward; on level ground nothing is added).
+   feed-forward; on level ground nothing is added). Over a height map (``ground_map``) the loads,
+   normal to the local ground of gradient s_i under hub i, push the body by -W_i s_i: the
+   feed-forward adds sum W_i s_i (and its yaw moment), with the measured loads and the map's
+   gradients at the hubs.
 2. Allocation (``allocation``): each wheel's (f_x, f_y) in the heading frame, least squares
    weighted by the measured loads.
 3. Per wheel, the identified models at its measured load W_i: the steering angle delta and the
@@ -56,6 +59,14 @@ class Ground(Protocol):
         ...
 
 
+class GroundMap(Protocol):
+    """A height map over the ground plane (``rover_cosim.terramechanics.terrain.HeightMap``)."""
+
+    def gradient(self, x: Any, y: Any) -> tuple[Any, Any]:
+        """(dh/dx, dh/dy) [1] at the points (x, y) [m]."""
+        ...
+
+
 WHEELS = 6
 PATHS = {"turn": turn_path, "lane_change": lane_change_path}
 MAX_STEER = math.radians(45.0)    # rad: steering range
@@ -78,7 +89,8 @@ class PathFollowingController:
                  kv: float = 1.0, kp: float = 0.01, a_max: float = 0.1,
                  k_e: float = 0.25, k_de: float = 1.0, a_n_max: float = 0.3,
                  k_psi: float = 1.0, k_r: float = 2.0, alpha_max: float = 0.5,
-                 wn: float = 342.0, step: float = 1e-3, terrain: Ground | None = None, g: float = 1.62):
+                 wn: float = 342.0, step: float = 1e-3, terrain: Ground | None = None, g: float = 1.62,
+                 ground_map: GroundMap | None = None):
         models, longitudinal, _ = read_model(model, name)
         if models.lateral is None:
             raise ValueError(f"block {name!r}: {models.source} has no lateral model (run `make identify`)")
@@ -95,6 +107,9 @@ class PathFollowingController:
         if terrain is not None and not (hasattr(terrain, "gravity") and hasattr(terrain, "level")):
             raise TypeError(f"block {name!r}: terrain = {terrain!r}: expected a PlaneTerrain or None (level)")
         self.terrain, self.g = terrain, g
+        if ground_map is not None and not hasattr(ground_map, "gradient"):
+            raise TypeError(f"block {name!r}: ground_map = {ground_map!r}: expected a HeightMap or None")
+        self.ground_map = ground_map
         self.path: Path = path if isinstance(path, Path) else PATHS[path]()
         self.lateral = models.lateral
         self.inverse = LongitudinalInverse(longitudinal, WHEELS, wn, step, name)
@@ -140,6 +155,15 @@ class PathFollowingController:
         signals = {"s": where.s, "s_ref": s_ref, "cross_track": where.cross_track, "heading_error": offset}
         return demand, along, signals, (where.curvature, offset)
 
+    def _ground_pull(self, u: np.ndarray, loads: np.ndarray) -> np.ndarray:
+        """(F_x, F_y, M_z) [N, N, N·m] of the loads on the height map's local slopes, heading frame."""
+        x, y, yaw = (float(value) for value in u[:3])
+        cos, sin = math.cos(yaw), math.sin(yaw)
+        gx, gy = self.ground_map.gradient(x + cos * self.x_hub - sin * self.y_hub,  # type: ignore[union-attr]
+                                          y + sin * self.x_hub + cos * self.y_hub)
+        fx, fy = -loads * (gx * cos + gy * sin), -loads * (-gx * sin + gy * cos)
+        return np.array([fx.sum(), fy.sum(), float(np.sum(self.x_hub * fy - self.y_hub * fx))])
+
     # --- 3. per wheel -----------------------------------------------------------------------------
     def _inverse_steering(self, loads: np.ndarray, gamma: np.ndarray, fx: np.ndarray,
                           fy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -174,6 +198,8 @@ class PathFollowingController:
         loads = np.clip(np.asarray(u[6:6 + WHEELS], float), 1.0, None)
         slip_angles = np.asarray(u[6 + WHEELS:6 + 2 * WHEELS], float)
         demand, along, signals, (curvature, offset) = self._tracking(t, u)
+        if self.ground_map is not None:
+            demand = demand - self._ground_pull(u, loads)
         if self.steering == "kinematic":
             steer, fx_des, fy_des = self._kinematic_steering(along, curvature, offset, signals["cross_track"], loads,
                                                              demand[0])

@@ -1,4 +1,5 @@
-"""``make simulate`` (after the path scenarios): the steerable rover on sloped ground (issue 35).
+"""``make simulate`` (after the path scenarios): the steerable rover on sloped ground and over a
+height map (issue 35).
 
 Scenario ``slope_traverse``: a straight traverse along +x across a side slope (the valley to the
 right, ``PlaneTerrain.side_slope``) of 10 and 20 deg at 0.3 m/s on the paper's soil, started
@@ -11,8 +12,19 @@ rolling on the path, with
 - ``kinematic``: kinematic steering (the ablation): the wheels along their hubs' commanded
   velocities, the downhill pull left to the cross-track feedback.
 
+Scenario ``crater``: 20 m along x at 1.0 m/s on level ground past a crater-like depression
+(``terramechanics.terrain.crater``: a bowl 0.12 m deep of radius 4 m, centred 2.5 m to the right
+of the path at x = 10 m; deeper or narrower bowls twist the footprint by more than the limbs'
+21 mm static compression and lift wheels off), the height map given hub by hub by the ground participant
+(``jobs.ground.GroundBlock``), with the identified models (``inverse``, ``cosim``); the
+controller adds the pull of the loads on the map's local slopes at the hubs as a feed-forward
+(``PathFollowingController(ground_map=...)``); the ablation ``unaware``: the same controller
+without it (the bowl's slopes a disturbance). The map is written beside the results
+(``terrain_crater_heightmap.csv``) and read back from there for the runs.
+
 results/simulation/
-  terrain_<scenario>.csv, terrain_<scenario>_cosim.csv, terrain_<scenario>_kinematic.csv
+  terrain_crater_heightmap.csv  the crater's grid (HeightMap's CSV)
+  terrain_<scenario>.csv, terrain_<scenario>_cosim.csv, terrain_<scenario>_{kinematic,unaware}.csv
                         the columns of path_*.csv (``path_following.trajectories``) and the
                         ground height under the centre of gravity, z_ground [m]
   terrain_metrics.csv   per scenario and run: cross-track RMS and max [m], heading error RMS and max
@@ -30,7 +42,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -50,8 +62,10 @@ from rover_cosim.orchestrator.runs import system_record
 from rover_cosim.progress import Stages
 from rover_cosim.terramechanics import PlaneTerrain, Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
+from rover_cosim.terramechanics.terrain import HeightMap, crater
 
 from . import terrain_figures
+from .ground import SIGNALS, GroundBlock
 from .path_following import BODY, STEP, WHEELS, agreement, connect_controller, trajectories
 from .path_following import metrics as path_metrics
 from .plants import add_plant_fmu, add_rover
@@ -60,7 +74,23 @@ from .simulate import RECORD_INTERVAL, checked_models, models_of
 SPEED = 0.3          # m/s, the traverse's target speed
 TRAVERSE = 6.0       # m, the traverse's length (20 s at 0.3 m/s: the ablation settles in about 15 s)
 SLOPES = {"slope_traverse_10": 10.0, "slope_traverse_20": 20.0}  # scenario -> side slope [deg]
-RUNS = ("inverse", "cosim", "kinematic")
+RUNS = ("inverse", "cosim", "kinematic", "unaware")
+
+
+@dataclass(frozen=True)
+class CraterScenario:
+    """The crater scenario: path ``length`` [m] along x at ``speed`` [m/s], a crater of ``depth`` [m]
+    and ``radius`` [m] centred at ``centre`` [m] (``terramechanics.terrain.crater``)."""
+
+    length: float = 20.0
+    speed: float = 1.0
+    centre: tuple[float, float] = (10.0, -2.5)
+    depth: float = 0.12
+    radius: float = 4.0
+
+
+CRATER = CraterScenario()
+SCENARIOS = (*SLOPES, "crater")
 FMUS = ("SteerableRover", "SteerableRoverBody", "Wheel")
 G = 1.62             # m/s², the rover's gravity (RoverParameters.g, the FMUs' default)
 MASS = 1570.0        # kg, RoverParameters.M
@@ -81,10 +111,36 @@ class TerrainResult:
 
 
 def terrain_of(scenario: str) -> PlaneTerrain:
-    """The ground of ``scenario``: a side slope, the valley to the right of the path along +x."""
-    if scenario not in SLOPES:
-        raise ValueError(f"scenario = {scenario!r}: expected one of {sorted(SLOPES)}")
-    return PlaneTerrain.side_slope(SLOPES[scenario], valley="right")
+    """The ground plane of ``scenario``: a side slope, the valley to the right of the path along +x
+    (the crater: level)."""
+    if scenario not in SCENARIOS:
+        raise ValueError(f"scenario = {scenario!r}: expected one of {list(SCENARIOS)}")
+    return PlaneTerrain.side_slope(SLOPES[scenario], valley="right") if scenario in SLOPES else PlaneTerrain()
+
+
+def crater_map() -> HeightMap:
+    """The crater scenario's height map (``CRATER``)."""
+    return crater(CRATER.centre, CRATER.depth, CRATER.radius, rim=0.0)
+
+
+def speed_of(scenario: str) -> float:
+    """m/s: the scenario's target speed."""
+    return CRATER.speed if scenario == "crater" else SPEED
+
+
+class Ground:
+    """What a run drives on: the plane and, over it, a height map (or none); ``height`` [m] is the
+    world height of the plane plus the map's (its height along the plane's normal)."""
+
+    def __init__(self, plane: PlaneTerrain, height_map: HeightMap | None = None):
+        self.plane, self.map = plane, height_map
+
+    def height(self, x: Any, y: Any) -> Any:
+        base = self.plane.height(x, y)
+        return base if self.map is None else base + math.cos(self.plane.slope) * self.map.height(x, y)
+
+    def label(self) -> str:
+        return self.plane.label() + ("" if self.map is None else f", {self.map.source}")
 
 
 def traverse_path(length: float = TRAVERSE) -> ReferencePath:
@@ -94,46 +150,70 @@ def traverse_path(length: float = TRAVERSE) -> ReferencePath:
     return ReferencePath((Line(length),))
 
 
-def stop_time(length: float = TRAVERSE) -> float:
+def stop_time(length: float = TRAVERSE, speed: float = SPEED) -> float:
     """s: until the reference point reaches the end of the traverse (to the step)."""
-    return float(np.floor(traverse_path(length).length / SPEED / STEP) * STEP)
+    return float(np.floor(traverse_path(length).length / speed / STEP) * STEP)
 
 
 def _radius(choice: Choice | None) -> float:
     return (choice.wheel if choice else Wheel()).r
 
 
+def _add_ground(builder: SystemBuilder, body: str, height_map: HeightMap | None) -> list[str]:
+    """The ground participant on ``body``'s hubs (none without a map); its name in a list."""
+    if height_map is None:
+        return []
+    builder.add_block("ground", GroundBlock("ground", height_map))
+    for name in BODY:
+        builder.connect(f"{body}.{name}", f"ground.{name}")
+    for signal in SIGNALS:
+        for i in WHEELS:
+            builder.connect(f"ground.{signal}[{i}]", f"{body}.{signal}[{i}]")
+    return ["ground"]
+
+
 def traverse_system(fmu_dir: Path, model: ModelSet | Path, terrain: PlaneTerrain, run_: str = "inverse",
-                    choice: Choice | None = None, length: float = TRAVERSE) -> System:
-    """The traverse on ``terrain``: ``run_`` "inverse" or "kinematic" on SteerableRover.fmu,
-    "cosim" on SteerableRoverBody + 6 Wheel (the controller first in the Gauss-Seidel order)."""
+                    choice: Choice | None = None, length: float = TRAVERSE, *, speed: float = SPEED,
+                    height_map: HeightMap | None = None) -> System:
+    """The traverse along x of ``length`` [m] at ``speed`` [m/s] on ``terrain`` (and over
+    ``height_map``, given by the ground participant): ``run_`` "inverse" or "kinematic" on
+    SteerableRover.fmu, "cosim" on SteerableRoverBody + 6 Wheel (the controller first in the
+    Gauss-Seidel order, the ground after the body), "unaware" as "inverse" with a controller that
+    knows neither the slope nor the map (no feed-forward of their pull)."""
     if run_ not in RUNS:
         raise ValueError(f"run = {run_!r}: expected one of {RUNS}")
     if not isinstance(terrain, PlaneTerrain):
         raise TypeError(f"terrain = {terrain!r}: expected a PlaneTerrain")
-    builder = SystemBuilder(f"traverse {terrain.label()} ({run_})").simulation(
-        stop_time=stop_time(length), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
-    spin = SPEED / _radius(choice)
-    block = PathFollowingController("ctrl", models_of(model), path=traverse_path(length), v_target=SPEED,
+    if not (math.isfinite(speed) and speed > 0):
+        raise ValueError(f"speed = {speed!r} m/s: expected > 0")
+    builder = SystemBuilder(f"traverse {Ground(terrain, height_map).label()} ({run_})").simulation(
+        stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
+    spin = speed / _radius(choice)
+    block = PathFollowingController("ctrl", models_of(model), path=traverse_path(length), v_target=speed,
                                     steering="kinematic" if run_ == "kinematic" else "inverse", step=STEP,
-                                    terrain=terrain, g=G, mass=MASS)
+                                    terrain=None if run_ == "unaware" else terrain, g=G, mass=MASS,
+                                    ground_map=height_map if run_ in ("inverse", "cosim") else None)
     if run_ == "cosim":
         wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu",
-                           len(WHEELS), choice, lateral=True, body_start={"v": SPEED}, wheel_start={"omega": spin})
+                           len(WHEELS), choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": spin})
         builder.set_parameters("body", terrain.fmu_parameters())
         builder.add_block("ctrl", block)
         connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
         for i, wheel in zip(WHEELS, wheels):
             builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
             builder.connect(f"ctrl.steer[{i}]", f"body.steer[{i}]")
-        return builder.simulation(order=["ctrl", "body", *wheels]).build()
+        ground = _add_ground(builder, "body", height_map)
+        return builder.simulation(order=["ctrl", "body", *ground, *wheels]).build()
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice,
-                  {"v": SPEED, **{f"omega[{i}]": spin for i in WHEELS}})
+                  {"v": speed, **{f"omega[{i}]": spin for i in WHEELS}})
     builder.set_parameters("rover", terrain.fmu_parameters())
     builder.add_block("ctrl", block)
     connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
     for i in WHEELS:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
+    ground = _add_ground(builder, "rover", height_map)
+    if ground:
+        builder.simulation(order=["ctrl", "rover", *ground])
     return builder.build()
 
 
@@ -143,11 +223,11 @@ def motor_energy(table: pd.DataFrame) -> float:
     return float(np.trapezoid(power, table["time"].to_numpy()))
 
 
-def metrics(table: pd.DataFrame) -> dict[str, float]:
+def metrics(table: pd.DataFrame, speed: float = SPEED) -> dict[str, float]:
     """The path metrics (``path_following.metrics``), the heading error RMS and max [rad], per wheel
     the means over the second half of the run (the steady traverse) of slip [-], slip angle [rad],
     sinkage [m] and load [N], and the motors' energy per metre of path [J/m]."""
-    row = path_metrics(table, SPEED)
+    row = path_metrics(table, speed)
     row["heading_error_rms_rad"] = float(np.sqrt(np.mean(table["heading_error"] ** 2)))
     row["heading_error_max_rad"] = float(np.abs(table["heading_error"]).max())
     steady = table[table["time"] >= table["time"].iloc[-1] / 2]
@@ -159,67 +239,105 @@ def metrics(table: pd.DataFrame) -> dict[str, float]:
     return row
 
 
-def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = tuple(SLOPES),
+def runs_of(scenario: str, runs: tuple[str, ...]) -> tuple[str, ...]:
+    """The runs of ``scenario`` among ``runs``: the slopes' ablation is kinematic steering, the
+    crater's the identified models with the map unknown to the controller (``unaware``)."""
+    return tuple(r for r in runs if r != ("kinematic" if scenario == "crater" else "unaware"))
+
+
+def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = SCENARIOS,
                 choice: Choice | Soil | Wheel | None = None, *, allow_model_mismatch: bool = False,
                 progress: Callable[[float], None] | None = None, record_interval: float = RECORD_INTERVAL,
-                length: float = TRAVERSE, runs: tuple[str, ...] = RUNS) -> TerrainResult:
-    """Every scenario with every run of ``runs`` (``inverse`` and ``cosim`` with compensation,
-    ``kinematic`` the ablation) on the soil and wheel of ``choice`` (default: the paper's); writes
-    every file (all or none). ``length`` [m]: the traverse (6 m; the tests run shorter ones)."""
+                length: float | None = None, runs: tuple[str, ...] = RUNS) -> TerrainResult:
+    """Every scenario with the runs of ``runs`` it has (``runs_of``: ``inverse`` and ``cosim`` with
+    compensation, the ablation ``kinematic`` or, for the crater, ``unaware``) on the soil and wheel
+    of ``choice`` (default: the paper's); writes every file (all or none). ``length`` [m]: the slope traverses' length
+    (None: 6 m; the tests run shorter ones; the crater's path is 20 m)."""
     started = time.perf_counter()
     choice = as_choice(choice)
     steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
-    traverse_path(length)
-    unknown = [s for s in scenarios if s not in SLOPES] + [r for r in runs if r not in RUNS]
+    slope_length = TRAVERSE if length is None else length
+    traverse_path(slope_length)
+    unknown = [s for s in scenarios if s not in SCENARIOS] + [r for r in runs if r not in RUNS]
     if unknown or not scenarios or "inverse" not in runs:
-        raise ValueError(f"scenarios {scenarios!r}, runs {runs!r}: expected scenarios of {sorted(SLOPES)} and runs "
+        raise ValueError(f"scenarios {scenarios!r}, runs {runs!r}: expected scenarios of {list(SCENARIOS)} and runs "
                          f"of {RUNS} with 'inverse' among them")
     fmu_dir = Path(fmu_dir).resolve()
+    out = Path(out_dir)
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
-    stages = Stages(progress, len(scenarios) * len(runs))
+    plan = [(s, label) for s in scenarios for label in runs_of(s, runs)]
+    stages = Stages(progress, len(plan))
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     walls: dict[str, float] = {}
     systems: dict[str, Any] = {}
-    for i, scenario in enumerate(scenarios):
-        terrain = terrain_of(scenario)
-        for j, label in enumerate(runs):
-            system = traverse_system(fmu_dir, models, terrain, label, choice, length)
-            systems[f"{scenario}/{label}"] = system_record(system)
-            outcome = run(system, progress=stages.stage(i * len(runs) + j))
-            table = trajectories(outcome.data, cosim=label == "cosim")
-            table["z_ground"] = terrain.height(table["x"], table["y"])
-            tables[scenario, label] = table
-            walls[f"{scenario}/{label}"] = outcome.wall_seconds
-    metric_table = pd.DataFrame([{"scenario": s, "run": label, "side_slope_deg": SLOPES[s], "target_speed_m_s": SPEED,
-                                  **metrics(tables[s, label])} for s in scenarios for label in runs])
-    agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"], SPEED)}
+    grounds: dict[str, Ground] = {}
+    files: dict[Path, bytes] = {}
+    for k, (scenario, label) in enumerate(plan):
+        if scenario not in grounds:
+            height_map = None
+            if scenario == "crater":  # written, then read back: the runs use the file's map
+                files[out / "terrain_crater_heightmap.csv"] = crater_map().write("")
+                height_map = _read_back(files[out / "terrain_crater_heightmap.csv"])
+            grounds[scenario] = Ground(terrain_of(scenario), height_map)
+        ground = grounds[scenario]
+        system = traverse_system(fmu_dir, models, ground.plane, label, choice, _length(scenario, slope_length),
+                                 speed=speed_of(scenario), height_map=ground.map)
+        systems[f"{scenario}/{label}"] = system_record(system)
+        outcome = run(system, progress=stages.stage(k))
+        table = trajectories(outcome.data, cosim=label == "cosim")
+        table["z_ground"] = ground.height(table["x"], table["y"])
+        tables[scenario, label] = table
+        walls[f"{scenario}/{label}"] = outcome.wall_seconds
+    metric_table = pd.DataFrame([{"scenario": s, "run": label, "side_slope_deg": SLOPES.get(s, 0.0),
+                                  "target_speed_m_s": speed_of(s), **metrics(tables[s, label], speed_of(s))}
+                                 for s, label in plan])
+    agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"], speed_of(s))}
                                     for s in scenarios if "cosim" in runs])
     record = run_record("rover-cosim simulate (terrain)",
-                        {"scenarios": {s: {"terrain": vars(terrain_of(s)), "side_slope_deg": SLOPES[s]}
-                                       for s in scenarios}, "target_speed_m_s": SPEED, "length_m": length,
-                         "stop_time_s": stop_time(length), "step_s": STEP, "model": str(model), "runs": list(runs),
+                        {"scenarios": {s: {"terrain": vars(terrain_of(s)), "side_slope_deg": SLOPES.get(s, 0.0),
+                                           "target_speed_m_s": speed_of(s), "length_m": _length(s, slope_length),
+                                           "stop_time_s": stop_time(_length(s, slope_length), speed_of(s)),
+                                           **({"crater": asdict(CRATER)} if s == "crater" else {})}
+                                       for s in scenarios},
+                         "step_s": STEP, "model": str(model), "runs": list(runs),
                          "algorithm": "gauss-seidel", "record_interval_s": record_interval})
     record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
                    "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
                    "model_mismatch": mismatch, "systems": systems, "wall_seconds": time.perf_counter() - started,
                    "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
-    out = Path(out_dir)
-    suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic"}
-    files = {out / f"terrain_{s}{suffix[label]}.csv": every(table, record_interval, STEP).to_csv(
-        index=False, float_format="%.8g").encode() for (s, label), table in tables.items()}
+    suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic", "unaware": "_unaware"}
+    files.update({out / f"terrain_{s}{suffix[label]}.csv": every(table, record_interval, STEP).to_csv(
+        index=False, float_format="%.8g").encode() for (s, label), table in tables.items()})
     files.update({
         out / "terrain_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "terrain_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "terrain_xy.png": terrain_figures.paths_over_terrain(
-            {s: (traverse_path(length), terrain_of(s)) for s in scenarios}, tables),
+            {s: (traverse_path(_length(s, slope_length)), grounds[s]) for s in scenarios}, tables),
         out / "terrain.json": json_bytes(record),
     })
     for s in scenarios:
         files[out / f"terrain_wheels_{s}.png"] = terrain_figures.wheels(
-            {label: tables[s, label] for label in runs if label != "cosim"}, s)
+            {label: tables[s, label] for label in runs_of(s, runs) if label != "cosim"}, s)
     write_all(files, folder=out, stale=("terrain_*",))  # the straight run's and the paths' files stay
     return TerrainResult(sorted(files), tables, metric_table, agreement_table, record)
 
 
-__all__ = ["BODY", "RUNS", "SLOPES", "SPEED", "TRAVERSE", "TerrainResult", "metrics", "motor_energy", "run_terrain",
-           "stop_time", "terrain_of", "traverse_path", "traverse_system"]
+def _length(scenario: str, slope_length: float) -> float:
+    return CRATER.length if scenario == "crater" else slope_length
+
+
+def _read_back(text: bytes) -> HeightMap:
+    """The height map of the CSV ``text`` (as ``HeightMap.read`` reads the written file)."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "terrain_crater_heightmap.csv"
+        path.write_bytes(text)
+        height_map = HeightMap.read(path)
+    height_map.source = "crater (terrain_crater_heightmap.csv)"
+    return height_map
+
+
+__all__ = ["BODY", "CRATER", "RUNS", "SCENARIOS", "SLOPES", "SPEED", "TRAVERSE", "Ground", "TerrainResult",
+           "crater_map", "metrics", "motor_energy", "run_terrain", "speed_of", "stop_time", "terrain_of",
+           "traverse_path", "traverse_system"]

@@ -5,31 +5,36 @@ from __future__ import annotations
 import matplotlib
 
 matplotlib.use("Agg")
+from typing import Any
+
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
 from rover_cosim.control.path import Path
 from rover_cosim.identification.figures import png_bytes
-from rover_cosim.terramechanics import PlaneTerrain
 
 LABELS = {"inverse": "identified models, downhill pull compensated (SteerableRover.fmu)",
           "cosim": "identified models, compensated (co-simulated)",
-          "kinematic": "kinematic steering (ablation)"}
-STYLES = {"inverse": "-", "cosim": "--", "kinematic": ":"}
-COLORS = {"inverse": "tab:blue", "cosim": "tab:orange", "kinematic": "tab:red"}
+          "kinematic": "kinematic steering (ablation)",
+          "unaware": "identified models, the map unknown to the controller (ablation)"}
+STYLES = {"inverse": "-", "cosim": "--", "kinematic": ":", "unaware": ":"}
+COLORS = {"inverse": "tab:blue", "cosim": "tab:orange", "kinematic": "tab:red", "unaware": "tab:red"}
 
 
-def paths_over_terrain(scenarios: dict[str, tuple[Path, PlaneTerrain]],
+def paths_over_terrain(scenarios: dict[str, tuple[Path, Any]],
                        tables: dict[tuple[str, str], pd.DataFrame]) -> bytes:
-    """Per scenario: the ground's height contours [m] with the reference path and the centre of
-    gravity of each run (top), the cross-track error against arc length (bottom)."""
+    """Per scenario: the ground's height contours [m] (``terrain.height(x, y)``, ``terrain.label()``)
+    with the reference path and the centre of gravity of each run (top), the cross-track error
+    against arc length (bottom)."""
     fig, axes = plt.subplots(2, len(scenarios), figsize=(6.5 * len(scenarios), 9), squeeze=False)
     for column, (scenario, (path, terrain)) in enumerate(scenarios.items()):
         top, bottom = axes[0][column], axes[1][column]
         runs = {label: table for (name, label), table in tables.items() if name == scenario}
         ys = np.concatenate([path.y, *[t["y"].to_numpy() for t in runs.values()]])
         half = max(1.0, 1.5 * float(np.abs(ys).max()))
+        if getattr(terrain, "map", None) is not None:  # a height map: show it around the path
+            half = max(half, 6.0)
         x = np.linspace(float(path.x.min()) - 1.0, float(path.x.max()) + 1.0, 120)
         y = np.linspace(-half, half, 80)
         grid_x, grid_y = np.meshgrid(x, y)
@@ -38,13 +43,16 @@ def paths_over_terrain(scenarios: dict[str, tuple[Path, PlaneTerrain]],
         fig.colorbar(filled, ax=top, label="ground height z [m]", orientation="horizontal", pad=0.15)
         top.plot(path.x, path.y, color="0.3", lw=5, alpha=0.4, label="reference path")
         for label, table in runs.items():
-            top.plot(table["x"], table["y"], STYLES[label], color=COLORS[label], label=LABELS[label])
-            bottom.plot(table["s"], 100 * table["cross_track"], STYLES[label], color=COLORS[label],
-                        label=LABELS[label])
+            name = LABELS[label] if terrain.plane.slope else LABELS[label].replace("downhill pull", "map's pull")
+            top.plot(table["x"], table["y"], STYLES[label], color=COLORS[label], label=name)
+            bottom.plot(table["s"], 100 * table["cross_track"], STYLES[label], color=COLORS[label], label=name)
+        if getattr(terrain, "map", None) is not None:
+            top.set_aspect("equal")
         top.set_xlabel("x along the ground [m]")
-        top.set_ylabel("y along the ground [m] (downhill: -y)")
-        top.set_title(f"{terrain.label()}: centre of gravity over the ground's height\n"
-                      "(y stretched; the ground's x axis runs level across the slope)", fontsize=10)
+        top.set_ylabel("y along the ground [m]")
+        top.set_title(f"{terrain.label()}: centre of gravity\n"
+                      + ("(y stretched; the ground's x axis runs level across the slope)"
+                         if getattr(terrain, "map", None) is None else "(to scale)"), fontsize=10)
         bottom.set_xlabel("arc length s [m]")
         bottom.set_ylabel("cross-track error [cm] (left/uphill +)")
         bottom.set_title("cross-track error along the path")
@@ -73,6 +81,7 @@ def wheels(tables: dict[str, pd.DataFrame], scenario: str) -> bytes:
     axes[-1].set_xlabel("time [s]")
     kinds = {"-": "solid", "--": "dashed", ":": "dotted"}
     runs = ", ".join(f"{kinds[STYLES[label]]}: {LABELS[label].split(' (')[0]}" for label in tables)
-    axes[0].set_title(f"{scenario.replace('_', ' ')} deg: wheels 1-3 left/uphill (front, middle, rear), "
+    title = "crater" if scenario == "crater" else f"{scenario.replace('_', ' ')} deg"
+    axes[0].set_title(f"{title}: wheels 1-3 left/uphill (front, middle, rear), "
                       f"4-6 right/downhill\n{runs}", fontsize=10)
     return png_bytes(fig)
