@@ -177,7 +177,8 @@ class HeightMap:
         self.source = source
         for name, axis in (("x", self.x), ("y", self.y)):
             if axis.ndim != 1 or axis.size < 4 or not np.isfinite(axis).all() or not (np.diff(axis) > 0).all():
-                raise ValueError(f"{source}: the grid's {name} = {axis!r} m: expected at least 4 finite, "
+                shown = ", ".join(f"{v:g}" for v in axis.ravel()[:6]) + (", ..." if axis.size > 6 else "")
+                raise ValueError(f"{source}: the grid's {name} = [{shown}] m: expected at least 4 finite, "
                                  "strictly increasing values")
         if self.heights.shape != (self.y.size, self.x.size):
             raise ValueError(f"{source}: heights of shape {self.heights.shape}: expected (len(y), len(x)) = "
@@ -186,7 +187,7 @@ class HeightMap:
         if bad.size:
             j, i = bad[0]
             raise ValueError(f"{source}: height at x = {self.x[i]:g} m, y = {self.y[j]:g} m is "
-                             f"{self.heights[j, i]!r}: expected a finite height in m")
+                             f"{float(self.heights[j, i])!r}: expected a finite height in m")
         self._spline = RectBivariateSpline(self.y, self.x, self.heights, kx=3, ky=3)
 
     def _clamped(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:

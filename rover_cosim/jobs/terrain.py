@@ -118,14 +118,14 @@ def terrain_of(scenario: str) -> PlaneTerrain:
     return PlaneTerrain.side_slope(SLOPES[scenario], valley="right") if scenario in SLOPES else PlaneTerrain()
 
 
-def crater_map() -> HeightMap:
-    """The crater scenario's height map (``CRATER``)."""
-    return crater(CRATER.centre, CRATER.depth, CRATER.radius, rim=0.0)
+def crater_map(scenario: CraterScenario = CRATER) -> HeightMap:
+    """The crater scenario's height map."""
+    return crater(scenario.centre, scenario.depth, scenario.radius, rim=0.0)
 
 
-def speed_of(scenario: str) -> float:
+def speed_of(scenario: str, crater_scenario: CraterScenario = CRATER) -> float:
     """m/s: the scenario's target speed."""
-    return CRATER.speed if scenario == "crater" else SPEED
+    return crater_scenario.speed if scenario == "crater" else SPEED
 
 
 class Ground:
@@ -241,18 +241,22 @@ def metrics(table: pd.DataFrame, speed: float = SPEED) -> dict[str, float]:
 
 def runs_of(scenario: str, runs: tuple[str, ...]) -> tuple[str, ...]:
     """The runs of ``scenario`` among ``runs``: the slopes' ablation is kinematic steering, the
-    crater's the identified models with the map unknown to the controller (``unaware``)."""
-    return tuple(r for r in runs if r != ("kinematic" if scenario == "crater" else "unaware"))
+    crater's the identified models with the map unknown to the controller (``unaware``); the
+    co-simulated rover on the steeper slope and the crater (not again on the 10 deg slope: time)."""
+    left_out = {"kinematic" if scenario == "crater" else "unaware"} | ({"cosim"} if scenario == "slope_traverse_10"
+                                                                       else set())
+    return tuple(r for r in runs if r not in left_out)
 
 
 def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = SCENARIOS,
                 choice: Choice | Soil | Wheel | None = None, *, allow_model_mismatch: bool = False,
                 progress: Callable[[float], None] | None = None, record_interval: float = RECORD_INTERVAL,
-                length: float | None = None, runs: tuple[str, ...] = RUNS) -> TerrainResult:
+                length: float | None = None, runs: tuple[str, ...] = RUNS,
+                crater_scenario: CraterScenario = CRATER) -> TerrainResult:
     """Every scenario with the runs of ``runs`` it has (``runs_of``: ``inverse`` and ``cosim`` with
     compensation, the ablation ``kinematic`` or, for the crater, ``unaware``) on the soil and wheel
     of ``choice`` (default: the paper's); writes every file (all or none). ``length`` [m]: the slope traverses' length
-    (None: 6 m; the tests run shorter ones; the crater's path is 20 m)."""
+    (None: 6 m; the tests run shorter ones); ``crater_scenario``: the crater's path and bowl."""
     started = time.perf_counter()
     choice = as_choice(choice)
     steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
@@ -266,6 +270,8 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
     out = Path(out_dir)
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     plan = [(s, label) for s in scenarios for label in runs_of(s, runs)]
+    speeds = {s: speed_of(s, crater_scenario) for s in scenarios}
+    lengths = {s: _length(s, slope_length, crater_scenario) for s in scenarios}
     stages = Stages(progress, len(plan))
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     walls: dict[str, float] = {}
@@ -276,12 +282,12 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
         if scenario not in grounds:
             height_map = None
             if scenario == "crater":  # written, then read back: the runs use the file's map
-                files[out / "terrain_crater_heightmap.csv"] = crater_map().write("")
+                files[out / "terrain_crater_heightmap.csv"] = crater_map(crater_scenario).write("")
                 height_map = _read_back(files[out / "terrain_crater_heightmap.csv"])
             grounds[scenario] = Ground(terrain_of(scenario), height_map)
         ground = grounds[scenario]
-        system = traverse_system(fmu_dir, models, ground.plane, label, choice, _length(scenario, slope_length),
-                                 speed=speed_of(scenario), height_map=ground.map)
+        system = traverse_system(fmu_dir, models, ground.plane, label, choice, lengths[scenario],
+                                 speed=speeds[scenario], height_map=ground.map)
         systems[f"{scenario}/{label}"] = system_record(system)
         outcome = run(system, progress=stages.stage(k))
         table = trajectories(outcome.data, cosim=label == "cosim")
@@ -289,15 +295,15 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
         tables[scenario, label] = table
         walls[f"{scenario}/{label}"] = outcome.wall_seconds
     metric_table = pd.DataFrame([{"scenario": s, "run": label, "side_slope_deg": SLOPES.get(s, 0.0),
-                                  "target_speed_m_s": speed_of(s), **metrics(tables[s, label], speed_of(s))}
+                                  "target_speed_m_s": speeds[s], **metrics(tables[s, label], speeds[s])}
                                  for s, label in plan])
-    agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"], speed_of(s))}
-                                    for s in scenarios if "cosim" in runs])
+    agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"], speeds[s])}
+                                    for s in scenarios if (s, "cosim") in tables])
     record = run_record("rover-cosim simulate (terrain)",
                         {"scenarios": {s: {"terrain": vars(terrain_of(s)), "side_slope_deg": SLOPES.get(s, 0.0),
-                                           "target_speed_m_s": speed_of(s), "length_m": _length(s, slope_length),
-                                           "stop_time_s": stop_time(_length(s, slope_length), speed_of(s)),
-                                           **({"crater": asdict(CRATER)} if s == "crater" else {})}
+                                           "target_speed_m_s": speeds[s], "length_m": lengths[s],
+                                           "stop_time_s": stop_time(lengths[s], speeds[s]),
+                                           **({"crater": asdict(crater_scenario)} if s == "crater" else {})}
                                        for s in scenarios},
                          "step_s": STEP, "model": str(model), "runs": list(runs),
                          "algorithm": "gauss-seidel", "record_interval_s": record_interval})
@@ -312,7 +318,7 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
         out / "terrain_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "terrain_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "terrain_xy.png": terrain_figures.paths_over_terrain(
-            {s: (traverse_path(_length(s, slope_length)), grounds[s]) for s in scenarios}, tables),
+            {s: (traverse_path(lengths[s]), grounds[s]) for s in scenarios}, tables),
         out / "terrain.json": json_bytes(record),
     })
     for s in scenarios:
@@ -322,8 +328,8 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
     return TerrainResult(sorted(files), tables, metric_table, agreement_table, record)
 
 
-def _length(scenario: str, slope_length: float) -> float:
-    return CRATER.length if scenario == "crater" else slope_length
+def _length(scenario: str, slope_length: float, crater_scenario: CraterScenario = CRATER) -> float:
+    return crater_scenario.length if scenario == "crater" else slope_length
 
 
 def _read_back(text: bytes) -> HeightMap:
@@ -339,5 +345,5 @@ def _read_back(text: bytes) -> HeightMap:
 
 
 __all__ = ["BODY", "CRATER", "RUNS", "SCENARIOS", "SLOPES", "SPEED", "TRAVERSE", "Ground", "TerrainResult",
-           "crater_map", "metrics", "motor_energy", "run_terrain", "speed_of", "stop_time", "terrain_of",
-           "traverse_path", "traverse_system"]
+           "CraterScenario", "crater_map", "metrics", "motor_energy", "run_terrain", "speed_of", "stop_time",
+           "terrain_of", "traverse_path", "traverse_system"]
