@@ -80,8 +80,11 @@ def wheels(tables: dict[str, pd.DataFrame], scenario: str) -> bytes:
     axes[0].legend(fontsize=7, ncol=6, loc="upper right")
     axes[-1].set_xlabel("time [s]")
     kinds = {"-": "solid", "--": "dashed", ":": "dotted"}
-    runs = ", ".join(f"{kinds[STYLES[label]]}: {LABELS[label].split(' (')[0]}" for label in tables)
-    title = "crater" if scenario == "crater" else f"{scenario.replace('_', ' ')} deg"
-    axes[0].set_title(f"{title}: wheels 1-3 left/uphill (front, middle, rear), "
-                      f"4-6 right/downhill\n{runs}", fontsize=10)
+    crater = scenario == "crater"
+    pull = "map's pull" if crater else "downhill pull"
+    run_names = {label: LABELS[label].split(" (")[0].replace("downhill pull", pull) for label in tables}
+    runs = ", ".join(f"{kinds[STYLES[label]]}: {run_names[label]}" for label in tables)
+    title = "crater" if crater else f"{scenario.replace('_', ' ')} deg"
+    sides = "1-3 left, 4-6 right (the bowl's side)" if crater else "1-3 left/uphill, 4-6 right/downhill"
+    axes[0].set_title(f"{title}: wheels {sides}; front, middle, rear\n{runs}", fontsize=10)
     return png_bytes(fig)
