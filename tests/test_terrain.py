@@ -400,3 +400,15 @@ def test_past_the_crater_the_maps_feed_forward_holds_the_path(fmu_dir, identifie
     assert loads.min() > 50.0 and loads.max() - loads.min() > 100.0
     assert table["z_ground"].min() < -0.02
     assert HeightMap.read(tmp_path / "terrain_crater_heightmap.csv").heights.min() < -0.039
+
+
+def test_simulate_offers_the_terrain_scenarios_alone(tmp_path):
+    """``rover-cosim simulate --only terrain`` is a choice of the command; a wrong one names them."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-P", "-m", "rover_cosim", "simulate", "--only", "hills", "--out",
+                           str(tmp_path / "out"), "--fmu-dir", str(tmp_path), "--model", str(tmp_path / "m.json")],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert "'hills'" in done.stderr and "terrain" in done.stderr and "Traceback" not in done.stderr
