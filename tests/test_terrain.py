@@ -9,12 +9,14 @@ balance; the traverse with the downhill pull compensated against kinematic steer
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
 from rover_cosim.control.path_controller import PathFollowingController
+from rover_cosim.control.terrain_controller import TerrainPathController
 from rover_cosim.jobs.ground import GroundBlock
 from rover_cosim.jobs.terrain import SLOPES, CraterScenario, run_terrain, traverse_path
 from rover_cosim.orchestrator.builder import SystemBuilder
@@ -199,20 +201,35 @@ def test_level_ground_in_any_downhill_direction_is_the_level_rover_exactly(fmus)
         np.testing.assert_array_equal(level[name], default[name], err_msg=name)
 
 
-def test_the_controller_on_level_ground_is_the_controller_without_terrain(identified):
-    """The same inputs give the same outputs, bit for bit, with terrain=PlaneTerrain() and without;
-    on a 20 deg side slope the lateral demand grows by the downhill pull."""
+def test_the_terrain_controller_on_level_ground_is_the_path_controller(identified):
+    """The same inputs give the same outputs, bit for bit: the path controller and the terrain
+    controller on level ground (in any downhill direction) with no map, both steerings; on a 20 deg
+    side slope the wheels' lateral demand grows by the downhill pull; over a tilted map by the
+    loads' pull on it; and the C twin (which knows no pull) is offered only without one."""
     model = identified.files[0].parent / "model.json"
-    blocks = {name: PathFollowingController("ctrl", model, path=traverse_path(5.0), v_target=0.3, terrain=terrain)
-              for name, terrain in (("none", None), ("level", PlaneTerrain()),
-                                    ("slope", PlaneTerrain.side_slope(20.0)))}
-    u = np.array([0.1, -0.01, 0.002, 0.3, -0.001, 0.0, *[424.0] * 6, *[0.0] * 6])
-    out = {name: block.start(0.0, u) for name, block in blocks.items()}
-    np.testing.assert_array_equal(out["level"], out["none"])
-    fy_des = {name: value[18:24] for name, value in out.items()}  # Fy_des[1..6]
-    pull = MASS * G * math.sin(math.radians(20.0))
+    options: dict[str, Any] = {"path": traverse_path(5.0), "v_target": 0.3}
+    u = np.array([0.1, -0.01, 0.002, 0.3, -0.001, 0.0, *[424.0, 410.0, 430.0, 440.0, 400.0, 420.0], *[0.0] * 6])
+    for steering in ("inverse", "kinematic"):
+        plain = PathFollowingController("ctrl", model, steering=steering, **options).start(0.0, u)
+        for terrain in (None, PlaneTerrain(), PlaneTerrain(0.0, 1.3)):
+            block = TerrainPathController("ctrl", model, steering=steering, terrain=terrain, **options)
+            np.testing.assert_array_equal(block.start(0.0, u), plain)
+    x = y = np.linspace(-20, 20, 41)
+    gx, gy = np.meshgrid(x, y)
+    blocks = {"none": PathFollowingController("ctrl", model, **options),
+              "slope": TerrainPathController("ctrl", model, terrain=PlaneTerrain.side_slope(20.0), **options),
+              "map": TerrainPathController("ctrl", model, ground_map=HeightMap(x, y, 0.05 * gy), **options)}
+    fy_des = {name: block.start(0.0, u)[18:24] for name, block in blocks.items()}  # Fy_des[1..6]
     # the wheels' lateral demand (in their frames, steered by a few degrees) now holds the pull
+    pull = MASS * G * math.sin(math.radians(20.0))
     assert 0.95 * pull < (fy_des["slope"] - fy_des["none"]).sum() < 1.05 * pull
+    pull = 0.05 * sum(u[6:12])                           # the loads on the map's slope, to the right
+    assert 0.95 * pull < (fy_des["map"] - fy_des["none"]).sum() < 1.05 * pull
+    for name in ("slope", "map"):
+        held = blocks[name]
+        assert isinstance(held, TerrainPathController) and held.native() is None
+    with pytest.raises(ValueError, match="g = -1.0"):
+        TerrainPathController("ctrl", model, g=-1.0, **options)
 
 
 def test_the_reference_wheel_at_each_wheels_state_on_the_slope_gives_the_fmus_forces(fmus):

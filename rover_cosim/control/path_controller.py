@@ -12,13 +12,6 @@ as an orchestrator block for the steerable rover.
      k_psi (psi_p - psi) + k_r (v_s kappa - r) with k_psi = 1.0 1/s², k_r = 2.0 1/s (critically
      damped at 1 rad/s), yaw moment M_z = Izz times that, saturated at Izz alpha_max.
    The body's force demand M (a_t, a_n) turned into the heading frame, and M_z.
-   On sloped ground (``terrain``, a ``PlaneTerrain``) the wheels must also hold the body against
-   gravity's pull in the ground plane: the demand is M (a_t, a_n) - M (g_along, g_lateral), with
-   gravity's components in the heading frame of ``PlaneTerrain.gravity`` (the downhill pull as a
-   feed-forward; on level ground nothing is added). Over a height map (``ground_map``) the loads,
-   normal to the local ground of gradient s_i under hub i, push the body by -W_i s_i: the
-   feed-forward adds sum W_i s_i (and its yaw moment), with the measured loads and the map's
-   gradients at the hubs.
 2. Allocation (``allocation``): each wheel's (f_x, f_y) in the heading frame, least squares
    weighted by the measured loads.
 3. Per wheel, the identified models at its measured load W_i: the steering angle delta and the
@@ -29,15 +22,12 @@ as an orchestrator block for the steerable rover.
    the last step's); the torque for Fx_des by the paper's inverse longitudinal model
    (``longitudinal``). ``steering = "kinematic"`` is the ablation: each wheel pointed along the
    velocity its hub would have if the body moved as commanded (no slip-angle compensation),
-   yaw rate v_s kappa + k_psi/k_r-style corrections, Fx_des from the along-path demand alone
-   (with gravity's component along the heading: the longitudinal model still holds the speed on an
-   up- or down-slope; the lateral pull is left to the cross-track feedback through the steering).
+   yaw rate v_s kappa + k_psi/k_r-style corrections, Fx_des from the along-path demand alone.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any, Protocol
 
 import numpy as np
 
@@ -46,26 +36,6 @@ from rover_cosim.identification.model_set import ModelSet
 from .allocation import allocate, allocation_matrix
 from .longitudinal import LongitudinalInverse, read_model
 from .path import Path, lane_change_path, turn_path
-
-
-class Ground(Protocol):
-    """What the controller needs of the ground (``rover_cosim.terramechanics.PlaneTerrain``)."""
-
-    @property
-    def level(self) -> bool: ...
-
-    def gravity(self, heading: float, g: float) -> tuple[Any, Any, float]:
-        """Gravity [m/s²] along the heading, to its left, into the ground (heading [rad])."""
-        ...
-
-
-class GroundMap(Protocol):
-    """A height map over the ground plane (``rover_cosim.terramechanics.terrain.HeightMap``)."""
-
-    def gradient(self, x: Any, y: Any) -> tuple[Any, Any]:
-        """(dh/dx, dh/dy) [1] at the points (x, y) [m]."""
-        ...
-
 
 WHEELS = 6
 PATHS = {"turn": turn_path, "lane_change": lane_change_path}
@@ -89,8 +59,7 @@ class PathFollowingController:
                  kv: float = 1.0, kp: float = 0.01, a_max: float = 0.1,
                  k_e: float = 0.25, k_de: float = 1.0, a_n_max: float = 0.3,
                  k_psi: float = 1.0, k_r: float = 2.0, alpha_max: float = 0.5,
-                 wn: float = 342.0, step: float = 1e-3, terrain: Ground | None = None, g: float = 1.62,
-                 ground_map: GroundMap | None = None):
+                 wn: float = 342.0, step: float = 1e-3):
         models, longitudinal, _ = read_model(model, name)
         if models.lateral is None:
             raise ValueError(f"block {name!r}: {models.source} has no lateral model (run `make identify`)")
@@ -99,17 +68,10 @@ class PathFollowingController:
         if steering not in ("inverse", "kinematic"):
             raise ValueError(f"block {name!r}: steering = {steering!r}: expected 'inverse' or 'kinematic'")
         for key, value in (("v_target", v_target), ("mass", mass), ("yaw_inertia", yaw_inertia), ("y_limb", y_limb),
-                           ("a_max", a_max), ("a_n_max", a_n_max), ("alpha_max", alpha_max), ("step", step),
-                           ("g", g)):
+                           ("a_max", a_max), ("a_n_max", a_n_max), ("alpha_max", alpha_max), ("step", step)):
             if not value > 0:
                 raise ValueError(f"block {name!r}: {key} = {value!r}: expected > 0")
         self.name, self.steering, self.step_size = name, steering, step
-        if terrain is not None and not (hasattr(terrain, "gravity") and hasattr(terrain, "level")):
-            raise TypeError(f"block {name!r}: terrain = {terrain!r}: expected a PlaneTerrain or None (level)")
-        self.terrain, self.g = terrain, g
-        if ground_map is not None and not hasattr(ground_map, "gradient"):
-            raise TypeError(f"block {name!r}: ground_map = {ground_map!r}: expected a HeightMap or None")
-        self.ground_map = ground_map
         self.path: Path = path if isinstance(path, Path) else PATHS[path]()
         self.lateral = models.lateral
         self.inverse = LongitudinalInverse(longitudinal, WHEELS, wn, step, name)
@@ -149,20 +111,8 @@ class PathFollowingController:
         demand = np.array([self.mass * (a_t * math.cos(offset) + a_n * math.sin(offset)),
                            self.mass * (-a_t * math.sin(offset) + a_n * math.cos(offset)),
                            self.yaw_inertia * alpha])
-        if self.terrain is not None and not self.terrain.level:  # the downhill pull, held by the wheels
-            g_along, g_lateral, _ = self.terrain.gravity(yaw, self.g)
-            demand[:2] -= self.mass * np.array([float(g_along), float(g_lateral)])
         signals = {"s": where.s, "s_ref": s_ref, "cross_track": where.cross_track, "heading_error": offset}
         return demand, along, signals, (where.curvature, offset)
-
-    def _ground_pull(self, u: np.ndarray, loads: np.ndarray) -> np.ndarray:
-        """(F_x, F_y, M_z) [N, N, N·m] of the loads on the height map's local slopes, heading frame."""
-        x, y, yaw = (float(value) for value in u[:3])
-        cos, sin = math.cos(yaw), math.sin(yaw)
-        gx, gy = self.ground_map.gradient(x + cos * self.x_hub - sin * self.y_hub,  # type: ignore[union-attr]
-                                          y + sin * self.x_hub + cos * self.y_hub)
-        fx, fy = -loads * (gx * cos + gy * sin), -loads * (-gx * sin + gy * cos)
-        return np.array([fx.sum(), fy.sum(), float(np.sum(self.x_hub * fy - self.y_hub * fx))])
 
     # --- 3. per wheel -----------------------------------------------------------------------------
     def _inverse_steering(self, loads: np.ndarray, gamma: np.ndarray, fx: np.ndarray,
@@ -198,8 +148,6 @@ class PathFollowingController:
         loads = np.clip(np.asarray(u[6:6 + WHEELS], float), 1.0, None)
         slip_angles = np.asarray(u[6 + WHEELS:6 + 2 * WHEELS], float)
         demand, along, signals, (curvature, offset) = self._tracking(t, u)
-        if self.ground_map is not None:
-            demand = demand - self._ground_pull(u, loads)
         if self.steering == "kinematic":
             steer, fx_des, fy_des = self._kinematic_steering(along, curvature, offset, signals["cross_track"], loads,
                                                              demand[0])

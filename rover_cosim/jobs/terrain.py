@@ -6,7 +6,7 @@ right, ``PlaneTerrain.side_slope``) of 10 and 20 deg at 0.3 m/s on the paper's s
 rolling on the path, with
 
 - ``inverse``: the identified longitudinal and lateral models, the downhill pull M g sin(slope)
-  compensated as a feed-forward lateral force (``PathFollowingController(terrain=...)``), on
+  compensated as a feed-forward lateral force (``TerrainPathController(terrain=...)``), on
   SteerableRover.fmu;
 - ``cosim``: the same controller on SteerableRoverBody + 6 Wheel (the body given the same ground);
 - ``kinematic``: kinematic steering (the ablation): the wheels along their hubs' commanded
@@ -18,7 +18,7 @@ of the path at x = 10 m; deeper or narrower bowls twist the footprint by more th
 21 mm static compression and lift wheels off), the height map given hub by hub by the ground participant
 (``jobs.ground.GroundBlock``), with the identified models (``inverse``, ``cosim``); the
 controller adds the pull of the loads on the map's local slopes at the hubs as a feed-forward
-(``PathFollowingController(ground_map=...)``); the ablation ``unaware``: the same controller
+(``TerrainPathController(ground_map=...)``); the ablation ``unaware``: the same controller
 without it (the bowl's slopes a disturbance). The map is written beside the results
 (``terrain_crater_heightmap.csv``) and read back from there for the runs.
 
@@ -53,7 +53,7 @@ from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summ
 from rover_cosim.common.rows import every, steps_between_rows
 from rover_cosim.control.path import Line
 from rover_cosim.control.path import Path as ReferencePath
-from rover_cosim.control.path_controller import PathFollowingController
+from rover_cosim.control.terrain_controller import TerrainPathController
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.master import run
@@ -189,7 +189,7 @@ def traverse_system(fmu_dir: Path, model: ModelSet | Path, terrain: PlaneTerrain
     builder = SystemBuilder(f"traverse {Ground(terrain, height_map).label()} ({run_})").simulation(
         stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
     spin = speed / _radius(choice)
-    block = PathFollowingController("ctrl", models_of(model), path=traverse_path(length), v_target=speed,
+    block = TerrainPathController("ctrl", models_of(model), path=traverse_path(length), v_target=speed,
                                     steering="kinematic" if run_ == "kinematic" else "inverse", step=STEP,
                                     terrain=None if run_ == "unaware" else terrain, g=G, mass=MASS,
                                     ground_map=height_map if run_ in ("inverse", "cosim") else None)
