@@ -253,7 +253,7 @@ def test_the_reference_wheel_at_each_wheels_state_on_the_slope_gives_the_fmus_fo
         np.testing.assert_allclose(run[f"Fz[{i}]"], run[f"body.W[{i}]"], rtol=1e-8)
 
 
-def _energy(run: np.ndarray, terrain: PlaneTerrain) -> tuple[np.ndarray, np.ndarray]:
+def _energy(run: Any, terrain: PlaneTerrain) -> tuple[np.ndarray, np.ndarray]:
     """(mechanical energy [J], the drive torques' work since the start [J]) of a SteerableRover run:
     kinetic (body translation and rotation, wheel spin), gravity's potential M g z_ground(x, y) +
     M g cos(slope) z, the limb springs' 1/2 k d²; the torques' power on wheels and body
@@ -429,3 +429,31 @@ def test_simulate_offers_the_terrain_scenarios_alone(tmp_path):
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 2
     assert "'hills'" in done.stderr and "terrain" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_energy_is_never_created_over_a_height_map(fmus):
+    """Driving and turning over a bowl (the map given by the ground participant): the soil and the
+    dampers take energy out and the map's first-order law (the load's push -W s on the hub, the
+    limb compressed by the ground's height) creates none beyond 0.1 % of what changed hands."""
+    bowl = crater((4.0, -1.0), 0.05, 3.0, rim=0.0)
+    builder = SystemBuilder("over a bowl").simulation(stop_time=6.0, step=1e-3, algorithm="gauss-seidel")
+    start = {"v": 0.3, **{f"omega[{i}]": 0.3 / Wheel().r for i in WHEELS},
+             **{f"tau[{i}]": 25.0 for i in WHEELS}, **{f"steer[{i}]": TURN[i] for i in WHEELS}}
+    builder.add_fmu("rover", fmus["SteerableRover"], start=start)
+    builder.add_block("ground", GroundBlock("ground", bowl))
+    for name in ("x", "y", "yaw", "v", "vy", "yawRate"):
+        builder.connect(f"rover.{name}", f"ground.{name}")
+    for signal in ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGradientLateral"):
+        for i in WHEELS:
+            builder.connect(f"ground.{signal}[{i}]", f"rover.{signal}[{i}]")
+    names = ("x", "y", "v", "vy", "yawRate", "body.w", "body.p", "body.q", "body.z",
+             *[f"{n}[{i}]" for n in ("omega", "body.deflection", "body.tau", "body.steer") for i in WHEELS])
+    builder.record(*[f"rover.{n}" for n in names], "ground.groundHeight[1]")
+    data = run(builder.simulation(order=["rover", "ground"]).build()).data
+    table = {"time": data["time"].to_numpy(), **{n: data[f"rover.{n}"].to_numpy() for n in names}}
+    energy, work = _energy(table, PlaneTerrain())
+    dissipated = work - (energy - energy[0])
+    scale = max(np.abs(energy - energy[0]).max(), np.abs(work).max())
+    assert scale > 100.0 and data["ground.groundHeight[1]"].min() < -0.02   # the wheels went into the bowl
+    assert dissipated.min() > -1e-3 * scale
+    assert np.diff(dissipated).min() > -1e-3 * scale
