@@ -56,7 +56,8 @@ fmus3: $(STAMP)
 identify: fmus
 	$(VENV)/bin/rover-cosim identify --out $(RESULTS)/identification --fmu fmus/SingleWheel.fmu $(SOIL_OPTIONS)
 
-## simulate: paper Sec. 4, closed loop on Rover.fmu and RoverBody + 6 Wheel -> results/simulation/
+## simulate: paper Sec. 4, closed loop on Rover.fmu and RoverBody + 6 Wheel, then the steerable rover's paths
+## and side-slope traverses (issue 35) -> results/simulation/
 simulate: identify
 	$(VENV)/bin/rover-cosim simulate --out $(RESULTS)/simulation --fmu-dir fmus --model $(RESULTS)/identification/model.json $(SOIL_OPTIONS)
 

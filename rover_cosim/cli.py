@@ -217,8 +217,9 @@ def build_parser() -> argparse.ArgumentParser:
     simulate.add_argument("--fmu-dir", type=_path, default=Path("fmus"), help="where the FMUs are")
     simulate.add_argument("--model", type=_path, default=Path("results/identification/model.json"),
                           help="identified model (from `rover-cosim identify`)")
-    simulate.add_argument("--only", choices=("straight", "path"), default=None,
-                          help="only the paper's straight run, or only the path following (default: both)")
+    simulate.add_argument("--only", choices=("straight", "path", "terrain"), default=None,
+                          help="only the paper's straight run, only the path following, or only the terrain "
+                               "scenarios (side-slope traverses; default: all three)")
     simulate.add_argument("--allow-model-mismatch", action="store_true",
                           help="use a model identified on another soil or wheel (refused otherwise; recorded)")
     simulate.add_argument("--adapt", action="store_true",
@@ -690,12 +691,9 @@ def _is_fmu(path: Path) -> bool:
 
 def _simulate(args: argparse.Namespace) -> int:
     from rover_cosim.common.rows import steps_between_rows
-    from rover_cosim.control.adaptive import Calibration
-    from rover_cosim.jobs.path_following import run_path_following
-    from rover_cosim.jobs.simulate import STEP, run_simulation
+    from rover_cosim.jobs.simulate import STEP
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
-    from rover_cosim.progress import ProgressBar
 
     if not _output_folder(args.out, "simulate"):
         return 2
@@ -718,24 +716,42 @@ def _simulate(args: argparse.Namespace) -> int:
     if choice is None:
         return 2
     try:
-        allow = args.allow_model_mismatch or args.adapt
-        adapt = Calibration(duration=args.calibration, sinkage_sensor=args.sinkage_sensor) if args.adapt else None
-        if args.only != "path":
-            bar = ProgressBar("simulate: the paper's straight run", enabled=not args.quiet)
-            straight = run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow,
-                                      progress=bar, record_interval=args.record_interval, adapt=adapt)
-            bar.close()
-            _print_straight(straight)
-        if args.only != "straight":
-            bar = ProgressBar("simulate: path following", enabled=not args.quiet)
-            path = run_path_following(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
-                                      progress=bar, record_interval=args.record_interval)
-            bar.close()
-            _print_path(path)
+        _simulate_runs(args, choice)
     except (SystemFileError, RunError, ValueError) as error:
         print(f"rover-cosim simulate: {error} (nothing written)", file=sys.stderr)
         return 1
     return 0
+
+
+def _simulate_runs(args: argparse.Namespace, choice: Any) -> None:
+    """The runs ``rover-cosim simulate`` asked for (``--only``): the paper's straight run, the path
+    following, the terrain scenarios, each writing its files."""
+    from rover_cosim.control.adaptive import Calibration
+    from rover_cosim.jobs.path_following import run_path_following
+    from rover_cosim.jobs.simulate import run_simulation
+    from rover_cosim.jobs.terrain import run_terrain
+    from rover_cosim.progress import ProgressBar
+
+    allow = args.allow_model_mismatch or args.adapt
+    adapt = Calibration(duration=args.calibration, sinkage_sensor=args.sinkage_sensor) if args.adapt else None
+    if args.only in (None, "straight"):
+        bar = ProgressBar("simulate: the paper's straight run", enabled=not args.quiet)
+        straight = run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow,
+                                  progress=bar, record_interval=args.record_interval, adapt=adapt)
+        bar.close()
+        _print_straight(straight)
+    if args.only in (None, "path"):
+        bar = ProgressBar("simulate: path following", enabled=not args.quiet)
+        path = run_path_following(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                                  progress=bar, record_interval=args.record_interval)
+        bar.close()
+        _print_path(path)
+    if args.only in (None, "terrain"):
+        bar = ProgressBar("simulate: side-slope traverses", enabled=not args.quiet)
+        terrain = run_terrain(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                              progress=bar, record_interval=args.record_interval)
+        bar.close()
+        _print_terrain(terrain)
 
 
 def _model_readable(path: Path, command: str) -> bool:
@@ -826,6 +842,16 @@ def _print_path(outcome) -> None:  # noqa: ANN001 - PathResult, imported lazily
     rms = outcome.metrics.filter(like="rms_F")
     table["largest RMS(Fx - Fx_des) [N]"] = rms.filter(like="rms_Fx").max(axis=1)
     table["largest RMS(Fy - Fy_des) [N]"] = rms.filter(like="rms_Fy").max(axis=1)
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    for path in outcome.files:
+        print(f"wrote {path}")
+
+
+def _print_terrain(outcome) -> None:  # noqa: ANN001 - TerrainResult, imported lazily
+    columns = {"side_slope_deg": "side slope [deg]", "cross_track_rms_m": "cross-track RMS [m]",
+               "cross_track_max_m": "max [m]", "heading_error_max_rad": "heading error max [rad]",
+               "energy_per_metre_J_m": "energy [J/m]"}
+    table = outcome.metrics[["scenario", "run", *columns]].rename(columns=columns)
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     for path in outcome.files:
         print(f"wrote {path}")

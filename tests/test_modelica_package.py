@@ -50,7 +50,8 @@ def test_the_fmu_sub_package_holds_exactly_the_fmus_make_fmus_builds():
 INTERFACES = {"WheelHub": ("Components.RigidWheel", "FMUs.Wheel"),
               "BodyHubs": ("Components.Chassis", "FMUs.RoverBody"),
               "SteerableBodyHubs": ("Components.SteerableChassis", "FMUs.SteerableRoverBody"),
-              "PitchPlaneRover": ("FMUs.Rover", "Examples.RoverReconnected")}
+              "PitchPlaneRover": ("FMUs.Rover", "Examples.RoverReconnected"),
+              "GroundContacts": ("Components.SteerableChassis", "FMUs.SteerableRover")}
 DECLARATION_RE = re.compile(r"^\s*(input|output)\s+Real\s+(\w+)", re.MULTILINE)
 
 

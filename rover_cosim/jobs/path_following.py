@@ -94,7 +94,7 @@ def controller(models: ModelSet, scenario: str, steering: str, straight: float =
                                    v_target=SCENARIOS[scenario], steering=steering, step=STEP)
 
 
-def _connect_controller(builder: SystemBuilder, body: str, wheel: Any) -> None:
+def connect_controller(builder: SystemBuilder, body: str, wheel: Any) -> None:
     """Body state, loads and slip angles to the controller (``wheel(i, name)``: a wheel output)."""
     for name in BODY:
         builder.connect(f"{body}.{name}", f"ctrl.{name}")
@@ -117,7 +117,7 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, stee
     start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
     builder.add_block("ctrl", controller(models_of(model), scenario, steering, straight))
-    _connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
     for i in WHEELS:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
     return builder.build()
@@ -140,7 +140,7 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice
                                    radius=wheel.r, inertia=wheel.J, calibration=calibration,
                                    path=scenario_path(scenario, straight), v_target=speed, step=STEP)
     builder.add_block("ctrl", block)
-    _connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
     for i in WHEELS:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
     connect_telemetry(builder, "rover", calibration, ("pitch", "roll"))
@@ -160,7 +160,7 @@ def cosim_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: C
     wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(WHEELS),
                        choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": speed / _radius(choice)})
     builder.add_block("ctrl", controller(models_of(model), scenario, "inverse", straight))
-    _connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
+    connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
     for i, wheel in zip(WHEELS, wheels):
         builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
         builder.connect(f"ctrl.steer[{i}]", f"body.steer[{i}]")

@@ -1,8 +1,10 @@
 within RoverTerramechanics.FMUs;
 model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every wheel driven and steered, with six terramechanics wheels (monolithic)"
+  extends RoverTerramechanics.Interfaces.GroundContacts;
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
+  parameter RoverTerramechanics.Parameters.TerrainParameters terrain "Ground plane: slope and downhill direction (default level)";
   parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
@@ -10,9 +12,9 @@ model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every whe
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel";
   input Real steer[6](each unit="rad") "Steering angle of each wheel, positive to the left";
-  output Real x(unit="m") "Position of the centre of gravity, world x";
-  output Real y(unit="m") "Position of the centre of gravity, world y";
-  output Real yaw(unit="rad") "Heading against world x, positive to the left";
+  output Real x(unit="m") "Position of the centre of gravity along the ground's x axis (world x on level ground)";
+  output Real y(unit="m") "Position of the centre of gravity along the ground's y axis (world y on level ground)";
+  output Real yaw(unit="rad") "Heading against the ground's x axis, positive to the left";
   output Real v(unit="m/s") "Forward velocity of the centre of gravity, along the heading";
   output Real vy(unit="m/s") "Lateral velocity of the centre of gravity, to the left";
   output Real yawRate(unit="rad/s") "Yaw rate";
@@ -26,7 +28,7 @@ model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every whe
   output Real slipAngle[6](each unit="rad") "Slip angle of each wheel's hub velocity";
   output Real sinkage[6](each unit="m") "Sinkage of each wheel";
   output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
-  RoverTerramechanics.Components.SteerableChassis body(rover=rover) "Body and limbs";
+  RoverTerramechanics.Components.SteerableChassis body(rover=rover, terrain=terrain) "Body and limbs";
   RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
   for i in 1:6 loop
@@ -38,6 +40,10 @@ equation
     body.Fy[i] = wheels[i].Fy;
     body.tau[i] = tau[i];
     body.steer[i] = steer[i];
+    body.groundHeight[i] = groundHeight[i];
+    body.groundHeightRate[i] = groundHeightRate[i];
+    body.groundGradientAlong[i] = groundGradientAlong[i];
+    body.groundGradientLateral[i] = groundGradientLateral[i];
     Fz[i] = wheels[i].Fz;
     Fx[i] = wheels[i].Fx;
     Fy[i] = wheels[i].Fy;
@@ -64,7 +70,11 @@ heave, pitch, roll on three compliant limbs per side); wheels: <code>Components.
 each fed its hub's velocity in its own frame, so it gets a slip and a slip angle and gives Fx,
 Fy (Ishigami et al. 2007) and Fz. Inputs <code>tau[1..6]</code> and <code>steer[1..6]</code>;
 limbs 1-3 front, middle, rear on the left, 4-6 on the right. With every steering angle zero it
-is <code>Rover</code> on level ground. The states <code>x</code>, <code>y</code>,
+is <code>Rover</code> on level ground. The ground is the plane of <code>terrain</code>
+(<code>Parameters.TerrainParameters</code>: slope and downhill direction; level by default):
+the loads act along its normal and the wheels' frames lie in it. A height map over the plane comes
+in hub by hub (<code>Interfaces.GroundContacts</code>: height, its rate, gradients; 0 by default)
+from a terrain participant. The states <code>x</code>, <code>y</code>,
 <code>yaw</code>, <code>v</code>, <code>vy</code>, <code>yawRate</code> and <code>omega[i]</code>
 take start values, so a run can start in motion.</p>
 </html>"));

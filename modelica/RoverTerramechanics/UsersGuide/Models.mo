@@ -93,7 +93,10 @@ its hub's velocity in its own frame (<code>v_hub</code> along, <code>v_lat</code
 so each has a slip and a slip angle.</p>
 <ul>
 <li>inputs: <code>tau[1..6]</code> [N&middot;m], <code>steer[1..6]</code> [rad] steering angle
-against the heading, positive to the left</li>
+against the heading, positive to the left; <code>groundHeight[1..6]</code> [m], <code>groundHeightRate[1..6]</code> [m/s],
+<code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: a height map
+over the ground plane hub by hub (<code>Interfaces.GroundContacts</code>; optional, start 0: the
+plane itself)</li>
 <li>outputs: <code>x</code>, <code>y</code> [m], <code>yaw</code> [rad], <code>v</code>,
 <code>vy</code> [m/s] (CoG velocity along and to the left of the heading), <code>yawRate</code>
 [rad/s], <code>pitch</code>, <code>roll</code> [rad] (roll positive: left side up), per wheel
@@ -104,10 +107,11 @@ against the heading, positive to the left</li>
 <code>body.y</code>, <code>body.yaw</code>, <code>body.v</code>, <code>body.vy</code>,
 <code>body.yawRate</code>, heave/pitch/roll and their rates, <code>wheels[i].omega</code></li>
 <li>parameters: <code>soil</code>, <code>wheel</code>, <code>rover</code> (RoverParameters, with
-<code>yLimb</code>, <code>Ixx</code>, <code>Izz</code>), <code>nNodes</code>,
+<code>yLimb</code>, <code>Ixx</code>, <code>Izz</code>), <code>terrain</code> (TerrainParameters:
+<code>slope</code>, <code>downhill</code> [rad]; level by default), <code>nNodes</code>,
 <code>nIterations</code>, <code>vEps</code>, <code>vHold</code>, <code>vStick</code></li>
-<li>limbs 1-3 front, middle, rear on the left (y = +yLimb), 4-6 on the right; level ground
-only</li>
+<li>limbs 1-3 front, middle, rear on the left (y = +yLimb), 4-6 on the right; the ground is the
+plane of <code>terrain</code> (x, y, yaw measured in it) with an optional height map over it</li>
 <li>with every <code>steer[i]</code> = 0 it is <code>Rover</code> on level ground (tests: equal to
 rounding)</li>
 <li>experiment: 10 s</li>
@@ -120,14 +124,18 @@ rounding)</li>
 <code>Wheel</code>s by the shipped <code>orchestrator/systems/steerable_rover_cosim.toml</code>.</p>
 <ul>
 <li>inputs: <code>Fx[1..6]</code>, <code>Fy[1..6]</code> [N] (wheel frames),
-<code>tau[1..6]</code> [N&middot;m], <code>steer[1..6]</code> [rad]</li>
+<code>tau[1..6]</code> [N&middot;m], <code>steer[1..6]</code> [rad]; <code>groundHeight[1..6]</code> [m], <code>groundHeightRate[1..6]</code> [m/s],
+<code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: a height map
+over the ground plane hub by hub (<code>Interfaces.GroundContacts</code>; optional, start 0: the
+plane itself)</li>
 <li>outputs: <code>W[1..6]</code> [N], <code>v_hub[1..6]</code>, <code>v_lat[1..6]</code> [m/s]
 to the wheels; the body's pose and rates <code>x</code>, <code>y</code> [m], <code>yaw</code>
 [rad], <code>v</code>, <code>vy</code> [m/s], <code>yawRate</code> [rad/s], <code>z</code> [m]
 (heave from static equilibrium), <code>pitch</code>, <code>roll</code> [rad]; internal states
 <code>w</code> [m/s] (heave rate), <code>q</code> [rad/s] (pitch rate), <code>p</code> [rad/s]
 (roll rate)</li>
-<li>parameters: <code>rover</code> (RoverParameters)</li>
+<li>parameters: <code>rover</code> (RoverParameters), <code>terrain</code>
+(TerrainParameters)</li>
 </ul>
 
 <h4>RoverReconnected</h4>

@@ -1,0 +1,101 @@
+"""The path-following controller on sloped ground and over a height map (issue 35).
+
+``PathFollowingController`` tracks the path with a force and yaw-moment demand at the body that
+the wheels must produce (``path_controller``, step 1). On sloped ground they must also hold the
+body against gravity's pull in the ground plane, and over a height map against the loads' pull on
+the local slopes. ``TerrainPathController`` adds both to the demand as a feed-forward, then
+allocates and inverts the identified models exactly as the path controller does:
+
+- the plane (``terrain``, a ``rover_cosim.terramechanics.PlaneTerrain``): with gravity's
+  components in the heading frame g_along, g_lateral (``terrain.gravity(heading, g)``), the demand
+  is M (a_t, a_n) - M (g_along, g_lateral);
+- a height map (``ground_map``, a ``terramechanics.terrain.HeightMap``): the load W_i, normal to
+  the local ground of gradient s_i under hub i (the map's at the hub's position), pushes the body
+  by -W_i s_i along and across the heading; the demand subtracts sum -W_i s_i and its yaw moment
+  sum (x_i f_y,i - y_i f_x,i), with the measured loads (as the controller clips them, >= 1 N).
+
+Without a slope and a map the demand, and every output, is the path controller's (bit for bit).
+The path controller's C twin knows neither feed-forward: this block offers it only on level
+ground without a map.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Protocol
+
+import numpy as np
+
+from .path_controller import WHEELS, PathFollowingController
+
+
+class Ground(Protocol):
+    """What the controller needs of the ground plane (``rover_cosim.terramechanics.PlaneTerrain``)."""
+
+    @property
+    def level(self) -> bool: ...
+
+    def gravity(self, heading: float, g: float) -> tuple[Any, Any, float]:
+        """Gravity [m/s²] along the heading, to its left, into the ground (heading [rad])."""
+        ...
+
+
+class GroundMap(Protocol):
+    """A height map over the ground plane (``rover_cosim.terramechanics.terrain.HeightMap``)."""
+
+    def gradient(self, x: Any, y: Any) -> tuple[Any, Any]:
+        """(dh/dx, dh/dy) [1] at the points (x, y) [m]."""
+        ...
+
+
+class TerrainPathController(PathFollowingController):
+    """``PathFollowingController`` (same inputs, outputs and options) with the ground's pull fed
+    forward: ``terrain`` (None: level), ``g`` [m/s²] the gravity it believes in, ``ground_map``
+    (None: no map)."""
+
+    def __init__(self, name: str, model: Any, *, terrain: Ground | None = None, g: float = 1.62,
+                 ground_map: GroundMap | None = None, **options: Any):
+        super().__init__(name, model, **options)
+        if not (isinstance(g, (int, float)) and math.isfinite(g) and g > 0):
+            raise ValueError(f"block {name!r}: g = {g!r} m/s²: expected a gravity > 0")
+        if terrain is not None and not (hasattr(terrain, "gravity") and hasattr(terrain, "level")):
+            raise TypeError(f"block {name!r}: terrain = {terrain!r}: expected a PlaneTerrain or None (level)")
+        if ground_map is not None and not hasattr(ground_map, "gradient"):
+            raise TypeError(f"block {name!r}: ground_map = {ground_map!r}: expected a HeightMap or None")
+        self.terrain, self.g, self.ground_map = terrain, float(g), ground_map
+
+    @property
+    def plain(self) -> bool:
+        """Level ground without a map: nothing to feed forward."""
+        return (self.terrain is None or self.terrain.level) and self.ground_map is None
+
+    def ground_pull(self, u: Any) -> tuple[float, float, float]:
+        """(F_x, F_y, M_z) [N, N, N·m]: gravity's and the map's pull on the body in the heading frame,
+        for the inputs ``u`` (x, y, yaw, v, vy, yawRate, W[1..6], ...)."""
+        x, y, yaw = float(u[0]), float(u[1]), float(u[2])
+        fx = fy = mz = 0.0
+        if self.terrain is not None and not self.terrain.level:
+            g_along, g_lateral, _ = self.terrain.gravity(yaw, self.g)
+            fx, fy = self.mass * float(g_along), self.mass * float(g_lateral)
+        if self.ground_map is not None:
+            loads = np.array([max(1.0, float(w)) for w in u[6:6 + WHEELS]])
+            cos, sin = math.cos(yaw), math.sin(yaw)
+            gx, gy = self.ground_map.gradient(x + cos * self.x_hub - sin * self.y_hub,
+                                              y + sin * self.x_hub + cos * self.y_hub)
+            hub_x, hub_y = -loads * (gx * cos + gy * sin), -loads * (-gx * sin + gy * cos)
+            fx, fy = fx + float(hub_x.sum()), fy + float(hub_y.sum())
+            mz = float(np.sum(self.x_hub * hub_y - self.y_hub * hub_x))
+        return fx, fy, mz
+
+    def _tracking(self, t: float, u: Any) -> Any:
+        demand, along, signals, path = super()._tracking(t, u)
+        if self.plain:
+            return demand, along, signals, path
+        fx, fy, mz = self.ground_pull(u)
+        held = [demand[0] - fx, demand[1] - fy, demand[2] - mz]
+        return (held if isinstance(demand, list) else np.array(held)), along, signals, path
+
+    def native(self) -> Any:
+        """The path controller's C twin on level ground without a map; else None (it knows no pull)."""
+        twin = getattr(super(), "native", None)
+        return twin() if self.plain and twin is not None else None

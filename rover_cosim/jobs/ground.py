@@ -1,0 +1,59 @@
+"""The ground participant of the steerable rover on a height map (issue 35): a Python block that
+gives each hub the ground under it (``Interfaces.GroundContacts`` of SteerableRover and
+SteerableRoverBody), from the body's pose and velocity.
+
+Why a participant and not a table inside the FMU: our exporter (rumoca -> CasADi -> C) has no
+table functions reading files, and a participant serves the monolithic FMU and the co-simulated
+body alike, with any map; the body's pose and velocity are states, so the block (direct
+feedthrough from them) closes no algebraic loop. The hub positions are the limbs' (pitch and
+roll of a few degrees neglected): hub i at (x, y) + R(yaw) (x_i, y_i), its velocity
+R(yaw) (v - r y_i, v_y + r x_i); then h_i, dh_i/dt = grad h . velocity, and the gradient turned
+into the heading frame.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rover_cosim.terramechanics.terrain import HeightMap
+
+WHEELS = 6
+BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
+SIGNALS = ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGradientLateral")
+
+
+class GroundBlock:
+    """Orchestrator block. Inputs: x, y, yaw, v, vy, yawRate of the body. Outputs per hub i:
+    groundHeight[i] [m], groundHeightRate[i] [m/s], groundGradientAlong[i], groundGradientLateral[i] [1]."""
+
+    def __init__(self, name: str, height_map: HeightMap, x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5),
+                 y_limb: float = 1.5):
+        if not isinstance(height_map, HeightMap):
+            raise TypeError(f"block {name!r}: height_map = {height_map!r}: expected a HeightMap")
+        if not y_limb > 0:
+            raise ValueError(f"block {name!r}: y_limb = {y_limb!r} m: expected > 0")
+        self.name, self.map = name, height_map
+        self.x_hub = np.array([*x_limb, *x_limb], float)
+        self.y_hub = np.array([y_limb] * 3 + [-y_limb] * 3, float)
+        self.inputs: tuple[str, ...] = BODY
+        self.outputs: tuple[str, ...] = tuple(f"{s}[{i}]" for s in SIGNALS for i in range(1, WHEELS + 1))
+        units = {"groundHeight": "m", "groundHeightRate": "m/s", "groundGradientAlong": "1",
+                 "groundGradientLateral": "1"}
+        self.units = {"x": "m", "y": "m", "yaw": "rad", "v": "m/s", "vy": "m/s", "yawRate": "rad/s",
+                      **{f"{s}[{i}]": units[s] for s in SIGNALS for i in range(1, WHEELS + 1)}}
+
+    def ground(self, u: np.ndarray) -> np.ndarray:
+        """The outputs for the body state ``u`` (the inputs)."""
+        x, y, yaw, v, vy, r = (float(value) for value in u[:6])
+        cos, sin = np.cos(yaw), np.sin(yaw)
+        hx, hy = x + cos * self.x_hub - sin * self.y_hub, y + sin * self.x_hub + cos * self.y_hub
+        ux, uy = v - r * self.y_hub, vy + r * self.x_hub          # hub velocities, heading frame
+        gx, gy = self.map.gradient(hx, hy)
+        along, lateral = gx * cos + gy * sin, -gx * sin + gy * cos
+        return np.concatenate([self.map.height(hx, hy), along * ux + lateral * uy, along, lateral])
+
+    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+        return self.ground(u0)
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        return self.ground(u)

@@ -1,0 +1,252 @@
+"""The ground under the steerable rover: a plane of any inclination (issue 35).
+
+The same law as the Modelica record ``Parameters.TerrainParameters`` (and the chassis that uses
+it): a plane of inclination ``slope`` θ [rad] whose direction of steepest descent makes the angle
+``downhill`` ψd [rad] with the ground's x axis (positive to the left). Positions (x, y) [m] and
+headings ψ [rad] are measured in the plane. Then
+
+    z_ground(x, y) = -sin θ (x cos ψd + y sin ψd)                [m, world height]
+    g_along   = g sin θ cos(ψd - ψ)                              [m/s², along the heading]
+    g_lateral = g sin θ sin(ψd - ψ)                              [m/s², to the left]
+    g_normal  = g cos θ                                          [m/s², into the ground]
+
+A plane of world gradients G_x = dz/dx, G_y = dz/dy is θ = atan(hypot(G_x, G_y)),
+ψd = atan2(-G_y, -G_x) (``PlaneTerrain.from_gradients``). Source of the setting: Ishigami, Miwa,
+Nagatani, Yoshida, J. Field Robotics 24(3), 2007 (steering on slopes of loose soil).
+
+``HeightMap`` (a grid file, bicubic spline) and ``crater``: a height map over the plane, given to
+the rover hub by hub (``Interfaces.GroundContacts``). ``static_hold`` and ``critical_slope``: a
+rover at rest on the plane by the reference wheel's static regime (``regimes``): whether the soil
+holds it, the holding torques, the creep.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .parameters import Soil, Wheel
+
+FloatArray = NDArray[np.float64]
+
+
+def _angle(name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+        raise ValueError(f"{name} = {value!r}: expected a finite angle in rad")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class PlaneTerrain:
+    """A ground plane: ``slope`` θ [rad], 0 <= θ < π/2, and ``downhill`` ψd [rad], the direction of
+    steepest descent against the ground's x axis, positive to the left (-π/2: the valley to the
+    right of a path along x). ``PlaneTerrain()`` is level ground."""
+
+    slope: float = 0.0
+    downhill: float = 0.0
+
+    def __post_init__(self) -> None:
+        slope, downhill = _angle("slope", self.slope), _angle("downhill", self.downhill)
+        if not 0.0 <= slope < math.pi / 2:
+            raise ValueError(f"slope = {self.slope!r} rad ({math.degrees(slope):.4g} deg): expected an inclination "
+                             "0 <= slope < pi/2 rad (0 to 90 deg, 90 excluded)")
+        object.__setattr__(self, "slope", slope)
+        object.__setattr__(self, "downhill", downhill)
+
+    @classmethod
+    def side_slope(cls, degrees: float, valley: str = "right") -> PlaneTerrain:
+        """A side slope of ``degrees`` [deg] for a path along +x, the valley to its ``valley``."""
+        if valley not in ("right", "left"):
+            raise ValueError(f"valley = {valley!r}: expected 'right' or 'left'")
+        angle = _angle("degrees", degrees)
+        if not 0.0 <= angle < 90.0:
+            raise ValueError(f"side slope = {degrees!r} deg: expected 0 <= slope < 90 deg")
+        return cls(math.radians(angle), -math.pi / 2 if valley == "right" else math.pi / 2)
+
+    @classmethod
+    def from_gradients(cls, gx: float, gy: float) -> PlaneTerrain:
+        """The plane z = gx x + gy y of world gradients ``gx`` = dz/dx, ``gy`` = dz/dy [m/m]."""
+        gx, gy = _angle("gx", gx), _angle("gy", gy)
+        return cls(math.atan(math.hypot(gx, gy)), math.atan2(-gy, -gx) if (gx or gy) else 0.0)
+
+    @property
+    def level(self) -> bool:
+        return self.slope == 0.0
+
+    def height(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
+        """World height z_ground [m] of the ground point (x, y) [m] (0 at the origin)."""
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        return -math.sin(self.slope) * (x * math.cos(self.downhill) + y * math.sin(self.downhill))
+
+    def gravity(self, heading: ArrayLike, g: float) -> tuple[FloatArray, FloatArray, float]:
+        """Gravity ``g`` [m/s²] in the heading frame of a body with heading ``heading`` [rad]:
+        (along the heading, to its left, into the ground) [m/s²]."""
+        heading = np.asarray(heading, float)
+        tangential = g * math.sin(self.slope)
+        return (tangential * np.cos(self.downhill - heading), tangential * np.sin(self.downhill - heading),
+                g * math.cos(self.slope))
+
+    def fmu_parameters(self) -> dict[str, float]:
+        """The plane as the steerable rover FMUs' parameters (``terrain.slope``, ``terrain.downhill``)."""
+        return {"terrain.slope": self.slope, "terrain.downhill": self.downhill}
+
+    def label(self) -> str:
+        if self.level:
+            return "level ground"
+        return f"{math.degrees(self.slope):.3g}° slope, downhill at {math.degrees(self.downhill):.3g}°"
+
+
+@dataclass(frozen=True)
+class StaticHold:
+    """A rover at rest on a ``PlaneTerrain``, by the reference wheel (``regimes``' static regime).
+
+    Attributes:
+        pull: gravity's pull in the ground plane, M g sin θ [N].
+        strength: what the soils under the wheels hold at most, sum of the patches' Mohr-Coulomb
+            strength c b L + W tan φ [N] at the static loads (equal shares of M g cos θ).
+        holding_torque: the drive torque of each wheel [N·m] that holds the component of the pull
+            along the heading (r M g_along / n, against it); the lateral component is held by the
+            wheels' lateral shear alone.
+        creep_speed: the speed [m/s] at which the static regime's regularised shear
+            F_max tanh(v / v_stick) carries the pull: a rover that holds creeps at it.
+    """
+
+    pull: float
+    strength: float
+    holding_torque: float
+    creep_speed: float
+
+    @property
+    def holds(self) -> bool:
+        return self.pull < self.strength
+
+
+def static_hold(terrain: PlaneTerrain, heading: float, mass: float, g: float, wheel: Wheel | None = None,
+                soil: Soil | None = None, wheels: int = 6, v_stick: float = 1e-4) -> StaticHold:
+    """The rover of ``mass`` [kg] at rest with heading ``heading`` [rad] on ``terrain`` under gravity
+    ``g`` [m/s²] on ``wheels`` wheels (see ``StaticHold``)."""
+    from .regimes import shear_strength
+    from .sinkage import wheel_state
+
+    wheel, soil = wheel or Wheel(), soil or Soil()
+    if not (mass > 0 and g > 0 and wheels >= 1 and v_stick > 0):
+        raise ValueError(f"mass = {mass!r} kg, g = {g!r} m/s², wheels = {wheels!r}, v_stick = {v_stick!r} m/s: "
+                         "expected mass > 0, g > 0, wheels >= 1, v_stick > 0")
+    along, _, normal = terrain.gravity(heading, g)
+    load = mass * normal / wheels
+    sinkage = float(wheel_state(load, 0.0, wheel, soil).sinkage)
+    strength = wheels * float(shear_strength(load, sinkage, wheel, soil))
+    pull = mass * g * math.sin(terrain.slope)
+    creep = v_stick * math.atanh(pull / strength) if pull < strength else math.inf
+    return StaticHold(pull, strength, -wheel.r * mass * float(along) / wheels, creep)
+
+
+def critical_slope(mass: float, g: float, wheel: Wheel | None = None, soil: Soil | None = None,
+                   wheels: int = 6) -> float:
+    """The steepest slope [rad] the soil holds the rover at rest on (``static_hold``'s pull equal to
+    its strength), by bisection to 1e-6 rad."""
+    low, high = 0.0, math.pi / 2 - 1e-6
+    while high - low > 1e-6:
+        middle = (low + high) / 2
+        if static_hold(PlaneTerrain(middle), 0.0, mass, g, wheel, soil, wheels).holds:
+            low = middle
+        else:
+            high = middle
+    return low
+
+
+class HeightMap:
+    """A height map over the ground plane: heights ``heights[j, i]`` [m] above the plane at the grid
+    points (``x[i]``, ``y[j]``) [m] (strictly increasing, at least 4 each), interpolated by a bicubic
+    spline (continuous height, gradient and curvature: smooth for the integrator). Outside the grid
+    the edge's height continues flat (gradient 0): give a grid whose edges are level.
+
+    The file (``read``, ``write``): CSV, the first row ``y\\x`` and the x values, then one row per y:
+    the y value and the heights along x."""
+
+    def __init__(self, x: ArrayLike, y: ArrayLike, heights: ArrayLike, source: str = "height map"):
+        from scipy.interpolate import RectBivariateSpline
+
+        self.x, self.y = np.asarray(x, float), np.asarray(y, float)
+        self.heights = np.asarray(heights, float)
+        self.source = source
+        for name, axis in (("x", self.x), ("y", self.y)):
+            if axis.ndim != 1 or axis.size < 4 or not np.isfinite(axis).all() or not (np.diff(axis) > 0).all():
+                shown = ", ".join(f"{v:g}" for v in axis.ravel()[:6]) + (", ..." if axis.size > 6 else "")
+                raise ValueError(f"{source}: the grid's {name} = [{shown}] m: expected at least 4 finite, "
+                                 "strictly increasing values")
+        if self.heights.shape != (self.y.size, self.x.size):
+            raise ValueError(f"{source}: heights of shape {self.heights.shape}: expected (len(y), len(x)) = "
+                             f"({self.y.size}, {self.x.size})")
+        bad = np.argwhere(~np.isfinite(self.heights))
+        if bad.size:
+            j, i = bad[0]
+            raise ValueError(f"{source}: height at x = {self.x[i]:g} m, y = {self.y[j]:g} m is "
+                             f"{float(self.heights[j, i])!r}: expected a finite height in m")
+        self._spline = RectBivariateSpline(self.y, self.x, self.heights, kx=3, ky=3)
+
+    def _clamped(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        cx, cy = np.clip(x, self.x[0], self.x[-1]), np.clip(y, self.y[0], self.y[-1])
+        inside = ((cx == x) & (cy == y)).astype(float)
+        return cx, cy, inside
+
+    def height(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
+        """Height [m] of the ground above the plane at (x, y) [m]."""
+        cx, cy, _ = self._clamped(x, y)
+        return np.asarray(self._spline.ev(cy, cx), float)
+
+    def gradient(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """(dh/dx, dh/dy) [1] at (x, y) [m] (0 outside the grid)."""
+        cx, cy, inside = self._clamped(x, y)
+        return (np.asarray(self._spline.ev(cy, cx, dy=1), float) * inside,
+                np.asarray(self._spline.ev(cy, cx, dx=1), float) * inside)
+
+    @classmethod
+    def read(cls, path: str | Path) -> HeightMap:
+        """The height map of the CSV file ``path`` (see the class); ValueError naming the file."""
+        path = Path(path)
+        try:
+            rows = np.loadtxt(path, delimiter=",", skiprows=0, dtype=str)
+            x = rows[0, 1:].astype(float)
+            y = rows[1:, 0].astype(float)
+            heights = rows[1:, 1:].astype(float)
+        except (OSError, ValueError, IndexError) as error:
+            raise ValueError(f"height map {path}: {error} (expected CSV: a row 'y\\\\x' and the x values, "
+                             "then rows of y and the heights)") from error
+        return cls(x, y, heights, source=f"height map {path}")
+
+    def write(self, path: str | Path) -> bytes:
+        """The CSV text of the map (written to ``path`` unless it is empty)."""
+        lines = ["y\\x," + ",".join(f"{v:.10g}" for v in self.x)]
+        lines += [f"{yj:.10g}," + ",".join(f"{h:.10g}" for h in row) for yj, row in zip(self.y, self.heights)]
+        text = ("\n".join(lines) + "\n").encode()
+        if str(path):
+            Path(path).write_bytes(text)
+        return text
+
+
+def crater(centre: tuple[float, float] = (6.0, -2.0), depth: float = 0.2, radius: float = 3.0,
+           rim: float = 0.1, spacing: float = 0.25, margin: float = 4.0) -> HeightMap:
+    """A crater-like depression [m]: a Gaussian bowl of ``depth`` and ``radius`` (its standard
+    deviation) with a raised ``rim`` of height ``rim`` at 1.5 ``radius``, centred at ``centre``,
+    sampled every ``spacing`` [m] over a square reaching ``margin`` radii from the centre (its edges
+    level to within micrometres)."""
+    for name, value in (("depth", depth), ("radius", radius), ("spacing", spacing), ("margin", margin)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"crater {name} = {value!r} m: expected > 0")
+    if not (math.isfinite(rim) and rim >= 0):
+        raise ValueError(f"crater rim = {rim!r} m: expected >= 0")
+    reach = margin * radius
+    x = np.arange(centre[0] - reach, centre[0] + reach + spacing / 2, spacing)
+    y = np.arange(centre[1] - reach, centre[1] + reach + spacing / 2, spacing)
+    gx, gy = np.meshgrid(x, y)
+    r = np.hypot(gx - centre[0], gy - centre[1])
+    bowl = -depth * np.exp(-0.5 * (r / radius) ** 2)
+    heights = bowl + rim * np.exp(-0.5 * ((r - 1.5 * radius) / (0.4 * radius)) ** 2)
+    return HeightMap(x, y, heights, source="crater")
