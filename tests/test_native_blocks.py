@@ -274,3 +274,30 @@ def test_a_block_ready_for_a_twin_it_then_lacks_is_asked_once_and_steps_on_in_py
     assert len(result.data) == 201 and result.steps == 200
     assert block.asked == 2 and handovers == [1]  # at the start, and once when it said it was ready
     assert result.step_seconds["late"] > 0  # stepped in Python to the end
+
+
+@pytest.mark.parametrize("steering", ["inverse", "kinematic"])
+def test_the_twin_takes_the_planes_pull_as_the_terrain_controller_does(model, steering):
+    """On a 20° side slope (and a diagonal one) the terrain controller's feed-forward of gravity's
+    pull is in the twin too: outputs bit for bit; over a height map it offers no twin."""
+    from rover_cosim.control.terrain_controller import TerrainPathController
+    from rover_cosim.terramechanics import PlaneTerrain
+
+    rng = np.random.default_rng(35)
+    for terrain in (PlaneTerrain.side_slope(20.0), PlaneTerrain(0.3, 2.5)):
+        block = TerrainPathController("ctrl", str(model), path="lane_change", steering=steering, terrain=terrain)
+        block.start(0.0, near_the_path(block, 0.0, rng))
+        twin = Twin(block, "path")
+        t = 0.0
+        for k in range(1, 1500):
+            u = near_the_path(block, 0.01 * k, rng)
+            expected, got = block.step(t, 1e-3, u), twin.step(t, 1e-3, u)
+            assert np.array_equal(expected, got), f"{terrain.label()}, step {k}: outputs differ"
+            t += 1e-3
+        twin.made.close()
+
+    class Bowl:
+        def gradient(self, x: Any, y: Any) -> tuple[Any, Any]:
+            return 0.01 * np.asarray(x), 0.01 * np.asarray(y)
+
+    assert TerrainPathController("ctrl", str(model), ground_map=Bowl()).native() is None

@@ -9,7 +9,8 @@
  * fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the error's text from path_message).
  *
  * Per step: the nearest point of the path (Path.locate), the body's force and yaw-moment demand
- * in the heading frame (_tracking), and per wheel either the steering and wheel-frame forces by
+ * in the heading frame (_tracking; with PULL, less gravity's pull on a ground plane as
+ * TerrainPathController feeds it forward), and per wheel either the steering and wheel-frame forces by
  * the identified lateral and longitudinal models (allocation, then Newton on the steering,
  * _inverse_steering) or the kinematic ablation (_kinematic_steering); the torques by the inverse
  * longitudinal law (inverse_law.h). */
@@ -21,7 +22,7 @@
 #define NEWTON_STEPS 2
 
 enum { MASS, YAW_INERTIA, V_TARGET, KV, KP, A_MAX, K_E, K_DE, A_N_MAX, K_PSI, K_R, ALPHA_MAX, STEP, WN, KINEMATIC,
-       MAX_STEER, MAX_SLIP_ANGLE, SPACING, LENGTH, WINDOW, N_SETTINGS };
+       MAX_STEER, MAX_SLIP_ANGLE, SPACING, LENGTH, WINDOW, PULL, SLOPE, DOWNHILL, GRAVITY, N_SETTINGS };
 enum { RATIONAL, EXPONENTIAL, POLYNOMIAL };
 
 typedef struct {
@@ -195,6 +196,13 @@ static int outputs(PathController *c, double t, int advance, double h) {
                       g[A_N_MAX]);
     double alpha = clip(g[K_PSI] * -offset + g[K_R] * (along * where.curvature - r), -g[ALPHA_MAX], g[ALPHA_MAX]);
     double demand[3] = {g[MASS] * (a_t * cs + a_n * sn), g[MASS] * (-a_t * sn + a_n * cs), g[YAW_INERTIA] * alpha};
+    if (g[PULL] != 0) { /* terrain_controller.py: gravity's pull on a ground plane, held by the wheels */
+        double tangential = g[GRAVITY] * sin(g[SLOPE]);
+        double along_g = tangential * cos(g[DOWNHILL] - yaw), lateral_g = tangential * sin(g[DOWNHILL] - yaw);
+        demand[0] = demand[0] - g[MASS] * along_g;
+        demand[1] = demand[1] - g[MASS] * lateral_g;
+        demand[2] = demand[2] - 0.0;
+    }
     if (g[KINEMATIC] != 0) {
         double rate = along * where.curvature - g[K_PSI] / g[K_R] * offset - g[K_E] / g[K_DE] * where.cross_track;
         double speed = 1e-3 > along ? 1e-3 : along;

@@ -213,7 +213,7 @@ class PathFollowingController:
         settings = [self.mass, self.yaw_inertia, self.v_target, g["kv"], g["kp"], g["a_max"], g["k_e"], g["k_de"],
                     g["a_n_max"], g["k_psi"], g["k_r"], g["alpha_max"], self.step_size, self.inverse.wn,
                     1.0 if self.steering == "kinematic" else 0.0, MAX_STEER, MAX_SLIP_ANGLE, self.path.spacing,
-                    self.path.length, WINDOW]
+                    self.path.length, WINDOW, *self._pull_settings()]
         table_loads, torques, settled, log_t, coefficients = self.inverse.tables()
         path = self.path
         bases = {"rational": 0, "exponential": 1, "polynomial": 2}
@@ -229,6 +229,10 @@ class PathFollowingController:
             raise MemoryError(f"block {self.name!r}: its C twin could not be made (tables of {len(table_loads)} loads "
                               f"x {len(torques)} torques: expected >= 2 each; or out of memory)")
         return native_code.NativeBlock(library, component, "path")
+
+    def _pull_settings(self) -> list[float]:
+        """The twin's ground pull: (on, slope [rad], downhill [rad], gravity [m/s²]); none here."""
+        return [0.0, 0.0, 0.0, 0.0]
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         if not 0 < h <= self.step_size * (1 + 1e-9):

@@ -15,8 +15,8 @@ allocates and inverts the identified models exactly as the path controller does:
   sum (x_i f_y,i - y_i f_x,i), with the measured loads (as the controller clips them, >= 1 N).
 
 Without a slope and a map the demand, and every output, is the path controller's (bit for bit).
-The path controller's C twin knows neither feed-forward: this block offers it only on level
-ground without a map.
+The path controller's C twin takes the plane's pull too (the same arithmetic); over a height map
+the block steps in Python.
 """
 
 from __future__ import annotations
@@ -31,6 +31,16 @@ from .path_controller import WHEELS, PathFollowingController
 
 class Ground(Protocol):
     """What the controller needs of the ground plane (``rover_cosim.terramechanics.PlaneTerrain``)."""
+
+    @property
+    def slope(self) -> float:
+        """Inclination [rad]."""
+        ...
+
+    @property
+    def downhill(self) -> float:
+        """Direction of steepest descent [rad]."""
+        ...
 
     @property
     def level(self) -> bool: ...
@@ -96,6 +106,12 @@ class TerrainPathController(PathFollowingController):
         return (held if isinstance(demand, list) else np.array(held)), along, signals, path
 
     def native(self) -> Any:
-        """The path controller's C twin on level ground without a map; else None (it knows no pull)."""
+        """The path controller's C twin, with the plane's pull where the ground is sloped; None over
+        a height map (the twin knows no map: the block then steps in Python)."""
         twin = getattr(super(), "native", None)
-        return twin() if self.plain and twin is not None else None
+        return twin() if self.ground_map is None and twin is not None else None
+
+    def _pull_settings(self) -> list[float]:
+        if self.terrain is None or self.terrain.level:
+            return [0.0, 0.0, 0.0, 0.0]
+        return [1.0, float(self.terrain.slope), float(self.terrain.downhill), self.g]
