@@ -82,7 +82,8 @@ def time_stage(name: str, arguments: list[str], folder: Path, code: Path | None 
     started = time.perf_counter()
     done = subprocess.run(argv, capture_output=True, text=True, check=False, env=env)
     wall = time.perf_counter() - started
-    entry: dict[str, Any] = {"command": ["rover-cosim", *argv[4:]], "wall_seconds": wall, "exit_code": done.returncode}
+    shown = " ".join(["rover-cosim", *argv[4:]]).replace(str(folder.parent), "<scratch>")
+    entry: dict[str, Any] = {"command": shown, "wall_seconds": wall, "exit_code": done.returncode}
     if done.returncode != 0:
         entry["stderr"] = done.stderr[-2000:]
     if name.startswith("montecarlo"):
