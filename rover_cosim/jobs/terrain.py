@@ -50,7 +50,7 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
-from rover_cosim.common.rows import every, steps_between_rows
+from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.control.path import Line
 from rover_cosim.control.path import Path as ReferencePath
 from rover_cosim.control.terrain_controller import TerrainPathController
@@ -312,8 +312,8 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
                    "model_mismatch": mismatch, "systems": systems, "wall_seconds": time.perf_counter() - started,
                    "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
     suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic", "unaware": "_unaware"}
-    files.update({out / f"terrain_{s}{suffix[label]}.csv": every(table, record_interval, STEP).to_csv(
-        index=False, float_format="%.8g").encode() for (s, label), table in tables.items()})
+    files.update({out / f"terrain_{s}{suffix[label]}.csv": csv_bytes(every(table, record_interval, STEP), "%.8g")
+                  for (s, label), table in tables.items()})
     files.update({
         out / "terrain_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "terrain_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),
