@@ -203,7 +203,8 @@ def _sample(watchers: list[Watcher], k: int, t: float, values: np.ndarray) -> st
     return stop
 
 
-def native_stepping_available() -> bool:
+def _native_stepping_available() -> bool:
+    """Whether the native stepper builds here (a block's late C twin needs it)."""
     return unavailable_reason() is None
 
 
@@ -214,7 +215,7 @@ def _run_steps(execution: Execution, values: np.ndarray, times: np.ndarray, watc
     n_steps = len(times) - 1
     python_stepped = (execution.participants[i] for i in execution.checked_in_python)
     late = [p for p in python_stepped if isinstance(p, BlockParticipant) and hasattr(p.block, "native_ready")
-            and execution.native_enabled and native_stepping_available()]
+            and execution.native_enabled and _native_stepping_available()]
     for k in range(first, n_steps):
         execution.step(values, float(times[k]), float(times[k + 1] - times[k]))
         reason = _sample(watchers, k + 1, float(times[k + 1]), values)
