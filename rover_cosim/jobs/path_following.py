@@ -73,7 +73,7 @@ class PathResult:
     record: dict[str, Any]
 
     def __repr__(self) -> str:
-        return summary_repr("PathResult", self.files, runs=len(self.tables))
+        return summary_repr(type(self).__name__, self.files, runs=len(self.tables))
 
 
 def scenario_path(scenario: str, straight: float = STRAIGHT) -> ReferencePath:

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
+from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.control.path import Line
 from rover_cosim.control.path import Path as ReferencePath
@@ -66,7 +66,7 @@ from rover_cosim.terramechanics.terrain import HeightMap, crater
 
 from . import terrain_figures
 from .ground import SIGNALS, GroundBlock
-from .path_following import BODY, STEP, WHEELS, agreement, connect_controller, trajectories
+from .path_following import BODY, STEP, WHEELS, PathResult, agreement, connect_controller, trajectories
 from .path_following import metrics as path_metrics
 from .plants import add_plant_fmu, add_rover
 from .simulate import RECORD_INTERVAL, checked_models, models_of
@@ -96,18 +96,9 @@ G = 1.62             # m/s², the rover's gravity (RoverParameters.g, the FMUs' 
 MASS = 1570.0        # kg, RoverParameters.M
 
 
-@dataclass
-class TerrainResult:
-    """What ``run_terrain`` wrote and measured."""
-
-    files: list[Path]
-    tables: dict[tuple[str, str], pd.DataFrame]   # (scenario, run) -> terrain_*.csv columns
-    metrics: pd.DataFrame                        # terrain_metrics.csv
-    agreement: pd.DataFrame                      # terrain_agreement.csv
-    record: dict[str, Any]
-
-    def __repr__(self) -> str:
-        return summary_repr("TerrainResult", self.files, runs=len(self.tables))
+class TerrainResult(PathResult):
+    """What ``run_terrain`` wrote and measured: the files, the tables by (scenario, run) (the
+    terrain_*.csv columns), terrain_metrics.csv, terrain_agreement.csv and the record."""
 
 
 def terrain_of(scenario: str) -> PlaneTerrain:

@@ -222,6 +222,18 @@ def closed_loop_section(simulation: Path, paper_soil: bool = True) -> list[str]:
     return sections
 
 
+def _agreement(path: Path, cosimulated: str) -> list[str]:
+    """The monolithic against the co-simulated steerable rover (path_agreement.csv,
+    terrain_agreement.csv), where the file exists."""
+    if not path.exists():
+        return []
+    agree = pd.read_csv(path).rename(columns={
+        "speed_max_difference_percent": "speed, largest difference [% of target]",
+        "load_max_difference_percent": "loads, largest difference [% of static]",
+        "path_max_difference_m": "path, largest distance [m]"})
+    return [f"<p>Monolithic against co-simulated ({cosimulated}):</p>", table(agree, default="{:.2g}")]
+
+
 def path_section(simulation: Path) -> list[str]:
     """The steerable rover following the turn and the lane change."""
     sections = ["<h2>Path following: the steerable rover with the identified Fx and Fy models</h2>",
@@ -248,13 +260,7 @@ def path_section(simulation: Path) -> list[str]:
     sections += ["<p>Floors of the issue: cross-track RMS &lt; 100 mm, max &lt; 300 mm, speed within 5 %, "
                  "force errors &lt; 2 N per wheel (every wheel's value in <code>path_metrics.csv</code>).</p>",
                  table(shown, default="{:.2f}")]
-    if agreement.exists():
-        agree = pd.read_csv(agreement).rename(columns={
-            "speed_max_difference_percent": "speed, largest difference [% of target]",
-            "load_max_difference_percent": "loads, largest difference [% of static]",
-            "path_max_difference_m": "path, largest distance [m]"})
-        sections += ["<p>Monolithic against co-simulated (SteerableRoverBody + 6 Wheel):</p>",
-                     table(agree, default="{:.2g}")]
+    sections += _agreement(agreement, "SteerableRoverBody + 6 Wheel")
     sections += [image(simulation / "path_xy.png", "paths in the plane and cross-track error; the co-simulated "
                        "run is dashed over the monolithic one (they coincide)"),
                  image(simulation / "path_wheels_turn.png", "turn: wheel forces, slip angles, steering, loads"),
@@ -305,13 +311,7 @@ def terrain_section(simulation: Path) -> list[str]:
                  "(uphill wheels 1-3 carry less, downhill 4-6 more). Energy: the motors' work "
                  "&int;&Sigma;&tau;<sub>i</sub>&omega;<sub>i</sub> dt per metre of path.</p>",
                  table(shown, default="{:.3g}")]
-    if agreement.exists():
-        agree = pd.read_csv(agreement).rename(columns={
-            "speed_max_difference_percent": "speed, largest difference [% of target]",
-            "load_max_difference_percent": "loads, largest difference [% of static]",
-            "path_max_difference_m": "path, largest distance [m]"})
-        sections += ["<p>Monolithic against co-simulated (SteerableRoverBody, given the same ground, + 6 Wheel):</p>",
-                     table(agree, default="{:.2g}")]
+    sections += _agreement(agreement, "SteerableRoverBody, given the same ground, + 6 Wheel")
     sections += [image(simulation / "terrain_xy.png", "paths over the ground's height contours and cross-track "
                        "error, compensated and kinematic"),
                  image(simulation / "terrain_wheels_slope_traverse_20.png",
