@@ -41,13 +41,6 @@ class Table:
     def __len__(self) -> int:
         return len(self.columns[0]) if self.columns else 0
 
-    def column(self, name: str) -> np.ndarray:
-        """The values of column ``name``; KeyError naming the columns there are."""
-        try:
-            return self.columns[self.names.index(name)]
-        except ValueError:
-            raise KeyError(f"{name!r}: expected one of {', '.join(self.names)}") from None
-
     def frame(self) -> Any:
         """The table as a pandas DataFrame (pandas imported here)."""
         import pandas as pd
