@@ -212,9 +212,15 @@ def _changed(soil_name: str, soil_table: dict[str, Any], wheel_name: str, wheel_
 
 def fmu_parameters(soil: Soil, wheel: Wheel) -> dict[str, float]:
     """The soil and wheel as the FMUs' parameters (``soil.c``, ``soil.kxBeta``, ``wheel.r`` ...)."""
-    values = {f"soil.{MODELICA_NAMES.get(k, k)}": v for k, v in asdict(soil).items()}
+    values = soil_parameters(soil)
     values.update({f"wheel.{k}": v for k, v in asdict(wheel).items()})
     return values
+
+
+def soil_parameters(soil: Soil, record: str = "soil") -> dict[str, float]:
+    """The soil as the FMUs' parameters of the record ``record`` (``soil``; ``soilB``: the second
+    soil of Wheel and SteerableRover, where a wheel's ``soilShare`` is 1)."""
+    return {f"{record}.{MODELICA_NAMES.get(k, k)}": v for k, v in asdict(soil).items()}
 
 
 def from_fmu_parameters(values: dict[str, float]) -> tuple[Soil, Wheel]:

@@ -167,6 +167,18 @@ class Soil:
         size = np.abs(np.asarray(slip_angle, dtype=float))
         return self.kx + self.kx_beta * size, self.ky + self.ky_beta * size
 
+    def blend(self, other: Soil, share: float) -> Soil:
+        """The soil under a wheel where ``other`` has the share ``share`` [1] in [0, 1]: each
+        parameter (1 - share) self + share other, as ``Components.RigidWheel`` blends ``soil`` and
+        ``soilB`` by its ``soilShare`` (exact at 0 and 1). Every range is convex, so the blend of
+        two valid soils is valid; xc, affine in phi when derived, blends as its derivation would."""
+        if not isinstance(other, Soil):
+            raise TypeError(f"other = {other!r}: expected a Soil")
+        if not (isinstance(share, (int, float)) and 0.0 <= share <= 1.0):
+            raise ValueError(f"share = {share!r}: expected a share of the other soil in [0, 1]")
+        keep = 1.0 - share
+        return Soil(**{f.name: keep * getattr(self, f.name) + share * getattr(other, f.name) for f in fields(self)})
+
     def bekker_modulus(self, b: float) -> float:
         """k = kc / b + kphi [N/m^(n+2)], the Bekker pressure-sinkage modulus for width b [m]."""
         return self.kc / b + self.kphi

@@ -15,7 +15,9 @@ A plane of world gradients G_x = dz/dx, G_y = dz/dy is θ = atan(hypot(G_x, G_y)
 Nagatani, Yoshida, J. Field Robotics 24(3), 2007 (steering on slopes of loose soil).
 
 ``HeightMap`` (a grid file, bicubic spline) and ``crater``: a height map over the plane, given to
-the rover hub by hub (``Interfaces.GroundContacts``). ``static_hold`` and ``critical_slope``: a
+the rover hub by hub (``Interfaces.GroundContacts``). ``SoilMap`` and ``soil_boundary``: where a
+second soil lies (its share in [0, 1], a grid file like the height map's), given to the wheels one
+by one (their ``soilShare``); ``hub_positions``: where the hubs are. ``static_hold`` and ``critical_slope``: a
 rover at rest on the plane by the reference wheel's static regime (``regimes``): whether the soil
 holds it, the holding torques, the creep.
 """
@@ -250,3 +252,79 @@ def crater(centre: tuple[float, float] = (6.0, -2.0), depth: float = 0.2, radius
     bowl = -depth * np.exp(-0.5 * (r / radius) ** 2)
     heights = bowl + rim * np.exp(-0.5 * ((r - 1.5 * radius) / (0.4 * radius)) ** 2)
     return HeightMap(x, y, heights, source="crater")
+
+
+def hub_positions(x: float, y: float, yaw: float, x_hub: FloatArray,
+                  y_hub: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """(x, y) [m] of the hubs in the ground plane for the body at (``x``, ``y``) [m] with heading
+    ``yaw`` [rad], the hubs at (``x_hub``, ``y_hub``) [m] in the body frame (pitch and roll of a few
+    degrees neglected)."""
+    cos, sin = math.cos(yaw), math.sin(yaw)
+    return x + cos * x_hub - sin * y_hub, y + sin * x_hub + cos * y_hub
+
+
+#: A share within this of 0 or 1 is 0 or 1 (``SoilMap.share``).
+SNAP = 1e-12
+
+
+class SoilMap:
+    """Where a second soil lies over the ground: the share s [1] of ``soil_b`` in the soil under a
+    wheel at (x, y) [m], 0 on ``soil``, 1 on ``soil_b``, in between a blend of their parameters
+    (``Soil.blend``, ``Components.RigidWheel``'s ``soilShare``). The shares ``shares[j, i]`` at the
+    grid points (``x[i]``, ``y[j]``) (at least 4 each, strictly increasing) are interpolated by a
+    bicubic spline clipped to [0, 1]; outside the grid the edge's share continues. The file
+    (``read``, ``write``): the CSV of ``HeightMap`` with shares for heights; the soils are not in
+    it (they are the FMUs' parameters ``soil`` and ``soilB``)."""
+
+    def __init__(self, x: ArrayLike, y: ArrayLike, shares: ArrayLike, soil: Soil, soil_b: Soil,
+                 source: str = "soil map"):
+        for name, value in (("soil", soil), ("soil_b", soil_b)):
+            if not isinstance(value, Soil):
+                raise TypeError(f"{source}: {name} = {value!r}: expected a Soil")
+        values = np.asarray(shares, float)
+        bad = np.argwhere(~(np.isfinite(values) & (values >= 0.0) & (values <= 1.0)))
+        if values.ndim == 2 and bad.size:
+            j, i = bad[0]
+            raise ValueError(f"{source}: share at grid point (row {j + 1}, column {i + 1}) is "
+                             f"{float(values[j, i])!r}: expected a share of the second soil in [0, 1]")
+        self.grid = HeightMap(x, y, values, source=source)
+        self.soil, self.soil_b, self.source = soil, soil_b, source
+
+    def share(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
+        """The share [1] of ``soil_b`` under the points (x, y) [m]; within 1e-12 of 0 or 1 it is 0 or 1
+        (the spline's round-off over a region of one soil: a wheel there is on that soil exactly)."""
+        share = np.clip(self.grid.height(x, y), 0.0, 1.0)
+        return np.where(share < SNAP, 0.0, np.where(share > 1.0 - SNAP, 1.0, share))
+
+    def soil_at(self, x: float, y: float) -> Soil:
+        """The soil under the point (x, y) [m]."""
+        return self.soil.blend(self.soil_b, float(self.share(x, y)))
+
+    @classmethod
+    def read(cls, path: str | Path, soil: Soil, soil_b: Soil) -> SoilMap:
+        """The soil map of the CSV file ``path`` between ``soil`` and ``soil_b``; ValueError naming the file."""
+        grid = HeightMap.read(path)
+        return cls(grid.x, grid.y, grid.heights, soil, soil_b, source=f"soil map {path}")
+
+    def write(self, path: str | Path) -> bytes:
+        """The CSV text of the map (written to ``path`` unless it is empty)."""
+        return self.grid.write(path)
+
+
+def soil_boundary(x_boundary: float, soil: Soil, soil_b: Soil, width: float = 0.5,
+                  x_span: tuple[float, float] = (-5.0, 15.0), y_span: tuple[float, float] = (-5.0, 5.0),
+                  spacing: float = 0.1) -> SoilMap:
+    """``soil`` up to a straight boundary across the x axis at ``x_boundary`` [m], ``soil_b`` beyond
+    it, the share rising over ``width`` [m] centred on the boundary as 3t² - 2t³ (t from 0 to 1:
+    continuous with its slope, smooth for the integrator), sampled every ``spacing`` [m] over
+    ``x_span`` x ``y_span`` [m]."""
+    for name, value in (("width", width), ("spacing", spacing)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"soil boundary {name} = {value!r} m: expected > 0")
+    if not (isinstance(x_boundary, (int, float)) and math.isfinite(x_boundary)):
+        raise ValueError(f"soil boundary x_boundary = {x_boundary!r} m: expected a finite position")
+    x = np.arange(x_span[0], x_span[1] + spacing / 2, spacing)
+    y = np.arange(y_span[0], y_span[1] + spacing / 2, spacing)
+    t = np.clip((x - x_boundary) / width + 0.5, 0.0, 1.0)
+    ramp = t * t * (3.0 - 2.0 * t)
+    return SoilMap(x, y, np.tile(ramp, (y.size, 1)), soil, soil_b, source=f"soil boundary at x = {x_boundary:g} m")

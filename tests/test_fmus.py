@@ -104,7 +104,7 @@ def test_model_description_interfaces_match_the_users_guide(fmus):
     outputs = {n for n, v in single.items() if v.causality == "output"}
     assert {"Fx", "Fz", "Tx", "slip", "sinkage", "omega", "v"} <= outputs
     wheel = variables(fmus["Wheel"])
-    assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub", "v_lat"}
+    assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub", "v_lat", "soilShare"}
     body = variables(fmus["RoverBody"])
     assert {f"Fx[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "input"}
     assert {f"W[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "output"}

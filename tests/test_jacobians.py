@@ -40,7 +40,17 @@ Inputs = Callable[[float], dict[str, float]]
 
 def _wheel(t: float) -> dict[str, float]:
     return {"tau": 20.0 + 10.0 * math.sin(8 * t), "W": 424.0 + 60.0 * math.sin(5 * t), "v_hub": 1.0,
-            "v_lat": 0.0 if t < 0.25 else 0.05}
+            "v_lat": 0.0 if t < 0.25 else 0.05, "soilShare": _share(t)}
+
+
+def _share(t: float) -> float:
+    """A wheel rolling across a soil boundary (inside (0, 1), where the share's column is defined
+    by central differences)."""
+    return 0.5 + 0.4 * math.sin(3 * t)
+
+
+#: The second soil of the runs with a soil share: softer and weaker than the first (the paper's).
+SOIL_B = {"soilB.kphi": 4e5, "soilB.c": 300.0, "soilB.phi": 0.55, "soilB.n": 1.1}
 
 
 def _single_wheel(t: float) -> dict[str, float]:
@@ -54,7 +64,8 @@ def _rover(t: float) -> dict[str, float]:
 def _steerable(t: float) -> dict[str, float]:
     steer = 0.0 if t < 0.25 else 0.08
     return {**_rover(t), **{f"steer[{i}]": steer * (1 if i in (1, 4) else -1 if i in (3, 6) else 0)
-                            for i in range(1, 7)}}
+                            for i in range(1, 7)},
+            **{f"soilShare[{i}]": _share(t + 0.1 * i) for i in range(1, 7)}}
 
 
 def _body(t: float) -> dict[str, float]:
@@ -68,11 +79,11 @@ def _steerable_body(t: float) -> dict[str, float]:
 
 
 SCENARIOS: dict[str, tuple[dict[str, float], Inputs]] = {
-    "Wheel": ({"omega": 1.0 / 0.355}, _wheel),
+    "Wheel": ({"omega": 1.0 / 0.355, **SOIL_B}, _wheel),
     "SingleWheel": ({"W": 575.0}, _single_wheel),
     "Rover": ({}, _rover),
     "RoverBody": ({}, _body),
-    "SteerableRover": ({}, _steerable),
+    "SteerableRover": (SOIL_B, _steerable),
     "SteerableRoverBody": ({}, _steerable_body),
 }
 

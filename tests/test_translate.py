@@ -53,7 +53,7 @@ def test_open_loop_rover_ode_matches_rumocas_simulation():
 
 @pytest.mark.parametrize("name, inputs", [
     ("SingleWheel", ["tau", "trackAngle"]),
-    ("Wheel", ["tau", "W", "v_hub", "v_lat"]),
+    ("Wheel", ["tau", "W", "v_hub", "v_lat", "soilShare"]),
     ("RoverBody", [f"Fx[{i}]" for i in range(1, 7)] + [f"tau[{i}]" for i in range(1, 7)]),
     ("Rover", [f"tau[{i}]" for i in range(1, 7)]),
 ])

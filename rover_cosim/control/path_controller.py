@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import ctypes
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path as FilePath
 
 import numpy as np
@@ -133,15 +133,14 @@ class PathFollowingController:
         from the last step's delta (two steps reach the solve's tolerance: delta changes by
         micro-radians per step); the slip is the one for Fx_des at the last step's delta."""
         steer, fx_des, fy_des = [], [], []
-        for load, angle, f_x, f_y, delta in zip(map(float, loads), map(float, gamma), map(float, fx), map(float, fy),
-                                                map(float, self.steer)):
-            slip = self.inverse.slip_for_force(load, f_x * math.cos(delta) + f_y * math.sin(delta))
-            coefficients = self.lateral.angle_coefficients_at(load, slip)
+        for wheel, (load, angle, f_x, f_y, delta) in enumerate(zip(map(float, loads), map(float, gamma), map(float, fx),
+                                                                   map(float, fy), map(float, self.steer))):
+            lateral = self._lateral_law(wheel, load, f_x * math.cos(delta) + f_y * math.sin(delta))
             low, high = _clip(angle - MAX_SLIP_ANGLE, -MAX_STEER, math.inf), _clip(angle + MAX_SLIP_ANGLE, -math.inf,
                                                                                    MAX_STEER)
             for _ in range(NEWTON_STEPS):
                 cos, sin = math.cos(delta), math.sin(delta)
-                model_fy, slope = self.lateral.fy_and_slope_at(coefficients, angle - delta)
+                model_fy, slope = lateral(angle - delta)
                 residual = model_fy - (f_y * cos - f_x * sin)
                 derivative = -slope + f_x * cos + f_y * sin  # d/d delta of the residual
                 delta = _clip(delta - residual / (derivative if abs(derivative) > 1e-9 else 1e-9), low, high)
@@ -150,6 +149,16 @@ class PathFollowingController:
             fx_des.append(f_x * cos + f_y * sin)
             fy_des.append(f_y * cos - f_x * sin)
         return np.array(steer), np.array(fx_des), np.array(fy_des)
+
+    def _lateral_law(self, wheel: int, load: float, force: float) -> Callable[[float], tuple[float, float]]:
+        """Wheel ``wheel``'s (0-5) lateral model at ``load`` [N] and at the slip the inverse
+        longitudinal model gives for ``force`` [N]: slip angle [rad] -> (Fy [N], dFy/dbeta [N/rad])."""
+        coefficients = self.lateral.angle_coefficients_at(load, self.inverse.slip_for_force(load, force))
+        return lambda beta: self.lateral.fy_and_slope_at(coefficients, beta)
+
+    def _torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool, step: float | None) -> np.ndarray:
+        """The wheels' torques [N·m] for ``forces`` [N] at ``loads`` [N] (``LongitudinalInverse.torques``)."""
+        return self.inverse.torques(loads, forces, advance, step)
 
     def _kinematic_steering(self, v: float, curvature: float, offset: float, cross_track: float,
                             loads: list[float], force_t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -177,7 +186,7 @@ class PathFollowingController:
             gamma = [a + d for a, d in zip(slip_angles, self.steer.tolist())]
             steer, fx_des, fy_des = self._inverse_steering(loads, gamma, fx, fy)
         self.steer = steer
-        torque = self.inverse.torques(np.array(loads), fx_des, advance, step)
+        torque = self._torques(np.array(loads), fx_des, advance, step)
         return np.concatenate([torque, steer, fx_des, fy_des, signals])
 
     def start(self, t0: float, u0: np.ndarray) -> np.ndarray:

@@ -14,18 +14,31 @@ allocates and inverts the identified models exactly as the path controller does:
   by -W_i s_i along and across the heading; the demand subtracts sum -W_i s_i and its yaw moment
   sum (x_i f_y,i - y_i f_x,i), with the measured loads (as the controller clips them, >= 1 N).
 
-Without a slope and a map the demand, and every output, is the path controller's (bit for bit).
-The path controller's C twin takes the plane's pull too (the same arithmetic); over a height map
-the block steps in Python.
+Soil that varies (``soil_map``, a ``terramechanics.terrain.SoilMap``, and ``model_b``, the models
+identified on its second soil): the soil the controller believes in under each wheel is the map's
+at the hub, a share s_i of the second soil. Each wheel's models are then the two soils' blended by
+s_i: the lateral force and its slope at a slip angle (1 - s_i) of the first model's + s_i of the
+second's (each at the slip its own inverse longitudinal model gives for the demand), and the
+torque (1 - s_i) tau_a + s_i tau_b, both inverse longitudinal laws (each with its filter) run on
+the same demands. Where the map believes the first soil (s_i = 0) a wheel's outputs are those of
+the controller without the map, bit for bit.
+
+Without a slope, a height map and a soil map the demand, and every output, is the path
+controller's (bit for bit). The path controller's C twin takes the plane's pull too (the same
+arithmetic); over a height map or a soil map the block steps in Python.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any, Protocol
 
 import numpy as np
 
+from rover_cosim.terramechanics.terrain import hub_positions
+
+from .longitudinal import LongitudinalInverse, read_model
 from .path_controller import WHEELS, PathFollowingController
 
 
@@ -58,14 +71,38 @@ class GroundMap(Protocol):
         ...
 
 
+class SoilBelief(Protocol):
+    """Where the controller believes the second soil lies (``rover_cosim.terramechanics.terrain.SoilMap``)."""
+
+    def share(self, x: Any, y: Any) -> Any:
+        """The share [1] of the second soil under the points (x, y) [m]."""
+        ...
+
+
 class TerrainPathController(PathFollowingController):
     """``PathFollowingController`` (same inputs, outputs and options) with the ground's pull fed
     forward: ``terrain`` (None: level), ``g`` [m/s²] the gravity it believes in, ``ground_map``
-    (None: no map)."""
+    (None: no map); and with the soil it believes in under each wheel: ``soil_map`` (None: the
+    soil ``model`` was identified on, everywhere) with ``model_b``, the models identified on the
+    map's second soil."""
 
     def __init__(self, name: str, model: Any, *, terrain: Ground | None = None, g: float = 1.62,
-                 ground_map: GroundMap | None = None, **options: Any):
+                 ground_map: GroundMap | None = None, soil_map: SoilBelief | None = None, model_b: Any = None,
+                 **options: Any):
         super().__init__(name, model, **options)
+        if (soil_map is None) != (model_b is None):
+            raise ValueError(f"block {name!r}: soil_map = {soil_map!r}, model_b = {model_b!r}: expected both (a "
+                             "SoilMap and the models identified on its second soil) or neither")
+        if soil_map is not None and not hasattr(soil_map, "share"):
+            raise TypeError(f"block {name!r}: soil_map = {soil_map!r}: expected a SoilMap or None")
+        self.soil_map = soil_map
+        self.shares = [0.0] * WHEELS
+        if model_b is not None:
+            models_b, longitudinal_b, _ = read_model(model_b, name)
+            if models_b.lateral is None:
+                raise ValueError(f"block {name!r}: model_b {models_b.source} has no lateral model")
+            self.lateral_b = models_b.lateral
+            self.inverse_b = LongitudinalInverse(longitudinal_b, WHEELS, self.inverse.wn, self.step_size, name)
         if not (isinstance(g, (int, float)) and math.isfinite(g) and g > 0):
             raise ValueError(f"block {name!r}: g = {g!r} m/s²: expected a gravity > 0")
         if terrain is not None and not (hasattr(terrain, "gravity") and hasattr(terrain, "level")):
@@ -90,14 +127,16 @@ class TerrainPathController(PathFollowingController):
         if self.ground_map is not None:
             loads = np.array([max(1.0, float(w)) for w in u[6:6 + WHEELS]])
             cos, sin = math.cos(yaw), math.sin(yaw)
-            gx, gy = self.ground_map.gradient(x + cos * self.x_hub - sin * self.y_hub,
-                                              y + sin * self.x_hub + cos * self.y_hub)
+            gx, gy = self.ground_map.gradient(*hub_positions(x, y, yaw, self.x_hub, self.y_hub))
             hub_x, hub_y = -loads * (gx * cos + gy * sin), -loads * (-gx * sin + gy * cos)
             fx, fy = fx + float(hub_x.sum()), fy + float(hub_y.sum())
             mz = float(np.sum(self.x_hub * hub_y - self.y_hub * hub_x))
         return fx, fy, mz
 
     def _tracking(self, t: float, u: Any) -> Any:
+        if self.soil_map is not None:  # the soil believed in under each wheel, for this step's laws
+            hubs = hub_positions(float(u[0]), float(u[1]), float(u[2]), self.x_hub, self.y_hub)
+            self.shares = [float(s) for s in self.soil_map.share(*hubs)]
         demand, along, signals, path = super()._tracking(t, u)
         if self.plain:
             return demand, along, signals, path
@@ -105,11 +144,41 @@ class TerrainPathController(PathFollowingController):
         held = [demand[0] - fx, demand[1] - fy, demand[2] - mz]
         return (held if isinstance(demand, list) else np.array(held)), along, signals, path
 
+    def _lateral_law(self, wheel: int, load: float, force: float) -> Callable[[float], tuple[float, float]]:
+        law = super()._lateral_law(wheel, load, force)
+        share = self.shares[wheel]
+        if share == 0.0:
+            return law
+        coefficients = self.lateral_b.angle_coefficients_at(load, self.inverse_b.slip_for_force(load, force))
+
+        def blended(beta: float) -> tuple[float, float]:
+            fy_a, slope_a = law(beta)
+            fy_b, slope_b = self.lateral_b.fy_and_slope_at(coefficients, beta)
+            return (1.0 - share) * fy_a + share * fy_b, (1.0 - share) * slope_a + share * slope_b
+        return blended
+
+    def _torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool, step: float | None) -> np.ndarray:
+        torque = super()._torques(loads, forces, advance, step)
+        if self.soil_map is None:
+            return torque
+        torque_b = self.inverse_b.torques(loads, forces, advance, step)
+        shares = np.array(self.shares)
+        return np.where(shares == 0.0, torque, (1.0 - shares) * torque + shares * torque_b)
+
+    def get_state(self) -> Any:
+        state = super().get_state()
+        return state if self.soil_map is None else (*state, self.inverse_b.filter_state.copy(), list(self.shares))
+
+    def set_state(self, state: Any) -> None:
+        super().set_state(state[:3])
+        if self.soil_map is not None:
+            self.inverse_b.filter_state, self.shares = state[3].copy(), list(state[4])
+
     def native(self) -> Any:
         """The path controller's C twin, with the plane's pull where the ground is sloped; None over
-        a height map (the twin knows no map: the block then steps in Python)."""
+        a height map or a soil map (the twin knows neither: the block then steps in Python)."""
         twin = getattr(super(), "native", None)
-        return twin() if self.ground_map is None and twin is not None else None
+        return twin() if self.ground_map is None and self.soil_map is None and twin is not None else None
 
     def _pull_settings(self) -> list[float]:
         if self.terrain is None or self.terrain.level:

@@ -1,6 +1,7 @@
-"""The ground participant of the steerable rover on a height map (issue 35): a Python block that
-gives each hub the ground under it (``Interfaces.GroundContacts`` of SteerableRover and
-SteerableRoverBody), from the body's pose and velocity.
+"""The ground participants of the steerable rover (issue 35): Python blocks that give each hub
+the ground under it (``GroundBlock``: ``Interfaces.GroundContacts`` of SteerableRover and
+SteerableRoverBody, from the body's pose and velocity) and each wheel the soil under it
+(``SoilBlock``: the ``soilShare`` inputs of SteerableRover or of each Wheel, from the pose).
 
 Why a participant and not a table inside the FMU: our exporter (rumoca -> CasADi -> C) has no
 table functions reading files, and a participant serves the monolithic FMU and the co-simulated
@@ -15,14 +16,36 @@ from __future__ import annotations
 
 import numpy as np
 
-from rover_cosim.terramechanics.terrain import HeightMap
+from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, hub_positions
 
 WHEELS = 6
 BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
 SIGNALS = ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGradientLateral")
 
 
-class GroundBlock:
+class _HubBlock:
+    """What both blocks share: the hubs in the body frame (limbs 1-3 front, middle, rear on the
+    left at ``y_limb`` [m], 4-6 on the right; ``x_limb`` [m] ahead of the centre of gravity), and
+    outputs that are a function of the inputs now (``values``)."""
+
+    def __init__(self, name: str, x_limb: tuple[float, float, float], y_limb: float):
+        if not y_limb > 0:
+            raise ValueError(f"block {name!r}: y_limb = {y_limb!r} m: expected > 0")
+        self.name = name
+        self.x_hub = np.array([*x_limb, *x_limb], float)
+        self.y_hub = np.array([y_limb] * 3 + [-y_limb] * 3, float)
+
+    def values(self, u: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+        return self.values(u0)
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        return self.values(u)
+
+
+class GroundBlock(_HubBlock):
     """Orchestrator block. Inputs: x, y, yaw, v, vy, yawRate of the body. Outputs per hub i:
     groundHeight[i] [m], groundHeightRate[i] [m/s], groundGradientAlong[i], groundGradientLateral[i] [1]."""
 
@@ -30,11 +53,8 @@ class GroundBlock:
                  y_limb: float = 1.5):
         if not isinstance(height_map, HeightMap):
             raise TypeError(f"block {name!r}: height_map = {height_map!r}: expected a HeightMap")
-        if not y_limb > 0:
-            raise ValueError(f"block {name!r}: y_limb = {y_limb!r} m: expected > 0")
-        self.name, self.map = name, height_map
-        self.x_hub = np.array([*x_limb, *x_limb], float)
-        self.y_hub = np.array([y_limb] * 3 + [-y_limb] * 3, float)
+        super().__init__(name, x_limb, y_limb)
+        self.map = height_map
         self.inputs: tuple[str, ...] = BODY
         self.outputs: tuple[str, ...] = tuple(f"{s}[{i}]" for s in SIGNALS for i in range(1, WHEELS + 1))
         units = {"groundHeight": "m", "groundHeightRate": "m/s", "groundGradientAlong": "1",
@@ -46,14 +66,32 @@ class GroundBlock:
         """The outputs for the body state ``u`` (the inputs)."""
         x, y, yaw, v, vy, r = (float(value) for value in u[:6])
         cos, sin = np.cos(yaw), np.sin(yaw)
-        hx, hy = x + cos * self.x_hub - sin * self.y_hub, y + sin * self.x_hub + cos * self.y_hub
+        hx, hy = hub_positions(x, y, yaw, self.x_hub, self.y_hub)
         ux, uy = v - r * self.y_hub, vy + r * self.x_hub          # hub velocities, heading frame
         gx, gy = self.map.gradient(hx, hy)
         along, lateral = gx * cos + gy * sin, -gx * sin + gy * cos
         return np.concatenate([self.map.height(hx, hy), along * ux + lateral * uy, along, lateral])
 
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
-        return self.ground(u0)
+    values = ground
 
-    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
-        return self.ground(u)
+
+class SoilBlock(_HubBlock):
+    """Orchestrator block: the soil under each wheel from a soil map. Inputs: x, y, yaw of the
+    body. Outputs: soilShare[i] [1], the share of the map's second soil under hub i (the input
+    ``soilShare`` of SteerableRover, per wheel, or of Wheel i)."""
+
+    def __init__(self, name: str, soil_map: SoilMap, x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5),
+                 y_limb: float = 1.5):
+        if not isinstance(soil_map, SoilMap):
+            raise TypeError(f"block {name!r}: soil_map = {soil_map!r}: expected a SoilMap")
+        super().__init__(name, x_limb, y_limb)
+        self.map = soil_map
+        self.inputs: tuple[str, ...] = BODY[:3]
+        self.outputs: tuple[str, ...] = tuple(f"soilShare[{i}]" for i in range(1, WHEELS + 1))
+        self.units = {"x": "m", "y": "m", "yaw": "rad", **{name: "1" for name in self.outputs}}
+
+    def shares(self, u: np.ndarray) -> np.ndarray:
+        """The outputs for the body pose ``u`` (the inputs)."""
+        return self.map.share(*hub_positions(float(u[0]), float(u[1]), float(u[2]), self.x_hub, self.y_hub))
+
+    values = shares

@@ -12,6 +12,7 @@ equation
   rover.groundHeightRate = zeros(6);
   rover.groundGradientAlong = zeros(6);
   rover.groundGradientLateral = zeros(6);
+  rover.soilShare = zeros(6);
   annotation (
     experiment(StartTime=0, StopTime=10, Interval=0.01, Tolerance=1e-6),
     Documentation(info="<html>
@@ -20,6 +21,6 @@ driven with <code>tauDrive</code>, front wheels steered <code>steerFront</code> 
 rear wheels as much to the right, starting at 0.5 m/s with the wheels rolling (omega = v/r). The
 body yaws left, rolls to the outside of the turn (left side up) and loads the outer wheels; the
 same system co-simulated is <code>steerable_rover_cosim.toml</code>. The ground is the plane of
-<code>rover.terrain</code> (level by default) without a height map (the ground inputs 0).</p>
+<code>rover.terrain</code> (level by default) without a height map (the ground inputs 0), on one soil (<code>soilShare</code> 0).</p>
 </html>"));
 end SteerableRoverTurn;

@@ -11,13 +11,14 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   RoverTerramechanics.Components.Chassis body(rover=rover, slope=slope) "Body and limbs";
-  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
+  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each soilB=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
   for i in 1:6 loop
     wheels[i].tau = tau[i];
     wheels[i].W = body.W[i];
     wheels[i].v_hub = body.v_hub[i];
     wheels[i].v_lat = 0 "pitch-plane rover: no sideways motion";
+    wheels[i].soilShare = 0 "one soil under every wheel";
     body.Fx[i] = wheels[i].Fx;
     body.tau[i] = tau[i];
     Fz[i] = wheels[i].Fz;

@@ -24,9 +24,10 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   output Real beta(unit="rad") "Slip angle of the hub velocity in the wheel frame: slipAngle + trackAngle";
   output Real v(unit="m/s", start=0, fixed=true) "Carriage (hub) velocity along the ground";
   output Real x(unit="m", start=0, fixed=true) "Carriage position along the ground";
-  RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick) "The wheel";
+  RoverTerramechanics.Components.RigidWheel rigidWheel(soil=soil, soilB=soil, wheel=wheel, nNodes=nNodes, nIterations=nIterations, vEps=vEps, vHold=vHold, vStick=vStick) "The wheel";
 equation
   rigidWheel.tau = tau;
+  rigidWheel.soilShare = 0 "one soil under the test bed";
   rigidWheel.W = W*cos(slope);
   beta = slipAngle + trackAngle;
   rigidWheel.v_hub = v*cos(beta);

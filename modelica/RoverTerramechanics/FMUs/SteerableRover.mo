@@ -1,7 +1,8 @@
 within RoverTerramechanics.FMUs;
 model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every wheel driven and steered, with six terramechanics wheels (monolithic)"
   extends RoverTerramechanics.Interfaces.GroundContacts;
-  parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
+  parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2): the soil under a wheel where its soilShare = 0";
+  parameter RoverTerramechanics.Parameters.SoilParameters soilB "Second soil: the soil under a wheel where its soilShare = 1 (default Table 2's)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
   parameter RoverTerramechanics.Parameters.TerrainParameters terrain "Ground plane: slope and downhill direction (default level)";
@@ -12,6 +13,7 @@ model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every whe
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel";
   input Real steer[6](each unit="rad") "Steering angle of each wheel, positive to the left";
+  input Real soilShare[6](each unit="1", each min=0, each max=1, each start=0) "Share of the second soil (soilB) in the soil under each wheel, from a soil map (0: soil)";
   output Real x(unit="m") "Position of the centre of gravity along the ground's x axis (world x on level ground)";
   output Real y(unit="m") "Position of the centre of gravity along the ground's y axis (world y on level ground)";
   output Real yaw(unit="rad") "Heading against the ground's x axis, positive to the left";
@@ -29,13 +31,14 @@ model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every whe
   output Real sinkage[6](each unit="m") "Sinkage of each wheel";
   output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
   RoverTerramechanics.Components.SteerableChassis body(rover=rover, terrain=terrain) "Body and limbs";
-  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
+  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each soilB=soilB, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
   for i in 1:6 loop
     wheels[i].tau = tau[i];
     wheels[i].W = body.W[i];
     wheels[i].v_hub = body.v_hub[i];
     wheels[i].v_lat = body.v_lat[i];
+    wheels[i].soilShare = soilShare[i];
     body.Fx[i] = wheels[i].Fx;
     body.Fy[i] = wheels[i].Fy;
     body.tau[i] = tau[i];
@@ -74,7 +77,10 @@ is <code>Rover</code> on level ground. The ground is the plane of <code>terrain<
 (<code>Parameters.TerrainParameters</code>: slope and downhill direction; level by default):
 the loads act along its normal and the wheels' frames lie in it. A height map over the plane comes
 in hub by hub (<code>Interfaces.GroundContacts</code>: height, its rate, gradients; 0 by default)
-from a terrain participant. The states <code>x</code>, <code>y</code>,
+from a terrain participant. The soil under each wheel is <code>soil</code>, or where its input
+<code>soilShare[i]</code> (start 0) is above 0 a blend with <code>soilB</code>
+(<code>Components.RigidWheel</code>), given wheel by wheel from a soil map by a soil
+participant. The states <code>x</code>, <code>y</code>,
 <code>yaw</code>, <code>v</code>, <code>vy</code>, <code>yawRate</code> and <code>omega[i]</code>
 take start values, so a run can start in motion.</p>
 </html>"));

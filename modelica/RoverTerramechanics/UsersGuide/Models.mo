@@ -77,11 +77,12 @@ co-simulation (the wheel side of the cut: <code>Interfaces.WheelHub</code>; phys
 <ul>
 <li>inputs: <code>tau</code> [N&middot;m], <code>W</code> [N] load, <code>v_hub</code> [m/s] hub
 speed, <code>v_lat</code> [m/s] the hub's speed to the wheel's left (start 0, optional: a system
-may leave it unconnected)</li>
+may leave it unconnected), <code>soilShare</code> [1] the share of the second soil under the wheel
+(start 0, optional: from a soil map)</li>
 <li>outputs: <code>Fx</code> [N], <code>Fz</code> [N], <code>Tx</code> [N&middot;m],
 <code>Fy</code> [N], <code>slipAngle</code> [rad], <code>slip</code> [1], <code>sinkage</code>
 [m], <code>omega</code> [rad/s] (a state with a start value), <code>entryAngle</code> [rad]</li>
-<li>parameters: <code>soil</code>, <code>wheel</code>, <code>nNodes</code>,
+<li>parameters: <code>soil</code>, <code>soilB</code> (the second soil), <code>wheel</code>, <code>nNodes</code>,
 <code>nIterations</code>, <code>vEps</code>, <code>vHold</code>, <code>vStick</code></li>
 </ul>
 
@@ -96,7 +97,8 @@ so each has a slip and a slip angle.</p>
 against the heading, positive to the left; <code>groundHeight[1..6]</code> [m], <code>groundHeightRate[1..6]</code> [m/s],
 <code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: a height map
 over the ground plane hub by hub (<code>Interfaces.GroundContacts</code>; optional, start 0: the
-plane itself)</li>
+plane itself); <code>soilShare[1..6]</code> [1]: the share of the second soil under each wheel
+(optional, start 0: <code>soil</code> everywhere)</li>
 <li>outputs: <code>x</code>, <code>y</code> [m], <code>yaw</code> [rad], <code>v</code>,
 <code>vy</code> [m/s] (CoG velocity along and to the left of the heading), <code>yawRate</code>
 [rad/s], <code>pitch</code>, <code>roll</code> [rad] (roll positive: left side up), per wheel
@@ -106,7 +108,7 @@ plane itself)</li>
 <li>states with start values (a run can start in motion): <code>body.x</code>,
 <code>body.y</code>, <code>body.yaw</code>, <code>body.v</code>, <code>body.vy</code>,
 <code>body.yawRate</code>, heave/pitch/roll and their rates, <code>wheels[i].omega</code></li>
-<li>parameters: <code>soil</code>, <code>wheel</code>, <code>rover</code> (RoverParameters, with
+<li>parameters: <code>soil</code>, <code>soilB</code> (the second soil), <code>wheel</code>, <code>rover</code> (RoverParameters, with
 <code>yLimb</code>, <code>Ixx</code>, <code>Izz</code>), <code>terrain</code> (TerrainParameters:
 <code>slope</code>, <code>downhill</code> [rad]; level by default), <code>nNodes</code>,
 <code>nIterations</code>, <code>vEps</code>, <code>vHold</code>, <code>vStick</code></li>
@@ -127,7 +129,8 @@ rounding)</li>
 <code>tau[1..6]</code> [N&middot;m], <code>steer[1..6]</code> [rad]; <code>groundHeight[1..6]</code> [m], <code>groundHeightRate[1..6]</code> [m/s],
 <code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: a height map
 over the ground plane hub by hub (<code>Interfaces.GroundContacts</code>; optional, start 0: the
-plane itself)</li>
+plane itself); <code>soilShare[1..6]</code> [1]: the share of the second soil under each wheel
+(optional, start 0: <code>soil</code> everywhere)</li>
 <li>outputs: <code>W[1..6]</code> [N], <code>v_hub[1..6]</code>, <code>v_lat[1..6]</code> [m/s]
 to the wheels; the body's pose and rates <code>x</code>, <code>y</code> [m], <code>yaw</code>
 [rad], <code>v</code>, <code>vy</code> [m/s], <code>yawRate</code> [rad/s], <code>z</code> [m]
