@@ -271,8 +271,11 @@ class SoilMap:
     """Where a second soil lies over the ground: the share s [1] of ``soil_b`` in the soil under a
     wheel at (x, y) [m], 0 on ``soil``, 1 on ``soil_b``, in between a blend of their parameters
     (``Soil.blend``, ``Components.RigidWheel``'s ``soilShare``). The shares ``shares[j, i]`` at the
-    grid points (``x[i]``, ``y[j]``) (at least 4 each, strictly increasing) are interpolated by a
-    bicubic spline clipped to [0, 1]; outside the grid the edge's share continues. The file
+    grid points (``x[i]``, ``y[j]``) (at least 4 each, strictly increasing) are interpolated
+    bilinearly: a share stays in [0, 1] and a region of one soil is that soil exactly (a bicubic
+    spline, as for heights, rings across a boundary and leaves traces of the other soil metres
+    away). The kinks at the grid lines are no events: each wheel's FMU holds its share, an input,
+    over a communication step. Outside the grid the edge's share continues. The file
     (``read``, ``write``): the CSV of ``HeightMap`` with shares for heights; the soils are not in
     it (they are the FMUs' parameters ``soil`` and ``soilB``)."""
 
@@ -287,13 +290,19 @@ class SoilMap:
             j, i = bad[0]
             raise ValueError(f"{source}: share at grid point (row {j + 1}, column {i + 1}) is "
                              f"{float(values[j, i])!r}: expected a share of the second soil in [0, 1]")
-        self.grid = HeightMap(x, y, values, source=source)
+        from scipy.interpolate import RegularGridInterpolator
+
+        self.grid = HeightMap(x, y, values, source=source)  # its checks of the grid, and its file
         self.soil, self.soil_b, self.source = soil, soil_b, source
+        self._linear = RegularGridInterpolator((self.grid.y, self.grid.x), self.grid.heights, method="linear")
 
     def share(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
         """The share [1] of ``soil_b`` under the points (x, y) [m]; within 1e-12 of 0 or 1 it is 0 or 1
-        (the spline's round-off over a region of one soil: a wheel there is on that soil exactly)."""
-        share = np.clip(self.grid.height(x, y), 0.0, 1.0)
+        (the weights' round-off over a region of one soil: a wheel there is on that soil exactly)."""
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        grid = self.grid
+        points = np.stack([np.clip(y, grid.y[0], grid.y[-1]), np.clip(x, grid.x[0], grid.x[-1])], axis=-1)
+        share = np.clip(self._linear(points.reshape(-1, 2)), 0.0, 1.0).reshape(x.shape)
         return np.where(share < SNAP, 0.0, np.where(share > 1.0 - SNAP, 1.0, share))
 
     def soil_at(self, x: float, y: float) -> Soil:
@@ -316,8 +325,7 @@ def soil_boundary(x_boundary: float, soil: Soil, soil_b: Soil, width: float = 0.
                   spacing: float = 0.1) -> SoilMap:
     """``soil`` up to a straight boundary across the x axis at ``x_boundary`` [m], ``soil_b`` beyond
     it, the share rising over ``width`` [m] centred on the boundary as 3t² - 2t³ (t from 0 to 1:
-    continuous with its slope, smooth for the integrator), sampled every ``spacing`` [m] over
-    ``x_span`` x ``y_span`` [m]."""
+    continuous with its slope), sampled every ``spacing`` [m] over ``x_span`` x ``y_span`` [m]."""
     for name, value in (("width", width), ("spacing", spacing)):
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
             raise ValueError(f"soil boundary {name} = {value!r} m: expected > 0")

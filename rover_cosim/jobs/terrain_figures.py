@@ -18,18 +18,29 @@ LABELS = {"inverse": "identified models, downhill pull compensated (SteerableRov
           "cosim": "identified models, compensated (co-simulated)",
           "kinematic": "kinematic steering (ablation)",
           "unaware": "identified models, the map unknown to the controller (ablation)"}
+#: The soil crossing's runs: what the controller believes of the soil, not of the ground's pull.
+SOIL_LABELS = {"inverse": "both soils' models, the soil map believed (SteerableRover.fmu)",
+               "cosim": "both soils' models, the soil map believed (co-simulated)",
+               "unaware": "the first soil's models everywhere (ablation)"}
 STYLES = {"inverse": "-", "cosim": "--", "kinematic": ":", "unaware": ":"}
 COLORS = {"inverse": "tab:blue", "cosim": "tab:orange", "kinematic": "tab:red", "unaware": "tab:red"}
 
 
+def run_label(scenario: str, label: str) -> str:
+    """How the figures name run ``label`` of ``scenario``."""
+    if scenario == "soil_crossing":
+        return SOIL_LABELS[label]
+    return LABELS[label] if scenario != "crater" else LABELS[label].replace("downhill pull", "map's pull")
+
+
 def paths_over_terrain(scenarios: dict[str, tuple[Path, Any]],
                        tables: dict[tuple[str, str], pd.DataFrame]) -> bytes:
-    """Per scenario: the ground's height contours [m] (``terrain.height(x, y)``, ``terrain.label()``)
-    with the reference path and the centre of gravity of each run (top), the cross-track error
-    against arc length (bottom)."""
-    fig, axes = plt.subplots(2, len(scenarios), figsize=(6.5 * len(scenarios), 9), squeeze=False)
-    for column, (scenario, (path, terrain)) in enumerate(scenarios.items()):
-        top, bottom = axes[0][column], axes[1][column]
+    """Per scenario (a row): the ground's height contours [m] (``terrain.height(x, y)``,
+    ``terrain.label()``; hatched where a soil map has its second soil) with the reference path and
+    the centre of gravity of each run (left), the cross-track error against arc length (right)."""
+    fig, axes = plt.subplots(len(scenarios), 2, figsize=(13, 4.6 * len(scenarios)), squeeze=False)
+    for row, (scenario, (path, terrain)) in enumerate(scenarios.items()):
+        top, bottom = axes[row][0], axes[row][1]
         runs = {label: table for (name, label), table in tables.items() if name == scenario}
         ys = np.concatenate([path.y, *[t["y"].to_numpy() for t in runs.values()]])
         half = max(1.0, 1.5 * float(np.abs(ys).max()))
@@ -40,10 +51,16 @@ def paths_over_terrain(scenarios: dict[str, tuple[Path, Any]],
         grid_x, grid_y = np.meshgrid(x, y)
         height = terrain.height(grid_x, grid_y)
         filled = top.contourf(grid_x, grid_y, height, levels=14, cmap="terrain", alpha=0.8)
-        fig.colorbar(filled, ax=top, label="ground height z [m]", orientation="horizontal", pad=0.15)
+        fig.colorbar(filled, ax=top, label="ground height z [m]", orientation="vertical", fraction=0.04)
         top.plot(path.x, path.y, color="0.3", lw=5, alpha=0.4, label="reference path")
+        soil_map = getattr(terrain, "soil_map", None)
+        if soil_map is not None:  # the second soil: hatched beyond the share's midpoint
+            share = soil_map.share(grid_x, grid_y)
+            top.contourf(grid_x, grid_y, share, levels=[0.5, 1.01], colors="none", hatches=["//"])
+            top.contour(grid_x, grid_y, share, levels=[0.5], colors="k", linewidths=1.0)
+            top.plot([], [], color="k", lw=1.0, label="soil boundary (hatched: the second soil)")
         for label, table in runs.items():
-            name = LABELS[label] if terrain.plane.slope else LABELS[label].replace("downhill pull", "map's pull")
+            name = run_label(scenario, label)
             top.plot(table["x"], table["y"], STYLES[label], color=COLORS[label], label=name)
             bottom.plot(table["s"], 100 * table["cross_track"], STYLES[label], color=COLORS[label], label=name)
         if getattr(terrain, "map", None) is not None:
@@ -58,7 +75,7 @@ def paths_over_terrain(scenarios: dict[str, tuple[Path, Any]],
         bottom.set_title("cross-track error along the path")
         for ax in (top, bottom):
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=8, loc="upper right" if ax is top else "lower left", framealpha=0.9)
+            ax.legend(fontsize=7, loc="upper right" if ax is top else "lower left", framealpha=0.9)
     return png_bytes(fig)
 
 
@@ -81,10 +98,10 @@ def wheels(tables: dict[str, pd.DataFrame], scenario: str) -> bytes:
     axes[-1].set_xlabel("time [s]")
     kinds = {"-": "solid", "--": "dashed", ":": "dotted"}
     crater = scenario == "crater"
-    pull = "map's pull" if crater else "downhill pull"
-    run_names = {label: LABELS[label].split(" (")[0].replace("downhill pull", pull) for label in tables}
+    run_names = {label: run_label(scenario, label).split(" (")[0] for label in tables}
     runs = ", ".join(f"{kinds[STYLES[label]]}: {run_names[label]}" for label in tables)
-    title = "crater" if crater else f"{scenario.replace('_', ' ')} deg"
+    title = {"crater": "crater", "soil_crossing": "soil crossing on a side slope"}.get(
+        scenario, f"{scenario.replace('_', ' ')} deg")
     sides = "1-3 left, 4-6 right (the bowl's side)" if crater else "1-3 left/uphill, 4-6 right/downhill"
     axes[0].set_title(f"{title}: wheels {sides}; front, middle, rear\n{runs}", fontsize=10)
     return png_bytes(fig)
