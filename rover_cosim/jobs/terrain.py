@@ -200,7 +200,7 @@ class Ground:
 
     def label(self) -> str:
         return (self.plane.label() + ("" if self.map is None else f", {self.map.source}")
-                + ("" if self.soil_map is None else f", {self.soil_map.source}"))
+                + ("" if self.soil_map is None else f",\n{self.soil_map.source}"))
 
 
 def traverse_path(length: float = TRAVERSE) -> ReferencePath:
@@ -383,12 +383,13 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
             if scenario == "crater":  # written, then read back: the runs use the file's map
                 files[out / "terrain_crater_heightmap.csv"] = crater_map(crater_scenario).write("")
                 height_map = _read_back(files[out / "terrain_crater_heightmap.csv"])
+                height_map.source = "crater (terrain_crater_heightmap.csv)"
             if scenario == "soil_crossing":  # the same for the soil map
                 path = out / "terrain_soil_crossing_soilmap.csv"
                 files[path] = soil_map_of((choice or choose()).soil, crossing).write("")
                 soil_map = _read_back(files[path], lambda name: SoilMap.read(name, (choice or choose()).soil,
                                                                              choose(soil=crossing.soil_b).soil))
-                soil_map.source = f"{crossing.soil_b} beyond x = {crossing.boundary:g} m ({path.name})"
+                soil_map.source = f"{crossing.soil_b} beyond x = {crossing.boundary:g} m"
                 model_b = identify_second_soil(fmu_dir / "SingleWheel.fmu", soil_map, choice or choose(),
                                                models.model().degree)
                 files[out / "terrain_soil_crossing_model_b.json"] = model_b.to_json()
@@ -467,8 +468,6 @@ def _read_back(text: bytes, reader: Callable[[Path], Any] = HeightMap.read) -> A
         path = Path(folder) / "map.csv"
         path.write_bytes(text)
         read = reader(path)
-    if reader is HeightMap.read:
-        read.source = "crater (terrain_crater_heightmap.csv)"
     return read
 
 
