@@ -19,7 +19,9 @@ from rover_cosim.control.terrain_controller import TerrainPathController
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.jobs.ground import SoilBlock
 from rover_cosim.jobs.terrain import SoilCrossingScenario, run_terrain, traverse_path
-from rover_cosim.terramechanics import PlaneTerrain, Soil
+from rover_cosim.orchestrator.builder import SystemBuilder
+from rover_cosim.orchestrator.master import run
+from rover_cosim.terramechanics import PlaneTerrain, Soil, Wheel, wheel_forces
 from rover_cosim.terramechanics.library import choose, soil_parameters
 from rover_cosim.terramechanics.terrain import SoilMap, soil_boundary
 
@@ -110,6 +112,67 @@ def test_the_wheel_fmu_on_a_share_is_the_wheel_fmu_on_the_blended_soil(fmus):
     soft = _wheel_run(fmus["Wheel"], soil_parameters(SOFT), 0.0)
     for name in ("Fx", "Fy", "sinkage", "omega"):
         np.testing.assert_array_equal(on_b[name], soft[name], err_msg=name)
+
+
+def test_the_reference_wheel_on_the_blended_soil_gives_the_wheel_fmus_forces(fmus):
+    """Cross-check against the numpy reference: Wheel.fmu on a share s of HIT-LSS1 gives, at its own
+    spin and the hub's velocity, terramechanics.wheel_forces on Soil.blend(paper, HIT-LSS1, s):
+    Fx, Fy, Tx within 1e-6 of the largest and the sinkage within 1e-6 relative (the sinkage solve's
+    tolerance); at s = 0.5 the forces differ from the paper soil's by far more."""
+    both = {**soil_parameters(PAPER), **soil_parameters(SOFT, "soilB")}
+    for share in (0.25, 0.5, 0.9):
+        run = _wheel_run(fmus["Wheel"], both, share)
+        blended = PAPER.blend(SOFT, share)
+        expected = wheel_forces(424.0, run["omega"], 0.5, Wheel(), blended, v_lateral=0.02)
+        for name, ours in (("Fx", "Fx"), ("Fy", "Fy"), ("Tx", "Tx")):
+            scale = np.abs(getattr(expected, name)).max()
+            assert np.abs(run[ours] - getattr(expected, name)).max() <= 1e-6 * scale, (name, share)
+        np.testing.assert_allclose(run["sinkage"], expected.sinkage, rtol=1e-6)
+    paper = wheel_forces(424.0, run["omega"], 0.5, Wheel(), PAPER, v_lateral=0.02)
+    assert np.abs(_wheel_run(fmus["Wheel"], both, 0.5)["sinkage"] - paper.sinkage).min() > 1e-3
+
+
+def test_at_rest_on_a_blend_the_wheel_stays_at_rest(fmus):
+    """No torque, no hub motion, a load, half on each soil: the wheel does not start to spin and
+    the soil pushes it nowhere (the static regime on the blended soil)."""
+    names = ["tau", "W", "v_hub", "v_lat", "soilShare"]
+    values = [0.0, 424.0, 0.0, 0.0, 0.5]
+    signal = np.array([(0.0, *values), (1.0, *values)], dtype=[("time", float)] + [(n, float) for n in names])
+    run = simulate_fmu(str(fmus["Wheel"]), stop_time=1.0, step_size=1e-3, output_interval=0.01, input=signal,
+                       start_values={**soil_parameters(PAPER), **soil_parameters(SOFT, "soilB")},
+                       fmi_type="CoSimulation", output=["omega", "Fx", "Fy", "sinkage"])
+    assert np.abs(run["omega"]).max() == 0.0 and np.abs(run["Fx"]).max() == 0.0 and np.abs(run["Fy"]).max() == 0.0
+    assert run["sinkage"].min() > 0.005
+
+
+def test_energy_is_never_created_driving_across_a_soil_boundary(fmus):
+    """The rover driving and turning from the paper's soil onto HIT-LSS1 (the shares given by the soil
+    participant, every wheel crossing): what the soil and the limb dampers take out never falls
+    (beyond 0.1 % of the energy that changed hands): a change of soil under a wheel creates none."""
+    from test_terrain import TURN, _energy
+
+    builder = SystemBuilder("across a boundary").simulation(stop_time=6.0, step=1e-3, algorithm="gauss-seidel")
+    start = {"v": 0.6, **{f"omega[{i}]": 0.6 / Wheel().r for i in WHEELS},
+             **{f"tau[{i}]": 25.0 for i in WHEELS}, **{f"steer[{i}]": TURN[i] for i in WHEELS},
+             **soil_parameters(SOFT, "soilB")}
+    builder.add_fmu("rover", fmus["SteerableRover"], start=start)
+    builder.add_block("soil", SoilBlock("soil", soil_boundary(1.8, PAPER, SOFT, width=0.5)))
+    for name in ("x", "y", "yaw"):
+        builder.connect(f"rover.{name}", f"soil.{name}")
+    for i in WHEELS:
+        builder.connect(f"soil.soilShare[{i}]", f"rover.soilShare[{i}]")
+    names = ("x", "y", "v", "vy", "yawRate", "body.w", "body.p", "body.q", "body.z",
+             *[f"{n}[{i}]" for n in ("omega", "body.deflection", "body.tau", "body.steer") for i in WHEELS])
+    builder.record(*[f"rover.{n}" for n in names], *[f"soil.soilShare[{i}]" for i in WHEELS])
+    data = run(builder.simulation(order=["rover", "soil"]).build()).data
+    table = {"time": data["time"].to_numpy(), **{n: data[f"rover.{n}"].to_numpy() for n in names}}
+    energy, work = _energy(table, PlaneTerrain())
+    dissipated = work - (energy - energy[0])
+    scale = max(np.abs(energy - energy[0]).max(), np.abs(work).max())
+    shares = data[[f"soil.soilShare[{i}]" for i in WHEELS]].to_numpy()
+    assert scale > 100.0 and shares[0].max() == 0.0 and shares[-1].min() == 1.0   # every wheel crossed
+    assert dissipated.min() > -1e-3 * scale
+    assert np.diff(dissipated).min() > -1e-3 * scale
 
 
 @pytest.mark.parametrize("model, variable", [("Wheel", "soilShare"), ("SteerableRover", "soilShare[2]")])

@@ -278,8 +278,9 @@ def _run_name(scenario: str, run: str) -> str:
 
 
 def terrain_section(simulation: Path) -> list[str]:
-    """The steerable rover across side slopes, with and without compensation of the downhill pull."""
-    sections = ["<h2>Terrain: traversing a side slope on loose soil</h2>",
+    """The steerable rover across side slopes, past a crater and from one soil onto another, with and
+    without the controller's knowledge of them."""
+    sections = ["<h2>Terrain: side slopes, a crater and a soil crossing</h2>",
                 ("<p>The steerable rover drives straight along x across a side slope (the valley to its right) "
                  "at 0.3 m/s on the paper's soil, started rolling on the path. Gravity's component down the "
                  "slope, M g sin(slope), pulls the body downhill; only the wheels' lateral forces hold it "
@@ -302,7 +303,8 @@ def terrain_section(simulation: Path) -> list[str]:
                  "the second soil's models for the run (the sweeps on SingleWheel.fmu at the rover's loads) and, "
                  "believing the soil map, uses under each wheel the models of the soil there; the ablation "
                  "keeps the paper soil's models everywhere (the slope still compensated), so it under-steers "
-                 "on the softer soil and the rover drifts downhill until the cross-track feedback holds it.</p>")]
+                 "on the softer soil and the rover drifts downhill until the cross-track feedback holds it (going "
+                 "downhill, its motors then do less work per metre).</p>")]
     metrics, agreement = simulation / "terrain_metrics.csv", simulation / "terrain_agreement.csv"
     if not metrics.exists():
         return [*sections, missing(metrics)]
