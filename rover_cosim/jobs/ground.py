@@ -24,14 +24,20 @@ SIGNALS = ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGra
 
 
 class _HubBlock:
-    """What both blocks share: the hubs in the body frame (limbs 1-3 front, middle, rear on the
-    left at ``y_limb`` [m], 4-6 on the right; ``x_limb`` [m] ahead of the centre of gravity), and
-    outputs that are a function of the inputs now (``values``)."""
+    """What both blocks share: a map (of the class ``map_type``, given as ``map_argument``), the
+    hubs in the body frame (limbs 1-3 front, middle, rear on the left at ``y_limb`` [m], 4-6 on the
+    right; ``x_limb`` [m] ahead of the centre of gravity), and outputs that are a function of the
+    inputs now (``values``)."""
 
-    def __init__(self, name: str, x_limb: tuple[float, float, float], y_limb: float):
+    map_type: type = object
+    map_argument = "map"
+
+    def __init__(self, name: str, the_map: object, x_limb: tuple[float, float, float], y_limb: float):
+        if not isinstance(the_map, self.map_type):
+            raise TypeError(f"block {name!r}: {self.map_argument} = {the_map!r}: expected a {self.map_type.__name__}")
         if not y_limb > 0:
             raise ValueError(f"block {name!r}: y_limb = {y_limb!r} m: expected > 0")
-        self.name = name
+        self.name, self.map = name, the_map
         self.x_hub = np.array([*x_limb, *x_limb], float)
         self.y_hub = np.array([y_limb] * 3 + [-y_limb] * 3, float)
 
@@ -49,12 +55,12 @@ class GroundBlock(_HubBlock):
     """Orchestrator block. Inputs: x, y, yaw, v, vy, yawRate of the body. Outputs per hub i:
     groundHeight[i] [m], groundHeightRate[i] [m/s], groundGradientAlong[i], groundGradientLateral[i] [1]."""
 
+    map_type, map_argument = HeightMap, "height_map"
+
     def __init__(self, name: str, height_map: HeightMap, x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5),
                  y_limb: float = 1.5):
-        if not isinstance(height_map, HeightMap):
-            raise TypeError(f"block {name!r}: height_map = {height_map!r}: expected a HeightMap")
-        super().__init__(name, x_limb, y_limb)
-        self.map = height_map
+        super().__init__(name, height_map, x_limb, y_limb)
+        self.map: HeightMap
         self.inputs: tuple[str, ...] = BODY
         self.outputs: tuple[str, ...] = tuple(f"{s}[{i}]" for s in SIGNALS for i in range(1, WHEELS + 1))
         units = {"groundHeight": "m", "groundHeightRate": "m/s", "groundGradientAlong": "1",
@@ -80,12 +86,12 @@ class SoilBlock(_HubBlock):
     body. Outputs: soilShare[i] [1], the share of the map's second soil under hub i (the input
     ``soilShare`` of SteerableRover, per wheel, or of Wheel i)."""
 
+    map_type, map_argument = SoilMap, "soil_map"
+
     def __init__(self, name: str, soil_map: SoilMap, x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5),
                  y_limb: float = 1.5):
-        if not isinstance(soil_map, SoilMap):
-            raise TypeError(f"block {name!r}: soil_map = {soil_map!r}: expected a SoilMap")
-        super().__init__(name, x_limb, y_limb)
-        self.map = soil_map
+        super().__init__(name, soil_map, x_limb, y_limb)
+        self.map: SoilMap
         self.inputs: tuple[str, ...] = BODY[:3]
         self.outputs: tuple[str, ...] = tuple(f"soilShare[{i}]" for i in range(1, WHEELS + 1))
         self.units = {"x": "m", "y": "m", "yaw": "rad", **{name: "1" for name in self.outputs}}
