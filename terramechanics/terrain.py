@@ -275,7 +275,8 @@ class SoilMap:
     bilinearly: a share stays in [0, 1] and a region of one soil is that soil exactly (a bicubic
     spline, as for heights, rings across a boundary and leaves traces of the other soil metres
     away). The kinks at the grid lines are no events: each wheel's FMU holds its share, an input,
-    over a communication step. Outside the grid the edge's share continues. The file
+    over a communication step. Outside the grid the edge's share continues. The C twins' law:
+    ``soil_map.h`` (the same arithmetic). The file
     (``read``, ``write``): the CSV of ``HeightMap`` with shares for heights; the soils are not in
     it (they are the FMUs' parameters ``soil`` and ``soilB``)."""
 
@@ -290,20 +291,27 @@ class SoilMap:
             j, i = bad[0]
             raise ValueError(f"{source}: share at grid point (row {j + 1}, column {i + 1}) is "
                              f"{float(values[j, i])!r}: expected a share of the second soil in [0, 1]")
-        from scipy.interpolate import RegularGridInterpolator
-
         self.grid = HeightMap(x, y, values, source=source)  # its checks of the grid, and its file
         self.soil, self.soil_b, self.source = soil, soil_b, source
-        self._linear = RegularGridInterpolator((self.grid.y, self.grid.x), self.grid.heights, method="linear")
 
     def share(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
         """The share [1] of ``soil_b`` under the points (x, y) [m]; within 1e-12 of 0 or 1 it is 0 or 1
         (the weights' round-off over a region of one soil: a wheel there is on that soil exactly)."""
         x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
-        grid = self.grid
-        points = np.stack([np.clip(y, grid.y[0], grid.y[-1]), np.clip(x, grid.x[0], grid.x[-1])], axis=-1)
-        share = np.clip(self._linear(points.reshape(-1, 2)), 0.0, 1.0).reshape(x.shape)
+        gx, gy, v = self.grid.x, self.grid.y, self.grid.heights
+        cx, cy = np.clip(x, gx[0], gx[-1]), np.clip(y, gy[0], gy[-1])
+        i = np.clip(np.searchsorted(gx, cx, side="right") - 1, 0, gx.size - 2)
+        j = np.clip(np.searchsorted(gy, cy, side="right") - 1, 0, gy.size - 2)
+        tx, ty = (cx - gx[i]) / (gx[i + 1] - gx[i]), (cy - gy[j]) / (gy[j + 1] - gy[j])
+        share = (1.0 - ty) * ((1.0 - tx) * v[j, i] + tx * v[j, i + 1]) + ty * ((1.0 - tx) * v[j + 1, i]
+                                                                             + tx * v[j + 1, i + 1])
+        share = np.clip(share, 0.0, 1.0)
         return np.where(share < SNAP, 0.0, np.where(share > 1.0 - SNAP, 1.0, share))
+
+    def hub_shares(self, x: float, y: float, yaw: float, x_hub: FloatArray, y_hub: FloatArray) -> FloatArray:
+        """The share [1] under each hub (``hub_positions``) of the body at (x, y) [m] heading
+        ``yaw`` [rad] (the soil participant's outputs; what a controller that believes the map uses)."""
+        return self.share(*hub_positions(x, y, yaw, x_hub, y_hub))
 
     def soil_at(self, x: float, y: float) -> Soil:
         """The soil under the point (x, y) [m]."""

@@ -205,15 +205,18 @@ def test_path_following_with_the_c_twin_is_the_python_path_following(fmu_dir, mo
 
 
 def test_a_change_of_an_included_header_compiles_the_twin_again(tmp_path, monkeypatch):
-    """The cache's digest covers the headers a twin includes (inverse_law.h): an edited law is
-    never served from a library built before the edit."""
+    """The cache's digest covers the headers a twin includes (inverse_law.h, and the soil map's
+    law from the folder beside its own): an edited law is never served from a library built
+    before the edit."""
     from rover_cosim.control import path_controller
 
     monkeypatch.setenv("ROVER_COSIM_CACHE", str(tmp_path / "cache"))
     source = tmp_path / "twin.c"
     source.write_text('#include "law.h"\nint twin_value(void) { return VALUE; }\n')
     (tmp_path / "law.h").write_text("#define VALUE 1\n")
-    assert native.local_headers(path_controller.C_SOURCE) == [path_controller.C_SOURCE.with_name("inverse_law.h")]
+    headers = [path.resolve() for path in native.local_headers(path_controller.C_SOURCE)]
+    assert headers == [path_controller.C_SOURCE.with_name("inverse_law.h").resolve(),
+                       (path_controller.C_SOURCE.parent.parent / "terramechanics" / "soil_map.h").resolve()]
     native.load_library.cache_clear()
     try:
         first = native.load_library(source, ("twin_value",))
@@ -301,3 +304,99 @@ def test_the_twin_takes_the_planes_pull_as_the_terrain_controller_does(model, st
             return 0.01 * np.asarray(x), 0.01 * np.asarray(y)
 
     assert TerrainPathController("ctrl", str(model), ground_map=Bowl()).native() is None
+
+
+# --- the soil map's twins (terramechanics/soil_map.h) -------------------------------------------------
+
+def _soil_maps() -> list[Any]:
+    """A straight boundary, and a grid of random shares on unevenly spaced lines."""
+    from rover_cosim.terramechanics import Soil
+    from rover_cosim.terramechanics.library import choose
+    from rover_cosim.terramechanics.terrain import SoilMap, soil_boundary
+
+    soft = choose(soil="hit_lss1").soil
+    rng = np.random.default_rng(35)
+    uneven = SoilMap(np.linspace(-3, 9, 13) ** 3 / 30, np.linspace(-4, 4, 9) ** 3 / 16, rng.uniform(0, 1, (9, 13)),
+                     Soil(), soft)
+    return [soil_boundary(5.0, Soil(), soft, width=2.0), uneven]
+
+
+def test_the_soil_participants_twin_gives_its_shares_bit_for_bit():
+    """Random poses on and beyond the grids (and a NaN pose): the same shares as the Python block."""
+    from rover_cosim.jobs.ground import SoilBlock
+
+    rng = np.random.default_rng(36)
+    for soil_map in _soil_maps():
+        block = SoilBlock("soil", soil_map)
+        block.start(0.0, np.array([0.0, 0.0, 0.0]))
+        twin = Twin(block, "soil")  # type: ignore[arg-type]
+        poses = np.column_stack([rng.uniform(-12, 40, 5000), rng.uniform(-8, 8, 5000), rng.uniform(-4, 4, 5000)])
+        for k, u in enumerate([*poses, np.array([np.nan, 0.0, 0.0])]):
+            expected, got = block.step(0.0, 1e-3, u), twin.step(0.0, 1e-3, u)
+            assert np.array_equal(expected, got, equal_nan=True), f"{soil_map.source}, pose {k}: {expected} {got}"
+        twin.made.close()
+
+
+@pytest.mark.parametrize("steering", ["inverse", "kinematic"])
+def test_the_twin_believes_a_soil_map_as_the_terrain_controller_does(model, steering):
+    """A controller that believes a soil map (the models of both soils blended under each wheel)
+    on a side slope: its twin's outputs bit for bit, across the boundary and on a random grid."""
+    from test_soil_map import _other_models
+
+    from rover_cosim.control.terrain_controller import TerrainPathController
+    from rover_cosim.identification.model_set import ModelSet
+    from rover_cosim.terramechanics import PlaneTerrain
+
+    models = ModelSet.read(model)
+    rng = np.random.default_rng(37)
+    for boundary, soil_map in zip((True, False), _soil_maps()):
+        block = TerrainPathController("ctrl", models, path="lane_change", steering=steering,
+                                      terrain=PlaneTerrain.side_slope(10.0), soil_map=soil_map,
+                                      model_b=_other_models(models))
+        block.start(0.0, near_the_path(block, 0.0, rng))
+        twin = Twin(block, "path")
+        t, shares = 0.0, set()
+        for k in range(1, 1500):
+            u = near_the_path(block, 0.01 * k, rng)
+            expected, got = block.step(t, 1e-3, u), twin.step(t, 1e-3, u)
+            assert np.array_equal(expected, got), f"{soil_map.source}, step {k}: outputs differ"
+            shares.update(block.shares)
+            t += 1e-3
+        assert len(shares) > 100 and (not boundary or {0.0, 1.0} <= shares)  # each soil and the blends met
+        twin.made.close()
+
+
+@pytest.mark.parametrize("plant", ["inverse", "cosim"])
+def test_the_soil_crossing_with_the_twins_is_the_python_soil_crossing(fmu_dir, model, plant):
+    """The soil crossing's system (the controller believing the map, the soil participant) stepped
+    by the native stepper: every participant native, the recorded frames equal to Python's."""
+    from test_soil_map import PAPER, _other_models
+
+    from rover_cosim.identification.model_set import ModelSet
+    from rover_cosim.jobs.terrain import soil_map_of, traverse_system
+    from rover_cosim.terramechanics import PlaneTerrain
+
+    models = ModelSet.read(model)
+
+    def system(native_stepping: bool) -> System:
+        made = traverse_system(fmu_dir, models, PlaneTerrain.side_slope(10.0), plant, length=3.0,
+                               soil_map=soil_map_of(PAPER, replace_crossing(boundary=1.5)),
+                               model_b=_other_models(models))
+        return short(made, 0.3, native=native_stepping)
+
+    python = run(system(False))
+    ours = system(True)
+    wiring = wire(ours)
+    with participants_of(ours, wiring) as participants:
+        master = make_master(ours, participants, wiring)
+        assert master.all_native  # the controller and the soil participant too
+        master.close()
+    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+
+
+def replace_crossing(**changes: Any) -> Any:
+    from dataclasses import replace
+
+    from rover_cosim.jobs.terrain import SOIL_CROSSING
+
+    return replace(SOIL_CROSSING, **changes)

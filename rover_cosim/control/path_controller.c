@@ -13,8 +13,13 @@
  * TerrainPathController feeds it forward), and per wheel either the steering and wheel-frame forces by
  * the identified lateral and longitudinal models (allocation, then Newton on the steering,
  * _inverse_steering) or the kinematic ablation (_kinematic_steering); the torques by the inverse
- * longitudinal law (inverse_law.h). */
+ * longitudinal law (inverse_law.h).
+ *
+ * Believing a soil map (terrain_controller.py, path_believe): the shares of the second soil under
+ * the hubs (../terramechanics/soil_map.h), and per wheel on a share s > 0 the lateral law and the
+ * torque blended with those of the second soil's models, (1 - s) first + s second. */
 #include "inverse_law.h"
+#include "../terramechanics/soil_map.h"
 
 #define WHEELS 6
 #define N_INPUTS (6 + 2 * WHEELS)
@@ -25,6 +30,14 @@ enum { MASS, YAW_INERTIA, V_TARGET, KV, KP, A_MAX, K_E, K_DE, A_N_MAX, K_PSI, K_
        MAX_STEER, MAX_SLIP_ANGLE, SPACING, LENGTH, WINDOW, PULL, SLOPE, DOWNHILL, GRAVITY, N_SETTINGS };
 enum { RATIONAL, EXPONENTIAL, POLYNOMIAL };
 
+/* A lateral model (identification/lateral.py LateralModel): its basis, the shape of its
+ * coefficients c[i][k][j] (terms x slip powers x load powers) and the basis' scales [rad]. */
+typedef struct {
+    int basis, terms, n_slip, n_load;
+    double *scales;                 /* beta_i [rad] */
+    double *coefficients;           /* c[i][k][j] */
+} Lateral;
+
 typedef struct {
     double settings[N_SETTINGS];
     Law law;
@@ -32,9 +45,12 @@ typedef struct {
     double *arc, *px, *py, *heading, *curvature;   /* per sample: s [m], x, y [m], heading [rad], curvature [1/m] */
     int hint;                       /* the last nearest sample, -1: none yet */
     int ignored;                    /* inputs after the law's that are accepted and not read */
-    int basis, terms, n_slip, n_load;
-    double *scales;                 /* beta_i [rad] */
-    double *lateral;                /* c[i][k][j], terms x n_slip x n_load */
+    Lateral lateral;
+    int believes;                   /* 1: a soil map is believed (the second soil's models below) */
+    Law law_b;
+    Lateral lateral_b;
+    SoilGrid grid;
+    double shares[WHEELS];          /* the second soil's share under each hub this step [1] */
     double x_hub[WHEELS], y_hub[WHEELS];
     double rows[3][2 * WHEELS];     /* the allocation matrix */
     double steer[WHEELS];           /* the last steering [rad] */
@@ -145,18 +161,19 @@ static int share(PathController *c, const double *demand, const double *loads, d
 }
 
 /* LateralModel.angle_coefficients_at: a_i(W, slip) = sum_k sum_j c[i][k][j] slip^k W^j. */
-static void angle_coefficients(const PathController *c, double load, double slip, double *a) {
+static void angle_coefficients(const Lateral *c, double load, double slip, double *a) {
     for (int i = 0; i < c->terms; i++) {
         double total = 0.0;
         for (int k = 0; k < c->n_slip; k++)
             for (int j = 0; j < c->n_load; j++)
-                total += c->lateral[(i * c->n_slip + k) * c->n_load + j] * pow(slip, (double)k) * pow(load, (double)j);
+                total += c->coefficients[(i * c->n_slip + k) * c->n_load + j] * pow(slip, (double)k)
+                         * pow(load, (double)j);
         a[i] = total;
     }
 }
 
 /* LateralModel.fy_and_slope_at (LateralForm.angle_terms): Fy [N] and dFy/dbeta [N/rad]. */
-static void fy_and_slope(const PathController *c, const double *a, double beta, double *fy, double *slope) {
+static void fy_and_slope(const Lateral *c, const double *a, double beta, double *fy, double *slope) {
     double magnitude = fabs(beta);
     double sign = beta > 0 ? 1.0 : beta < 0 ? -1.0 : beta;
     *fy = 0.0;
@@ -186,6 +203,7 @@ static int outputs(PathController *c, double t, int advance, double h) {
     for (int i = 0; i < WHEELS; i++) loads[i] = 1.0 > c->in[6 + i] ? 1.0 : c->in[6 + i];
     /* 1. tracking */
     double x = c->in[0], y = c->in[1], yaw = c->in[2], v = c->in[3], vy = c->in[4], r = c->in[5];
+    if (c->believes) soil_shares(&c->grid, x, y, yaw, c->x_hub, c->y_hub, WHEELS, c->shares);
     Location where = locate(c, x, y);
     double offset = yaw - where.heading;
     double cs = cos(offset), sn = sin(offset);
@@ -214,18 +232,29 @@ static int outputs(PathController *c, double t, int advance, double h) {
             fy_des[i] = 0.0;
         }
     } else {
-        double fx[WHEELS], fy[WHEELS], coefficients[16];
-        if (c->terms > 16) return ERROR;
+        double fx[WHEELS], fy[WHEELS], coefficients[16], coefficients_b[16];
+        if (c->lateral.terms > 16 || (c->believes && c->lateral_b.terms > 16)) return ERROR;
         if (share(c, demand, loads, fx, fy) != OK) return ERROR;
         for (int i = 0; i < WHEELS; i++) {
             double delta = c->steer[i], angle = c->in[6 + WHEELS + i] + c->steer[i], slip;
-            if (slip_for_force(&c->law, loads[i], fx[i] * cos(delta) + fy[i] * sin(delta), &slip) != OK) return ERROR;
-            angle_coefficients(c, loads[i], slip, coefficients);
+            double force = fx[i] * cos(delta) + fy[i] * sin(delta), s = c->believes ? c->shares[i] : 0.0;
+            if (slip_for_force(&c->law, loads[i], force, &slip) != OK) return ERROR;
+            angle_coefficients(&c->lateral, loads[i], slip, coefficients);
+            if (s != 0.0) { /* the second soil's lateral law at its own slip for the force */
+                if (slip_for_force(&c->law_b, loads[i], force, &slip) != OK) return ERROR;
+                angle_coefficients(&c->lateral_b, loads[i], slip, coefficients_b);
+            }
             double low = clip(angle - g[MAX_SLIP_ANGLE], -g[MAX_STEER], INFINITY);
             double high = clip(angle + g[MAX_SLIP_ANGLE], -INFINITY, g[MAX_STEER]);
             for (int k = 0; k < NEWTON_STEPS; k++) {
                 double cd = cos(delta), sd = sin(delta), model_fy, slope;
-                fy_and_slope(c, coefficients, angle - delta, &model_fy, &slope);
+                fy_and_slope(&c->lateral, coefficients, angle - delta, &model_fy, &slope);
+                if (s != 0.0) {
+                    double fy_b, slope_b;
+                    fy_and_slope(&c->lateral_b, coefficients_b, angle - delta, &fy_b, &slope_b);
+                    model_fy = (1.0 - s) * model_fy + s * fy_b;
+                    slope = (1.0 - s) * slope + s * slope_b;
+                }
                 double residual = model_fy - (fy[i] * cd - fx[i] * sd);
                 double derivative = -slope + fx[i] * cd + fy[i] * sd;
                 delta = clip(delta - residual / (fabs(derivative) > 1e-9 ? derivative : 1e-9), low, high);
@@ -236,11 +265,17 @@ static int outputs(PathController *c, double t, int advance, double h) {
             fy_des[i] = fy[i] * cd - fx[i] * sd;
         }
     }
-    double ad[4], bd[2];
+    double ad[4], bd[2], ad_b[4], bd_b[2];
     law_discretisation(&c->law, advance, h, ad, bd);
+    if (c->believes) law_discretisation(&c->law_b, advance, h, ad_b, bd_b);
     for (int i = 0; i < WHEELS; i++) {
         c->steer[i] = steer[i];
         if (law_torque(&c->law, i, loads[i], fx_des[i], advance, ad, bd, &c->out[i]) != OK) return ERROR;
+        if (c->believes) { /* both laws move on; the torque blended where the second soil is believed */
+            double torque_b, s = c->shares[i];
+            if (law_torque(&c->law_b, i, loads[i], fx_des[i], advance, ad_b, bd_b, &torque_b) != OK) return ERROR;
+            if (s != 0.0) c->out[i] = (1.0 - s) * c->out[i] + s * torque_b;
+        }
         c->out[WHEELS + i] = steer[i];
         c->out[2 * WHEELS + i] = fx_des[i];
         c->out[3 * WHEELS + i] = fy_des[i];
@@ -292,7 +327,10 @@ void path_free(void *component) {
     PathController *c = component;
     if (!c) return;
     law_free(&c->law);
-    double *arrays[] = {c->arc, c->px, c->py, c->heading, c->curvature, c->scales, c->lateral};
+    law_free(&c->law_b);
+    soil_grid_free(&c->grid);
+    double *arrays[] = {c->arc, c->px, c->py, c->heading, c->curvature, c->lateral.scales, c->lateral.coefficients,
+                        c->lateral_b.scales, c->lateral_b.coefficients};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) free(arrays[k]);
     free(c);
 }
@@ -317,17 +355,18 @@ void *path_new(const double *settings, int n_loads, int n_torques, int degree, c
     size_t n = (size_t)n_path, size = (size_t)(shape[0] * shape[1] * shape[2]);
     c->n_path = n_path;
     c->hint = hint;
-    c->basis = basis; c->terms = shape[0]; c->n_slip = shape[1]; c->n_load = shape[2];
+    c->lateral.basis = basis; c->lateral.terms = shape[0]; c->lateral.n_slip = shape[1]; c->lateral.n_load = shape[2];
     c->arc = law_copy(path, n);
     c->px = law_copy(path + n, n);
     c->py = law_copy(path + 2 * n, n);
     c->heading = law_copy(path + 3 * n, n);
     c->curvature = law_copy(path + 4 * n, n);
-    c->scales = law_copy(scales, (size_t)shape[0]);
-    c->lateral = law_copy(lateral, size);
+    c->lateral.scales = law_copy(scales, (size_t)shape[0]);
+    c->lateral.coefficients = law_copy(lateral, size);
     if (law_init(&c->law, WHEELS, n_loads, n_torques, degree, settings[WN], settings[STEP], inverse, torques, settled,
                  log_t, coefficients, filter, c->message) != 0
-        || !c->arc || !c->px || !c->py || !c->heading || !c->curvature || !c->scales || !c->lateral) {
+        || !c->arc || !c->px || !c->py || !c->heading || !c->curvature || !c->lateral.scales
+        || !c->lateral.coefficients) {
         path_free(c);
         return NULL;
     }
@@ -340,4 +379,31 @@ void *path_new(const double *settings, int n_loads, int n_torques, int degree, c
         c->rows[2][i] = -c->y_hub[i]; c->rows[2][WHEELS + i] = c->x_hub[i];
     }
     return c;
+}
+
+/* Believe a soil map: the second soil's longitudinal law (its tables as path_new's, with the
+ * filter state of the six wheels) and lateral model (as path_new's), and the map's grid of
+ * ``nx`` x ``ny`` points (``grid_x``, ``grid_y`` [m]; ``share``: row by row along x, one row per
+ * y). All arrays are copied. 0 ok; 3 for bad sizes or out of memory (the message says which). */
+int path_believe(void *component, int n_loads, int n_torques, int degree, const double *inverse,
+                 const double *torques, const double *settled, const double *log_t, const double *coefficients,
+                 const double *filter, int basis, const int *shape, const double *scales, const double *lateral,
+                 int nx, int ny, const double *grid_x, const double *grid_y, const double *share) {
+    PathController *c = component;
+    if (basis < RATIONAL || basis > POLYNOMIAL || shape[0] < 1 || shape[0] > 16 || shape[1] < 1 || shape[2] < 1) {
+        snprintf(c->message, sizeof c->message, "path_believe: bad lateral model");
+        return ERROR;
+    }
+    c->lateral_b.basis = basis; c->lateral_b.terms = shape[0]; c->lateral_b.n_slip = shape[1];
+    c->lateral_b.n_load = shape[2];
+    c->lateral_b.scales = law_copy(scales, (size_t)shape[0]);
+    c->lateral_b.coefficients = law_copy(lateral, (size_t)(shape[0] * shape[1] * shape[2]));
+    if (law_init(&c->law_b, WHEELS, n_loads, n_torques, degree, c->settings[WN], c->settings[STEP], inverse, torques,
+                 settled, log_t, coefficients, filter, c->message) != 0
+        || !c->lateral_b.scales || !c->lateral_b.coefficients || soil_grid_init(&c->grid, nx, ny, grid_x, grid_y, share)) {
+        snprintf(c->message, sizeof c->message, "path_believe: bad sizes or out of memory");
+        return ERROR;
+    }
+    c->believes = 1;
+    return OK;
 }

@@ -24,19 +24,18 @@ the same demands. Where the map believes the first soil (s_i = 0) a wheel's outp
 the controller without the map, bit for bit.
 
 Without a slope, a height map and a soil map the demand, and every output, is the path
-controller's (bit for bit). The path controller's C twin takes the plane's pull too (the same
-arithmetic); over a height map or a soil map the block steps in Python.
+controller's (bit for bit). The path controller's C twin takes the plane's pull and the belief in
+a soil map too (the same arithmetic); over a height map the block steps in Python.
 """
 
 from __future__ import annotations
 
+import ctypes
 import math
 from collections.abc import Callable
 from typing import Any, Protocol
 
 import numpy as np
-
-from rover_cosim.terramechanics.terrain import hub_positions
 
 from .longitudinal import LongitudinalInverse, read_model
 from .path_controller import WHEELS, PathFollowingController
@@ -74,8 +73,9 @@ class GroundMap(Protocol):
 class SoilBelief(Protocol):
     """Where the controller believes the second soil lies (``rover_cosim.terramechanics.terrain.SoilMap``)."""
 
-    def share(self, x: Any, y: Any) -> Any:
-        """The share [1] of the second soil under the points (x, y) [m]."""
+    def hub_shares(self, x: float, y: float, yaw: float, x_hub: Any, y_hub: Any) -> Any:
+        """The share [1] of the second soil under each hub (body frame ``x_hub``, ``y_hub`` [m]) of the
+        body at (x, y) [m] heading ``yaw`` [rad]."""
         ...
 
 
@@ -93,7 +93,7 @@ class TerrainPathController(PathFollowingController):
         if (soil_map is None) != (model_b is None):
             raise ValueError(f"block {name!r}: soil_map = {soil_map!r}, model_b = {model_b!r}: expected both (a "
                              "SoilMap and the models identified on its second soil) or neither")
-        if soil_map is not None and not hasattr(soil_map, "share"):
+        if soil_map is not None and not hasattr(soil_map, "hub_shares"):
             raise TypeError(f"block {name!r}: soil_map = {soil_map!r}: expected a SoilMap or None")
         self.soil_map = soil_map
         self.shares = [0.0] * WHEELS
@@ -127,7 +127,8 @@ class TerrainPathController(PathFollowingController):
         if self.ground_map is not None:
             loads = np.array([max(1.0, float(w)) for w in u[6:6 + WHEELS]])
             cos, sin = math.cos(yaw), math.sin(yaw)
-            gx, gy = self.ground_map.gradient(*hub_positions(x, y, yaw, self.x_hub, self.y_hub))
+            gx, gy = self.ground_map.gradient(x + cos * self.x_hub - sin * self.y_hub,
+                                              y + sin * self.x_hub + cos * self.y_hub)
             hub_x, hub_y = -loads * (gx * cos + gy * sin), -loads * (-gx * sin + gy * cos)
             fx, fy = fx + float(hub_x.sum()), fy + float(hub_y.sum())
             mz = float(np.sum(self.x_hub * hub_y - self.y_hub * hub_x))
@@ -135,8 +136,8 @@ class TerrainPathController(PathFollowingController):
 
     def _tracking(self, t: float, u: Any) -> Any:
         if self.soil_map is not None:  # the soil believed in under each wheel, for this step's laws
-            hubs = hub_positions(float(u[0]), float(u[1]), float(u[2]), self.x_hub, self.y_hub)
-            self.shares = [float(s) for s in self.soil_map.share(*hubs)]
+            shares = self.soil_map.hub_shares(float(u[0]), float(u[1]), float(u[2]), self.x_hub, self.y_hub)
+            self.shares = [float(s) for s in shares]
         demand, along, signals, path = super()._tracking(t, u)
         if self.plain:
             return demand, along, signals, path
@@ -175,10 +176,42 @@ class TerrainPathController(PathFollowingController):
             self.inverse_b.filter_state, self.shares = state[3].copy(), list(state[4])
 
     def native(self) -> Any:
-        """The path controller's C twin, with the plane's pull where the ground is sloped; None over
-        a height map or a soil map (the twin knows neither: the block then steps in Python)."""
-        twin = getattr(super(), "native", None)
-        return twin() if self.ground_map is None and self.soil_map is None and twin is not None else None
+        """The path controller's C twin, with the plane's pull where the ground is sloped and the
+        belief in a soil map (a ``SoilMap``'s grid); None over a height map (the twin knows no
+        map: the block then steps in Python)."""
+        if self.ground_map is not None or (self.soil_map is not None and not hasattr(self.soil_map, "grid")):
+            return None
+        twin = super().native()
+        if twin is None or self.soil_map is None:
+            return twin
+        if self.inverse_b.model.degree not in (1, 2) or self.lateral_b.form.shape()[0] > 16:
+            twin.close()
+            return None
+        library, real, pointer = twin.library, ctypes.c_double, ctypes.c_void_p
+
+        def doubles(values: object) -> ctypes.Array:
+            flat = np.ascontiguousarray(values, dtype=float).ravel()
+            return (real * max(1, flat.size))(*flat.tolist())
+
+        library.path_believe.restype = ctypes.c_int
+        library.path_believe.argtypes = ([pointer] + [ctypes.c_int] * 3 + [pointer] * 6 + [ctypes.c_int, pointer]
+                                         + [pointer] * 2 + [ctypes.c_int] * 2 + [pointer] * 3)
+        table_loads, torques, settled, log_t, coefficients = self.inverse_b.tables()
+        terms, slips, loads_ = self.lateral_b.form.shape()
+        grid = self.soil_map.grid  # a SoilMap (checked above)
+        bases = {"rational": 0, "exponential": 1, "polynomial": 2}
+        status = library.path_believe(
+            twin.component, len(table_loads), len(torques), self.inverse_b.model.degree, doubles(table_loads),
+            doubles(torques), doubles(settled), doubles(log_t), doubles(coefficients),
+            doubles(self.inverse_b.filter_state), bases[self.lateral_b.form.basis],
+            (ctypes.c_int * 3)(terms, slips, loads_), doubles(self.lateral_b.form.scales_rad),
+            doubles(self.lateral_b.coefficients), grid.x.size, grid.y.size, doubles(grid.x), doubles(grid.y),
+            doubles(grid.heights))
+        if status != 0:
+            message = twin.message()
+            twin.close()
+            raise MemoryError(f"block {self.name!r}: its C twin could not take the soil map: {message}")
+        return twin
 
     def _pull_settings(self) -> list[float]:
         if self.terrain is None or self.terrain.level:

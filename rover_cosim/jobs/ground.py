@@ -14,11 +14,17 @@ into the heading frame.
 
 from __future__ import annotations
 
+import ctypes
+from pathlib import Path
+
 import numpy as np
 
+from rover_cosim.orchestrator import native as native_code
 from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, hub_positions
 
 WHEELS = 6
+#: The soil participant's C twin (the law of terramechanics/soil_map.h), for the native stepper.
+SOIL_C_SOURCE = Path(__file__).with_name("soil_block.c")
 BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
 SIGNALS = ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGradientLateral")
 
@@ -45,10 +51,12 @@ class _HubBlock:
         raise NotImplementedError
 
     def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
-        return self.values(u0)
+        self.last = self.values(u0)
+        return self.last
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
-        return self.values(u)
+        self.last = self.values(u)
+        return self.last
 
 
 class GroundBlock(_HubBlock):
@@ -98,6 +106,28 @@ class SoilBlock(_HubBlock):
 
     def shares(self, u: np.ndarray) -> np.ndarray:
         """The outputs for the body pose ``u`` (the inputs)."""
-        return self.map.share(*hub_positions(float(u[0]), float(u[1]), float(u[2]), self.x_hub, self.y_hub))
+        return self.map.hub_shares(float(u[0]), float(u[1]), float(u[2]), self.x_hub, self.y_hub)
 
     values = shares
+
+    def native(self) -> native_code.NativeBlock | None:
+        """The block's C twin (soil_block.c: the same shares, bit for bit) with its outputs now, for
+        the native stepper; None where it cannot be compiled (the block then steps in Python)."""
+        library = native_code.load_library(SOIL_C_SOURCE)
+        if isinstance(library, str):
+            return None
+        real, pointer = ctypes.c_double, ctypes.c_void_p
+
+        def doubles(values: object) -> ctypes.Array:
+            flat = np.ascontiguousarray(values, dtype=float).ravel()
+            return (real * max(1, flat.size))(*flat.tolist())
+
+        library.soil_new.restype = pointer
+        library.soil_new.argtypes = [ctypes.c_int] * 2 + [pointer] * 5
+        grid = self.map.grid
+        component = library.soil_new(grid.x.size, grid.y.size, doubles(grid.x), doubles(grid.y),
+                                     doubles(grid.heights), doubles([self.x_hub, self.y_hub]),
+                                     doubles(getattr(self, "last", np.zeros(WHEELS))))
+        if not component:
+            raise MemoryError(f"block {self.name!r}: its C twin could not be made (out of memory)")
+        return native_code.NativeBlock(library, component, "soil")

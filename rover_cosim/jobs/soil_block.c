@@ -1,0 +1,85 @@
+/* The C twin of the soil participant (ground.py: SoilBlock) for the native stepper
+ * (rover_cosim.orchestrator.native): the law of ../terramechanics/soil_map.h, so that it gives the
+ * Python block's outputs bit for bit (checked by the tests).
+ *
+ * Inputs (value references 0 ..): x, y [m], yaw [rad] of the body. Outputs: soilShare[1..6] [1].
+ * The functions follow fmi2SetReal, fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the
+ * error's text from soil_message). */
+#include <stdio.h>
+
+#include "../terramechanics/soil_map.h"
+
+#define HUBS 6
+#define N_INPUTS 3
+#define OK 0
+#define ERROR 3
+
+typedef struct {
+    SoilGrid grid;
+    double x_hub[HUBS], y_hub[HUBS];
+    double in[N_INPUTS], out[HUBS];
+    char message[128];
+} SoilBlock;
+
+int soil_set_real(void *component, const unsigned int *vr, size_t n, const double *value) {
+    SoilBlock *c = component;
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] >= N_INPUTS) {
+            snprintf(c->message, sizeof c->message, "set_real: no such input");
+            return ERROR;
+        }
+        c->in[vr[k]] = value[k];
+    }
+    return OK;
+}
+
+int soil_get_real(void *component, const unsigned int *vr, size_t n, double *value) {
+    SoilBlock *c = component;
+    for (size_t k = 0; k < n; k++) {
+        if (vr[k] >= HUBS) {
+            snprintf(c->message, sizeof c->message, "get_real: no such output");
+            return ERROR;
+        }
+        value[k] = c->out[vr[k]];
+    }
+    return OK;
+}
+
+/* The outputs are the shares under the hubs at the inputs now (the block has no state). */
+int soil_do_step(void *component, double t, double h, int no_prior_state) {
+    SoilBlock *c = component;
+    (void)t;
+    (void)h;
+    (void)no_prior_state;
+    soil_shares(&c->grid, c->in[0], c->in[1], c->in[2], c->x_hub, c->y_hub, HUBS, c->out);
+    return OK;
+}
+
+const char *soil_message(void *component) { return ((SoilBlock *)component)->message; }
+
+void soil_free(void *component) {
+    SoilBlock *c = component;
+    if (!c) return;
+    soil_grid_free(&c->grid);
+    free(c);
+}
+
+/* A soil block on the grid of ``nx`` x ``ny`` points (``x``, ``y`` [m], ``share``: row by row
+ * along x, one row per y) with its hubs (``hubs``: x[6], then y[6] [m]) and its outputs now
+ * (``start``: the shares at the start). All arrays are copied. NULL for bad sizes or out of
+ * memory. */
+void *soil_new(int nx, int ny, const double *x, const double *y, const double *share, const double *hubs,
+               const double *start) {
+    SoilBlock *c = calloc(1, sizeof *c);
+    if (!c) return NULL;
+    if (soil_grid_init(&c->grid, nx, ny, x, y, share) != 0) {
+        soil_free(c);
+        return NULL;
+    }
+    for (int k = 0; k < HUBS; k++) {
+        c->x_hub[k] = hubs[k];
+        c->y_hub[k] = hubs[HUBS + k];
+        c->out[k] = start[k];
+    }
+    return c;
+}
