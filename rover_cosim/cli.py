@@ -233,6 +233,12 @@ def build_parser() -> argparse.ArgumentParser:
     simulate.add_argument("--record-interval", type=float, default=0.01,
                           help="rows kept in the trajectory files [s] (a whole number of 1 ms steps; default 0.01; "
                           "0.001: every step); metrics and figures use every step")
+    simulate.add_argument("--crossing-soil", default="hit_lss1", metavar="SOIL",
+                          help="the soil crossing's second soil, beyond its boundary: a library name, a TOML file or "
+                          "FILE:NAME (default: hit_lss1)")
+    simulate.add_argument("--crossing-belief", default=None, metavar="SOIL",
+                          help="the second soil the soil crossing's controller believes in (its models are identified "
+                          "on it), e.g. the soil.toml of `rover-cosim estimate-soil` (default: --crossing-soil)")
     simulate.add_argument("-q", "--quiet", action="store_true", help="no progress bars")
     _add_soil_options(simulate)
 
@@ -689,6 +695,20 @@ def _is_fmu(path: Path) -> bool:
         return False
 
 
+def _crossing_soils_known(args: argparse.Namespace) -> bool:
+    """Whether the soil crossing's soils (--crossing-soil, --crossing-belief) are known; else says why."""
+    from rover_cosim.terramechanics.library import choose
+
+    for option, name in (("--crossing-soil", args.crossing_soil), ("--crossing-belief", args.crossing_belief)):
+        try:
+            if name is not None:
+                choose(soil=name)
+        except ValueError as error:
+            print(f"rover-cosim simulate: {option}: {error}", file=sys.stderr)
+            return False
+    return True
+
+
 def _simulate(args: argparse.Namespace) -> int:
     from rover_cosim.common.rows import steps_between_rows
     from rover_cosim.jobs.simulate import STEP
@@ -715,6 +735,8 @@ def _simulate(args: argparse.Namespace) -> int:
     choice = _choice(args, "simulate")
     if choice is None:
         return 2
+    if args.only in (None, "terrain") and not _crossing_soils_known(args):
+        return 2
     try:
         _simulate_runs(args, choice)
     except (SystemFileError, RunError, ValueError) as error:
@@ -729,7 +751,7 @@ def _simulate_runs(args: argparse.Namespace, choice: Any) -> None:
     from rover_cosim.control.adaptive import Calibration
     from rover_cosim.jobs.path_following import run_path_following
     from rover_cosim.jobs.simulate import run_simulation
-    from rover_cosim.jobs.terrain import run_terrain
+    from rover_cosim.jobs.terrain import SoilCrossingScenario, run_terrain
     from rover_cosim.progress import ProgressBar
 
     allow = args.allow_model_mismatch or args.adapt
@@ -748,8 +770,9 @@ def _simulate_runs(args: argparse.Namespace, choice: Any) -> None:
         _print_path(path)
     if args.only in (None, "terrain"):
         bar = ProgressBar("simulate: side-slope traverses", enabled=not args.quiet)
+        crossing = SoilCrossingScenario(soil_b=args.crossing_soil, believed_soil_b=args.crossing_belief)
         terrain = run_terrain(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
-                              progress=bar, record_interval=args.record_interval)
+                              progress=bar, record_interval=args.record_interval, crossing=crossing)
         bar.close()
         _print_terrain(terrain)
 

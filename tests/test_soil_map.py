@@ -291,3 +291,36 @@ def test_crossing_onto_a_softer_soil_the_controller_that_believes_the_map_holds_
     scenario = result.record["parameters"]["scenarios"]["soil_crossing"]
     assert scenario["soil_crossing"]["soil_b"] == "hit_lss1" and scenario["side_slope_deg"] == 10.0
     assert len(result.record["soil_crossing_model_b_sha256"]) == 64
+
+
+def test_the_crossings_controller_believes_the_soil_estimated_from_test_bed_data(fmu_dir, identified, tmp_path):
+    """The soil-estimation issue's route into the crossing: HIT-LSS1 measured on a test bed (1 %
+    noise), its soil estimated from the paper's (``rover-cosim estimate-soil``'s soil.toml), and the
+    controller believing that soil beyond the boundary: its second soil's models identified on the
+    estimate (recorded), the rover held on the path as with the true soil (within 3 cm), and the
+    command line offering it."""
+    import subprocess
+    import sys
+
+    from rover_cosim.jobs.estimate_soil import run_estimate_soil, write_testbed_data
+
+    write_testbed_data(tmp_path / "bed.csv", choose(soil="hit_lss1"), slip_angles_deg=(0.0, 5.0, 10.0),
+                       noise=0.01, seed=35)
+    estimate = run_estimate_soil(tmp_path / "bed.csv", tmp_path / "estimate")
+    believed = tmp_path / "estimate" / "soil.toml"
+    short = SoilCrossingScenario(length=3.5, boundary=2.0, believed_soil_b=str(believed))
+    result = run_terrain(fmu_dir, identified.files[0].parent / "model.json", tmp_path / "run",
+                         scenarios=("soil_crossing",), runs=("inverse",), crossing=short)
+    assert result.metrics.set_index("run").loc["inverse", "cross_track_max_m"] < 0.03
+    record = result.record["parameters"]["scenarios"]["soil_crossing"]["soil_crossing"]
+    assert record["believed_soil_b"] == str(believed)
+    assert record["believed_soil_b_values"]["c"] == pytest.approx(estimate.estimate.soil.c, rel=1e-12)
+    assert record["believed_soil_b_values"]["c"] != SOFT.c          # an estimate, not the truth
+    model_b = ModelSet.read(tmp_path / "run" / "terrain_soil_crossing_model_b.json")
+    assert model_b.details["soil"]["c"] == record["believed_soil_b_values"]["c"]
+    done = subprocess.run([sys.executable, "-P", "-m", "rover_cosim", "simulate", "--only", "terrain", "--out",
+                           str(tmp_path / "cli"), "--fmu-dir", str(fmu_dir), "--model",
+                           str(identified.files[0].parent / "model.json"), "--crossing-belief", "no_such_soil"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "--crossing-belief" in done.stderr and "no_such_soil" in done.stderr
+    assert "Traceback" not in done.stderr and not (tmp_path / "cli" / "terrain.json").exists()

@@ -116,7 +116,13 @@ class SoilCrossingScenario:
     """The soil-crossing scenario: a straight traverse of ``length`` [m] at ``speed`` [m/s] across a
     side slope of ``slope_deg`` [deg], from the run's soil onto ``soil_b`` (a name of the soil
     library) beyond a boundary across the path at x = ``boundary`` [m], the share of ``soil_b``
-    rising over ``width`` [m] (``terramechanics.terrain.soil_boundary``)."""
+    rising over ``width`` [m] (``terramechanics.terrain.soil_boundary``); the controller that
+    believes the map takes ``believed_soil_b`` for the second soil."""
+
+    def believed(self) -> Soil:
+        """The second soil the controller believes in."""
+        return choose(soil=self.believed_soil_b or self.soil_b).soil
+
 
     length: float = 7.0
     speed: float = 0.3
@@ -124,6 +130,10 @@ class SoilCrossingScenario:
     boundary: float = 2.5
     width: float = 0.5
     soil_b: str = "hit_lss1"
+    #: the soil the controller believes lies beyond the boundary, its second soil's models identified
+    #: on it (as ``soil_b``: a library name, a TOML file or FILE:NAME, e.g. the soil.toml of
+    #: ``rover-cosim estimate-soil``); None: the true one, ``soil_b``
+    believed_soil_b: str | None = None
 
 
 SOIL_CROSSING = SoilCrossingScenario()
@@ -169,22 +179,22 @@ def soil_map_of(soil: Soil, crossing: SoilCrossingScenario = SOIL_CROSSING) -> S
     return soil_boundary(crossing.boundary, soil, soil_b, crossing.width, x_span=(-5.0, crossing.length + 5.0))
 
 
-def identify_second_soil(fmu_path: Path, soil_map: SoilMap, choice: Choice, degree: int) -> ModelSet:
-    """The longitudinal (of ``degree``) and lateral models of the map's second soil, identified by
-    the sweeps on ``fmu_path`` (SingleWheel.fmu) around CROSSING_LOADS, as the adaptive controller
-    identifies them on an estimated soil (``identification.online``), in this process."""
+def identify_second_soil(fmu_path: Path, soil: Soil, wheel: Wheel, degree: int) -> ModelSet:
+    """The longitudinal (of ``degree``) and lateral models of ``soil`` (the second soil the controller
+    believes in) and ``wheel``, identified by the sweeps on ``fmu_path`` (SingleWheel.fmu) around
+    CROSSING_LOADS, as the adaptive controller identifies them on an estimated soil
+    (``identification.online``), in this process."""
     import tempfile
 
     loads = sweep_loads(np.array(CROSSING_LOADS))
     with tempfile.TemporaryDirectory(prefix="rover-cosim-soil-b-") as cache:
-        model, _ = identify_on_soil(fmu_path, soil_map.soil_b, choice.wheel, Path(cache), degree,
-                                    SweepPlan(loads=loads))
-        lateral, _ = identify_lateral_on_soil(fmu_path, soil_map.soil_b, choice.wheel, Path(cache), loads)
+        model, _ = identify_on_soil(fmu_path, soil, wheel, Path(cache), degree, SweepPlan(loads=loads))
+        lateral, _ = identify_lateral_on_soil(fmu_path, soil, wheel, Path(cache), loads)
     label = f"degree {degree}"
     return ModelSet(label, {label: model}, lateral, {
         "identified_for": "the soil crossing's second soil (rover-cosim simulate, terrain)",
         "loads_N": list(loads), "fmu": {"path": str(fmu_path), "sha256": file_sha256(fmu_path)},
-        "soil": asdict(soil_map.soil_b), "wheel": asdict(choice.wheel)}, source="terrain_soil_crossing_model_b.json")
+        "soil": asdict(soil), "wheel": asdict(wheel)}, source="terrain_soil_crossing_model_b.json")
 
 
 class Ground:
@@ -367,6 +377,9 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
     fmu_dir = Path(fmu_dir).resolve()
     out = Path(out_dir)
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
+    if "soil_crossing" in scenarios:  # its soils named before anything runs
+        choose(soil=crossing.soil_b)
+        crossing.believed()
     plan = [(s, label) for s in scenarios for label in runs_of(s, runs)]
     speeds = {s: speed_of(s, crater_scenario, crossing) for s in scenarios}
     lengths = {s: _length(s, slope_length, crater_scenario, crossing) for s in scenarios}
@@ -390,8 +403,8 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
                 soil_map = _read_back(files[path], lambda name: SoilMap.read(name, (choice or choose()).soil,
                                                                              choose(soil=crossing.soil_b).soil))
                 soil_map.source = f"{crossing.soil_b} beyond x = {crossing.boundary:g} m"
-                model_b = identify_second_soil(fmu_dir / "SingleWheel.fmu", soil_map, choice or choose(),
-                                               models.model().degree)
+                model_b = identify_second_soil(fmu_dir / "SingleWheel.fmu", crossing.believed(),
+                                               (choice or choose()).wheel, models.model().degree)
                 files[out / "terrain_soil_crossing_model_b.json"] = model_b.to_json()
             grounds[scenario] = Ground(terrain_of(scenario, crossing), height_map, soil_map)
         ground = grounds[scenario]
@@ -457,7 +470,7 @@ def _side_slope(scenario: str, crossing: SoilCrossingScenario = SOIL_CROSSING) -
 def _second_soil(crossing: SoilCrossingScenario) -> dict[str, Any]:
     chosen = choose(soil=crossing.soil_b)
     return {"soil_b_values": asdict(chosen.soil), "soil_b_title": chosen.soil_entry.get("title"),
-            "soil_b_source": chosen.soil_entry.get("source")}
+            "soil_b_source": chosen.soil_entry.get("source"), "believed_soil_b_values": asdict(crossing.believed())}
 
 
 def _read_back(text: bytes, reader: Callable[[Path], Any] = HeightMap.read) -> Any:
