@@ -190,24 +190,51 @@ class HeightMap:
             j, i = bad[0]
             raise ValueError(f"{source}: height at x = {self.x[i]:g} m, y = {self.y[j]:g} m is "
                              f"{float(self.heights[j, i])!r}: expected a finite height in m")
-        self._spline = RectBivariateSpline(self.y, self.x, self.heights, kx=3, ky=3)
+        spline = RectBivariateSpline(self.y, self.x, self.heights, kx=3, ky=3)
+        #: The interpolating spline's knots along y and x and its coefficients c[row along y, column
+        #: along x] (FITPACK's fit, evaluated by ``_evaluate`` and by the C twins' height_map.h).
+        self.knots_y, self.knots_x, flat = (np.asarray(a, float) for a in spline.tck)
+        self.coefficients = flat.reshape(self.knots_y.size - 4, self.knots_x.size - 4)
 
     def _clamped(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
-        x, y = np.asarray(x, float), np.asarray(y, float)
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
         cx, cy = np.clip(x, self.x[0], self.x[-1]), np.clip(y, self.y[0], self.y[-1])
         inside = ((cx == x) & (cy == y)).astype(float)
         return cx, cy, inside
 
+    def _evaluate(self, cx: FloatArray, cy: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """(h, dh/dx, dh/dy) of the spline at the points (cx, cy) inside the grid: the cubic
+        B-spline bases by de Boor's recursion, summed over the 4 x 4 coefficients, row by row, in
+        the order of the C twins (height_map.h), each operation elementwise."""
+        by, dby = _cubic_basis(self.knots_y, cy)
+        bx, dbx = _cubic_basis(self.knots_x, cx)
+        ly = _interval(self.knots_y, cy) - 3
+        lx = _interval(self.knots_x, cx) - 3
+        value = np.zeros(cx.shape)
+        along_x = np.zeros(cx.shape)
+        along_y = np.zeros(cx.shape)
+        for a in range(4):
+            row = np.zeros(cx.shape)
+            row_dx = np.zeros(cx.shape)
+            for b in range(4):
+                c = self.coefficients[ly + a, lx + b]
+                row = row + c * bx[b]
+                row_dx = row_dx + c * dbx[b]
+            value = value + by[a] * row
+            along_x = along_x + by[a] * row_dx
+            along_y = along_y + dby[a] * row
+        return value, along_x, along_y
+
     def height(self, x: ArrayLike, y: ArrayLike) -> FloatArray:
         """Height [m] of the ground above the plane at (x, y) [m]."""
         cx, cy, _ = self._clamped(x, y)
-        return np.asarray(self._spline.ev(cy, cx), float)
+        return self._evaluate(cx, cy)[0]
 
     def gradient(self, x: ArrayLike, y: ArrayLike) -> tuple[FloatArray, FloatArray]:
         """(dh/dx, dh/dy) [1] at (x, y) [m] (0 outside the grid)."""
         cx, cy, inside = self._clamped(x, y)
-        return (np.asarray(self._spline.ev(cy, cx, dy=1), float) * inside,
-                np.asarray(self._spline.ev(cy, cx, dx=1), float) * inside)
+        _, along_x, along_y = self._evaluate(cx, cy)
+        return along_x * inside, along_y * inside
 
     @classmethod
     def read(cls, path: str | Path) -> HeightMap:
@@ -231,6 +258,43 @@ class HeightMap:
         if str(path):
             Path(path).write_bytes(text)
         return text
+
+
+def _interval(knots: FloatArray, u: FloatArray) -> NDArray[np.intp]:
+    """l with knots[l] <= u < knots[l + 1] among the spline's intervals (3 .. len - 5; the last
+    closed on the right)."""
+    return np.clip(np.searchsorted(knots, u, side="right") - 1, 3, knots.size - 5)
+
+
+def _cubic_basis(knots: FloatArray, u: FloatArray) -> tuple[list[FloatArray], list[FloatArray]]:
+    """The four cubic B-splines nonzero at ``u`` (those of indices l - 3 .. l) and their
+    derivatives, by de Boor's recursion from degree 0 (height_map.h computes the same)."""
+    interval = _interval(knots, u)
+    previous = [np.ones(u.shape)]
+    quadratic: list[FloatArray] = previous
+    for degree in (1, 2, 3):
+        current = []
+        for r in range(degree + 1):
+            j = interval - degree + r
+            term = np.zeros(u.shape)
+            if r > 0:
+                term = term + (u - knots[j]) / (knots[j + degree] - knots[j]) * previous[r - 1]
+            if r < degree:
+                term = term + (knots[j + degree + 1] - u) / (knots[j + degree + 1] - knots[j + 1]) * previous[r]
+            current.append(term)
+        if degree == 2:
+            quadratic = current
+        previous = current
+    slopes = []
+    for r in range(4):
+        j = interval - 3 + r
+        slope = np.zeros(u.shape)
+        if r > 0:
+            slope = slope + 3.0 * quadratic[r - 1] / (knots[j + 3] - knots[j])
+        if r < 3:
+            slope = slope - 3.0 * quadratic[r] / (knots[j + 4] - knots[j + 1])
+        slopes.append(slope)
+    return previous, slopes
 
 
 def crater(centre: tuple[float, float] = (6.0, -2.0), depth: float = 0.2, radius: float = 3.0,

@@ -205,8 +205,8 @@ def test_the_terrain_controller_on_level_ground_is_the_path_controller(identifie
     """The same inputs give the same outputs, bit for bit: the path controller and the terrain
     controller on level ground (in any downhill direction) with no map, both steerings; on a 20 deg
     side slope the wheels' lateral demand grows by the downhill pull; over a tilted map by the
-    loads' pull on it; and the C twin (which takes the plane's pull, not a map's) is offered on the
-    slope and not over the map (tests/test_native_blocks.py compares the twin on slopes)."""
+    loads' pull on it; and the C twin is offered on the slope and over the map
+    (tests/test_native_blocks.py compares the twin's outputs)."""
     model = identified.files[0].parent / "model.json"
     options: dict[str, Any] = {"path": traverse_path(5.0), "v_target": 0.3}
     u = np.array([0.1, -0.01, 0.002, 0.3, -0.001, 0.0, *[424.0, 410.0, 430.0, 440.0, 400.0, 420.0], *[0.0] * 6])
@@ -228,10 +228,11 @@ def test_the_terrain_controller_on_level_ground_is_the_path_controller(identifie
     assert 0.95 * pull < (fy_des["map"] - fy_des["none"]).sum() < 1.05 * pull
     on_slope, over_map = blocks["slope"], blocks["map"]
     assert isinstance(on_slope, TerrainPathController) and isinstance(over_map, TerrainPathController)
-    twin = on_slope.native()
-    assert over_map.native() is None and (twin is None or twin.prefix == "path")
-    if twin is not None:
-        twin.close()
+    for block in (on_slope, over_map):
+        twin = block.native()
+        assert twin is None or twin.prefix == "path"
+        if twin is not None:
+            twin.close()
     with pytest.raises(ValueError, match="g = -1.0"):
         TerrainPathController("ctrl", model, g=-1.0, **options)
 

@@ -17,8 +17,11 @@
  *
  * Believing a soil map (terrain_controller.py, path_believe): the shares of the second soil under
  * the hubs (../terramechanics/soil_map.h), and per wheel on a share s > 0 the lateral law and the
- * torque blended with those of the second soil's models, (1 - s) first + s second. */
+ * torque blended with those of the second soil's models, (1 - s) first + s second. Over a height
+ * map (path_ground_map, ../terramechanics/height_map.h): the pull of the loads on the map's local
+ * slopes under the hubs fed forward too (TerrainPathController.ground_pull). */
 #include "inverse_law.h"
+#include "../terramechanics/height_map.h"
 #include "../terramechanics/soil_map.h"
 
 #define WHEELS 6
@@ -50,7 +53,9 @@ typedef struct {
     Law law_b;
     Lateral lateral_b;
     SoilGrid grid;
-    double shares[WHEELS];          /* the second soil's share under each hub this step [1] */
+    double shares[WHEELS];
+    int has_map;                    /* 1: a height map's pull is fed forward (the spline below) */
+    HeightSpline spline;          /* the second soil's share under each hub this step [1] */
     double x_hub[WHEELS], y_hub[WHEELS];
     double rows[3][2 * WHEELS];     /* the allocation matrix */
     double steer[WHEELS];           /* the last steering [rad] */
@@ -214,12 +219,32 @@ static int outputs(PathController *c, double t, int advance, double h) {
                       g[A_N_MAX]);
     double alpha = clip(g[K_PSI] * -offset + g[K_R] * (along * where.curvature - r), -g[ALPHA_MAX], g[ALPHA_MAX]);
     double demand[3] = {g[MASS] * (a_t * cs + a_n * sn), g[MASS] * (-a_t * sn + a_n * cs), g[YAW_INERTIA] * alpha};
-    if (g[PULL] != 0) { /* terrain_controller.py: gravity's pull on a ground plane, held by the wheels */
-        double tangential = g[GRAVITY] * sin(g[SLOPE]);
-        double along_g = tangential * cos(g[DOWNHILL] - yaw), lateral_g = tangential * sin(g[DOWNHILL] - yaw);
-        demand[0] = demand[0] - g[MASS] * along_g;
-        demand[1] = demand[1] - g[MASS] * lateral_g;
-        demand[2] = demand[2] - 0.0;
+    if (g[PULL] != 0 || c->has_map) { /* terrain_controller.py ground_pull: held by the wheels */
+        double pull_x = 0.0, pull_y = 0.0, pull_z = 0.0;
+        if (g[PULL] != 0) { /* gravity's pull on a ground plane */
+            double tangential = g[GRAVITY] * sin(g[SLOPE]);
+            double along_g = tangential * cos(g[DOWNHILL] - yaw), lateral_g = tangential * sin(g[DOWNHILL] - yaw);
+            pull_x = g[MASS] * along_g;
+            pull_y = g[MASS] * lateral_g;
+        }
+        if (c->has_map) { /* the loads' pull on the map's slopes under the hubs */
+            double cm = cos(yaw), sm = sin(yaw), sum_x = 0.0, sum_y = 0.0;
+            for (int i = 0; i < WHEELS; i++) {
+                double height, slope_x, slope_y, w = c->in[6 + i];
+                height_at(&c->spline, x + cm * c->x_hub[i] - sm * c->y_hub[i], y + sm * c->x_hub[i] + cm * c->y_hub[i],
+                          &height, &slope_x, &slope_y);
+                double load = w > 1.0 ? w : 1.0;
+                double hub_x = -load * (slope_x * cm + slope_y * sm), hub_y = -load * (-slope_x * sm + slope_y * cm);
+                sum_x += hub_x;
+                sum_y += hub_y;
+                pull_z += c->x_hub[i] * hub_y - c->y_hub[i] * hub_x;
+            }
+            pull_x = pull_x + sum_x;
+            pull_y = pull_y + sum_y;
+        }
+        demand[0] = demand[0] - pull_x;
+        demand[1] = demand[1] - pull_y;
+        demand[2] = demand[2] - pull_z;
     }
     if (g[KINEMATIC] != 0) {
         double rate = along * where.curvature - g[K_PSI] / g[K_R] * offset - g[K_E] / g[K_DE] * where.cross_track;
@@ -329,6 +354,7 @@ void path_free(void *component) {
     law_free(&c->law);
     law_free(&c->law_b);
     soil_grid_free(&c->grid);
+    height_spline_free(&c->spline);
     double *arrays[] = {c->arc, c->px, c->py, c->heading, c->curvature, c->lateral.scales, c->lateral.coefficients,
                         c->lateral_b.scales, c->lateral_b.coefficients};
     for (size_t k = 0; k < sizeof arrays / sizeof *arrays; k++) free(arrays[k]);
@@ -405,5 +431,19 @@ int path_believe(void *component, int n_loads, int n_torques, int degree, const 
         return ERROR;
     }
     c->believes = 1;
+    return OK;
+}
+
+/* Feed a height map's pull forward: its spline (knots along x and y, coefficients and the grid's
+ * extent x0, x1, y0, y1 [m], as height_map.h's HeightSpline). All arrays are copied. 0 ok; 3 for
+ * bad sizes or out of memory. */
+int path_ground_map(void *component, int n_knots_x, const double *knots_x, int n_knots_y, const double *knots_y,
+                    const double *coefficients, const double *extent) {
+    PathController *c = component;
+    if (height_spline_init(&c->spline, n_knots_x, knots_x, n_knots_y, knots_y, coefficients, extent) != 0) {
+        snprintf(c->message, sizeof c->message, "path_ground_map: bad sizes or out of memory");
+        return ERROR;
+    }
+    c->has_map = 1;
     return OK;
 }

@@ -24,8 +24,8 @@ the same demands. Where the map believes the first soil (s_i = 0) a wheel's outp
 the controller without the map, bit for bit.
 
 Without a slope, a height map and a soil map the demand, and every output, is the path
-controller's (bit for bit). The path controller's C twin takes the plane's pull and the belief in
-a soil map too (the same arithmetic); over a height map the block steps in Python.
+controller's (bit for bit). The path controller's C twin takes the plane's pull, the height map's
+pull and the belief in a soil map too (the same arithmetic).
 """
 
 from __future__ import annotations
@@ -124,14 +124,21 @@ class TerrainPathController(PathFollowingController):
         if self.terrain is not None and not self.terrain.level:
             g_along, g_lateral, _ = self.terrain.gravity(yaw, self.g)
             fx, fy = self.mass * float(g_along), self.mass * float(g_lateral)
-        if self.ground_map is not None:
-            loads = np.array([max(1.0, float(w)) for w in u[6:6 + WHEELS]])
+        if self.ground_map is not None:  # in plain floats, in the order of the C twin
             cos, sin = math.cos(yaw), math.sin(yaw)
             gx, gy = self.ground_map.gradient(x + cos * self.x_hub - sin * self.y_hub,
                                               y + sin * self.x_hub + cos * self.y_hub)
-            hub_x, hub_y = -loads * (gx * cos + gy * sin), -loads * (-gx * sin + gy * cos)
-            fx, fy = fx + float(hub_x.sum()), fy + float(hub_y.sum())
-            mz = float(np.sum(self.x_hub * hub_y - self.y_hub * hub_x))
+            sum_x = sum_y = 0.0
+            for w, slope_x, slope_y, x_hub, y_hub in zip(u[6:6 + WHEELS], np.asarray(gx).tolist(),
+                                                         np.asarray(gy).tolist(), self.x_hub.tolist(),
+                                                         self.y_hub.tolist()):
+                load = max(1.0, float(w))
+                hub_x = -load * (slope_x * cos + slope_y * sin)
+                hub_y = -load * (-slope_x * sin + slope_y * cos)
+                sum_x += hub_x
+                sum_y += hub_y
+                mz += x_hub * hub_y - y_hub * hub_x
+            fx, fy = fx + sum_x, fy + sum_y
         return fx, fy, mz
 
     def _tracking(self, t: float, u: Any) -> Any:
@@ -176,12 +183,15 @@ class TerrainPathController(PathFollowingController):
             self.inverse_b.filter_state, self.shares = state[3].copy(), list(state[4])
 
     def native(self) -> Any:
-        """The path controller's C twin, with the plane's pull where the ground is sloped and the
-        belief in a soil map (a ``SoilMap``'s grid); None over a height map (the twin knows no
-        map: the block then steps in Python)."""
-        if self.ground_map is not None or (self.soil_map is not None and not hasattr(self.soil_map, "grid")):
+        """The path controller's C twin, with the plane's pull where the ground is sloped, the pull
+        of a height map (a ``HeightMap``'s spline) and the belief in a soil map (a ``SoilMap``'s
+        grid); None for maps of other kinds (the block then steps in Python)."""
+        if (self.ground_map is not None and not hasattr(self.ground_map, "knots_x")) or (
+                self.soil_map is not None and not hasattr(self.soil_map, "grid")):
             return None
         twin = super().native()
+        if twin is not None and self.ground_map is not None:
+            self._give_map(twin)
         if twin is None or self.soil_map is None:
             return twin
         if self.inverse_b.model.degree not in (1, 2) or self.lateral_b.form.shape()[0] > 16:
@@ -212,6 +222,26 @@ class TerrainPathController(PathFollowingController):
             twin.close()
             raise MemoryError(f"block {self.name!r}: its C twin could not take the soil map: {message}")
         return twin
+
+    def _give_map(self, twin: Any) -> None:
+        """The height map's spline to the twin (``path_ground_map``)."""
+        spline: Any = self.ground_map  # a HeightMap (native() checked it)
+        pointer = ctypes.c_void_p
+
+        def doubles(values: object) -> ctypes.Array:
+            flat = np.ascontiguousarray(values, dtype=float).ravel()
+            return (ctypes.c_double * max(1, flat.size))(*flat.tolist())
+
+        function = twin.library.path_ground_map
+        function.restype = ctypes.c_int
+        function.argtypes = [pointer, ctypes.c_int, pointer, ctypes.c_int, pointer, pointer, pointer]
+        extent = [spline.x[0], spline.x[-1], spline.y[0], spline.y[-1]]
+        status = function(twin.component, spline.knots_x.size, doubles(spline.knots_x), spline.knots_y.size,
+                          doubles(spline.knots_y), doubles(spline.coefficients), doubles(extent))
+        if status != 0:
+            message = twin.message()
+            twin.close()
+            raise MemoryError(f"block {self.name!r}: its C twin could not take the height map: {message}")
 
     def _pull_settings(self) -> list[float]:
         if self.terrain is None or self.terrain.level:

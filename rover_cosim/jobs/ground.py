@@ -15,7 +15,9 @@ into the heading frame.
 from __future__ import annotations
 
 import ctypes
+import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -23,8 +25,14 @@ from rover_cosim.orchestrator import native as native_code
 from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, hub_positions
 
 WHEELS = 6
-#: The soil participant's C twin (the law of terramechanics/soil_map.h), for the native stepper.
+#: The participants' C twins (the laws of terramechanics/height_map.h, soil_map.h), for the native stepper.
+GROUND_C_SOURCE = Path(__file__).with_name("ground_block.c")
 SOIL_C_SOURCE = Path(__file__).with_name("soil_block.c")
+
+
+def _doubles(values: object) -> ctypes.Array:
+    flat = np.ascontiguousarray(values, dtype=float).ravel()
+    return (ctypes.c_double * max(1, flat.size))(*flat.tolist())
 BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
 SIGNALS = ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGradientLateral")
 
@@ -37,6 +45,7 @@ class _HubBlock:
 
     map_type: type = object
     map_argument = "map"
+    outputs: tuple[str, ...] = ()
 
     def __init__(self, name: str, the_map: object, x_limb: tuple[float, float, float], y_limb: float):
         if not isinstance(the_map, self.map_type):
@@ -49,6 +58,23 @@ class _HubBlock:
 
     def values(self, u: np.ndarray) -> np.ndarray:
         raise NotImplementedError
+
+    def _twin(self, source: Path, prefix: str, map_types: list[Any],
+              *map_arguments: Any) -> native_code.NativeBlock | None:
+        """The C twin ``<prefix>_new(map_arguments..., hubs, outputs now)`` of ``source``; None where
+        it cannot be compiled."""
+        library = native_code.load_library(source)
+        if isinstance(library, str):
+            return None
+        new = getattr(library, f"{prefix}_new")
+        new.restype = ctypes.c_void_p
+        new.argtypes = [*map_types, ctypes.c_void_p, ctypes.c_void_p]
+        now = getattr(self, "last", None)
+        component = new(*map_arguments, _doubles([self.x_hub, self.y_hub]),
+                        _doubles(now if now is not None else np.zeros(len(self.outputs))))
+        if not component:
+            raise MemoryError(f"block {self.name!r}: its C twin could not be made (bad sizes or out of memory)")
+        return native_code.NativeBlock(library, component, prefix)
 
     def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
         self.last = self.values(u0)
@@ -79,7 +105,7 @@ class GroundBlock(_HubBlock):
     def ground(self, u: np.ndarray) -> np.ndarray:
         """The outputs for the body state ``u`` (the inputs)."""
         x, y, yaw, v, vy, r = (float(value) for value in u[:6])
-        cos, sin = np.cos(yaw), np.sin(yaw)
+        cos, sin = math.cos(yaw), math.sin(yaw)
         hx, hy = hub_positions(x, y, yaw, self.x_hub, self.y_hub)
         ux, uy = v - r * self.y_hub, vy + r * self.x_hub          # hub velocities, heading frame
         gx, gy = self.map.gradient(hx, hy)
@@ -87,6 +113,15 @@ class GroundBlock(_HubBlock):
         return np.concatenate([self.map.height(hx, hy), along * ux + lateral * uy, along, lateral])
 
     values = ground
+
+    def native(self) -> native_code.NativeBlock | None:
+        """The block's C twin (ground_block.c: the same outputs, bit for bit) with its outputs now,
+        for the native stepper; None where it cannot be compiled (the block then steps in Python)."""
+        spline = self.map
+        extent = [spline.x[0], spline.x[-1], spline.y[0], spline.y[-1]]
+        return self._twin(GROUND_C_SOURCE, "ground", [ctypes.c_int, ctypes.c_void_p] * 2 + [ctypes.c_void_p] * 2,
+                          spline.knots_x.size, _doubles(spline.knots_x), spline.knots_y.size,
+                          _doubles(spline.knots_y), _doubles(spline.coefficients), _doubles(extent))
 
 
 class SoilBlock(_HubBlock):
@@ -113,21 +148,6 @@ class SoilBlock(_HubBlock):
     def native(self) -> native_code.NativeBlock | None:
         """The block's C twin (soil_block.c: the same shares, bit for bit) with its outputs now, for
         the native stepper; None where it cannot be compiled (the block then steps in Python)."""
-        library = native_code.load_library(SOIL_C_SOURCE)
-        if isinstance(library, str):
-            return None
-        real, pointer = ctypes.c_double, ctypes.c_void_p
-
-        def doubles(values: object) -> ctypes.Array:
-            flat = np.ascontiguousarray(values, dtype=float).ravel()
-            return (real * max(1, flat.size))(*flat.tolist())
-
-        library.soil_new.restype = pointer
-        library.soil_new.argtypes = [ctypes.c_int] * 2 + [pointer] * 5
         grid = self.map.grid
-        component = library.soil_new(grid.x.size, grid.y.size, doubles(grid.x), doubles(grid.y),
-                                     doubles(grid.heights), doubles([self.x_hub, self.y_hub]),
-                                     doubles(getattr(self, "last", np.zeros(WHEELS))))
-        if not component:
-            raise MemoryError(f"block {self.name!r}: its C twin could not be made (out of memory)")
-        return native_code.NativeBlock(library, component, "soil")
+        return self._twin(SOIL_C_SOURCE, "soil", [ctypes.c_int] * 2 + [ctypes.c_void_p] * 3, grid.x.size,
+                          grid.y.size, _doubles(grid.x), _doubles(grid.y), _doubles(grid.heights))
