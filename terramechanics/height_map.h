@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grid_search.h"
+
 typedef struct {
     int n_knots_x, n_knots_y;   /* knots along x and y (>= 8 each) */
     double *knots_x, *knots_y;
@@ -20,20 +22,9 @@ typedef struct {
     double x0, x1, y0, y1;      /* the grid's extent [m] */
 } HeightSpline;
 
-/* np.clip of one value (NaN kept). */
-static double height_clip(double value, double low, double high) {
-    value = value != value ? value : (value > low ? value : low);
-    return value != value ? value : (value < high ? value : high);
-}
-
 /* terrain._interval: l with knots[l] <= u < knots[l + 1], clipped to 3 .. n - 5. */
 static int height_interval(const double *knots, int n, double u) {
-    int low = 0, high = n;
-    while (low < high) {
-        int mid = (low + high) / 2;
-        if (u < knots[mid]) high = mid; else low = mid + 1;
-    }
-    int l = low - 1;
+    int l = grid_bisect_right(knots, n, u) - 1;
     return l < 3 ? 3 : l > n - 5 ? n - 5 : l;
 }
 
@@ -65,7 +56,7 @@ static void height_basis(const double *knots, int n, double u, double *basis, do
 
 /* HeightMap.height and .gradient at (x, y) [m]: h [m], dh/dx, dh/dy [1]. */
 static void height_at(const HeightSpline *s, double x, double y, double *h, double *dhdx, double *dhdy) {
-    double cx = height_clip(x, s->x0, s->x1), cy = height_clip(y, s->y0, s->y1);
+    double cx = grid_clip(x, s->x0, s->x1), cy = grid_clip(y, s->y0, s->y1);
     double inside = (cx == x && cy == y) ? 1.0 : 0.0;
     double by[4], dby[4], bx[4], dbx[4];
     height_basis(s->knots_y, s->n_knots_y, cy, by, dby);

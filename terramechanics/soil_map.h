@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "grid_search.h"
+
 #define SOIL_SNAP 1e-12
 
 typedef struct {
@@ -21,36 +23,20 @@ typedef struct {
     double *share;       /* share[j * nx + i] at (x[i], y[j]) [1] */
 } SoilGrid;
 
-/* np.clip(value, low, high) of one value: minimum(maximum(value, low), high), NaN kept. */
-static double soil_clip(double value, double low, double high) {
-    value = value != value ? value : (value > low ? value : low);
-    return value != value ? value : (value < high ? value : high);
-}
-
-/* np.searchsorted(a, x, side="right"): the first index whose value is > x. */
-static int soil_bisect_right(const double *a, int n, double x) {
-    int low = 0, high = n;
-    while (low < high) {
-        int mid = (low + high) / 2;
-        if (x < a[mid]) high = mid; else low = mid + 1;
-    }
-    return low;
-}
-
 static int soil_cell(const double *axis, int n, double value) {
-    int k = soil_bisect_right(axis, n, value) - 1;
+    int k = grid_bisect_right(axis, n, value) - 1;
     return k < 0 ? 0 : k > n - 2 ? n - 2 : k;
 }
 
 /* SoilMap.share at one point. */
 static double soil_share(const SoilGrid *g, double x, double y) {
-    double cx = soil_clip(x, g->x[0], g->x[g->nx - 1]), cy = soil_clip(y, g->y[0], g->y[g->ny - 1]);
+    double cx = grid_clip(x, g->x[0], g->x[g->nx - 1]), cy = grid_clip(y, g->y[0], g->y[g->ny - 1]);
     int i = soil_cell(g->x, g->nx, cx), j = soil_cell(g->y, g->ny, cy);
     double tx = (cx - g->x[i]) / (g->x[i + 1] - g->x[i]), ty = (cy - g->y[j]) / (g->y[j + 1] - g->y[j]);
     const double *low = g->share + (size_t)j * (size_t)g->nx, *high = low + g->nx;
     double share = (1.0 - ty) * ((1.0 - tx) * low[i] + tx * low[i + 1])
                    + ty * ((1.0 - tx) * high[i] + tx * high[i + 1]);
-    share = soil_clip(share, 0.0, 1.0);
+    share = grid_clip(share, 0.0, 1.0);
     return share < SOIL_SNAP ? 0.0 : share > 1.0 - SOIL_SNAP ? 1.0 : share;
 }
 

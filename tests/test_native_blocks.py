@@ -112,20 +112,26 @@ def short(system: System, stop_time: float, **simulation: Any) -> System:
     return replace_settings(system, stop_time=stop_time, **simulation)
 
 
+def assert_native_is_python(system: Any) -> None:
+    """``system(native)``, a system stepped natively or not: natively every participant is stepped
+    by the native stepper, and the recorded frames equal those stepped in Python, exactly."""
+    python = run(system(False))
+    ours = system(True)
+    wiring = wire(ours)
+    with participants_of(ours, wiring) as participants:
+        master = make_master(ours, participants, wiring)
+        assert master.all_native
+        master.close()
+    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+
+
 @pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
 @pytest.mark.parametrize("plant", [monolithic_system, cosim_system], ids=["Rover.fmu", "co-simulated"])
 def test_the_closed_loop_with_the_c_twin_is_the_python_closed_loop(fmu_dir, model, plant, algorithm):
     def system(native_stepping: bool) -> System:
         return short(plant(fmu_dir, model), 0.4, algorithm=algorithm, native=native_stepping)
 
-    python = run(system(False))
-    ours = system(True)
-    wiring = wire(ours)
-    with participants_of(ours, wiring) as participants:
-        master = make_master(ours, participants, wiring)
-        assert master.all_native  # the controller is stepped by the stepper as well
-        master.close()
-    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+    assert_native_is_python(system)  # the controller is stepped by the stepper as well
 
 
 def test_a_failing_c_twin_is_named_with_its_message(fmu_dir, model):
@@ -194,35 +200,30 @@ def test_path_following_with_the_c_twin_is_the_python_path_following(fmu_dir, mo
                 else path_following.cosim_system(fmu_dir, model, "lane_change", straight=1.0))
         return short(made, 0.3, native=native_stepping)
 
-    python = run(system(False))
-    ours = system(True)
-    wiring = wire(ours)
-    with participants_of(ours, wiring) as participants:
-        master = make_master(ours, participants, wiring)
-        assert master.all_native  # the path controller is stepped by the stepper as well
-        master.close()
-    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+    assert_native_is_python(system)  # the path controller is stepped by the stepper as well
 
 
 def test_a_change_of_an_included_header_compiles_the_twin_again(tmp_path, monkeypatch):
-    """The cache's digest covers the headers a twin includes (inverse_law.h, and the soil map's
-    law from the folder beside its own): an edited law is never served from a library built
-    before the edit."""
+    """The cache's digest covers the headers a twin includes (inverse_law.h, the maps' laws from
+    the folder beside its own, and the header those include): an edited law is never served from
+    a library built before the edit."""
     from rover_cosim.control import path_controller
 
     monkeypatch.setenv("ROVER_COSIM_CACHE", str(tmp_path / "cache"))
     source = tmp_path / "twin.c"
     source.write_text('#include "law.h"\nint twin_value(void) { return VALUE; }\n')
-    (tmp_path / "law.h").write_text("#define VALUE 1\n")
+    (tmp_path / "law.h").write_text('#include "deeper.h"\n')
+    (tmp_path / "deeper.h").write_text("#define VALUE 1\n")
     headers = [path.resolve() for path in native.local_headers(path_controller.C_SOURCE)]
     laws = path_controller.C_SOURCE.parent.parent / "terramechanics"
     assert headers == [path_controller.C_SOURCE.with_name("inverse_law.h").resolve(),
-                       (laws / "height_map.h").resolve(), (laws / "soil_map.h").resolve()]
+                       (laws / "height_map.h").resolve(), (laws / "soil_map.h").resolve(),
+                       (laws / "grid_search.h").resolve()]  # included by the two maps' headers
     native.load_library.cache_clear()
     try:
         first = native.load_library(source, ("twin_value",))
         assert not isinstance(first, str) and first.twin_value() == 1
-        (tmp_path / "law.h").write_text("#define VALUE 2\n")
+        (tmp_path / "deeper.h").write_text("#define VALUE 2\n")  # a header the included one includes
         native.load_library.cache_clear()
         second = native.load_library(source, ("twin_value",))
         assert not isinstance(second, str) and second.twin_value() == 2
@@ -385,14 +386,7 @@ def test_the_soil_crossing_with_the_twins_is_the_python_soil_crossing(fmu_dir, m
                                model_b=_other_models(models))
         return short(made, 0.3, native=native_stepping)
 
-    python = run(system(False))
-    ours = system(True)
-    wiring = wire(ours)
-    with participants_of(ours, wiring) as participants:
-        master = make_master(ours, participants, wiring)
-        assert master.all_native  # the controller and the soil participant too
-        master.close()
-    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+    assert_native_is_python(system)  # the controller and the soil participant too
 
 
 def replace_crossing(**changes: Any) -> Any:
@@ -489,11 +483,4 @@ def test_the_crater_with_the_twins_is_the_python_crater(fmu_dir, model, plant):
         made = traverse_system(fmu_dir, model, PlaneTerrain(), plant, length=3.0, speed=1.0, height_map=height_map)
         return short(made, 0.3, native=native_stepping)
 
-    python = run(system(False))
-    ours = system(True)
-    wiring = wire(ours)
-    with participants_of(ours, wiring) as participants:
-        master = make_master(ours, participants, wiring)
-        assert master.all_native  # the controller and the ground participant too
-        master.close()
-    pd.testing.assert_frame_equal(python.data, run(ours).data, check_exact=True)
+    assert_native_is_python(system)  # the controller and the ground participant too

@@ -110,10 +110,20 @@ def _write_checksum(target: Path) -> None:
 
 
 def local_headers(source: Path) -> list[Path]:
-    """The headers beside ``source`` that it includes with quotes (``#include "name.h"``), which
-    the cached library's digest covers as well."""
-    names = re.findall(r'^\s*#\s*include\s+"([^"]+)"', source.read_text(), flags=re.MULTILINE)
-    return [source.parent / name for name in names if (source.parent / name).is_file()]
+    """The headers that ``source`` includes with quotes (``#include "name.h"``, relative to the
+    including file), and those they include in turn, each once in the order first met: the
+    cached library's digest covers them as well."""
+    found: list[Path] = []
+    pending = [source]
+    while pending:
+        including = pending.pop(0)
+        names = re.findall(r'^\s*#\s*include\s+"([^"]+)"', including.read_text(), flags=re.MULTILINE)
+        for name in names:
+            header = including.parent / name
+            if header.is_file() and header.resolve() not in {h.resolve() for h in found}:
+                found.append(header)
+                pending.append(header)
+    return found
 
 
 @cache

@@ -7,15 +7,12 @@
  * groundGradientAlong[i], then groundGradientLateral[i] [1]. The functions follow fmi2SetReal,
  * fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the error's text from ground_message). */
 #include <math.h>
-#include <stdio.h>
-
+#include "block_io.h"
 #include "../terramechanics/height_map.h"
 
 #define HUBS 6
 #define N_INPUTS 6
 #define N_OUTPUTS (4 * HUBS)
-#define OK 0
-#define ERROR 3
 
 typedef struct {
     HeightSpline spline;
@@ -26,26 +23,12 @@ typedef struct {
 
 int ground_set_real(void *component, const unsigned int *vr, size_t n, const double *value) {
     GroundBlock *c = component;
-    for (size_t k = 0; k < n; k++) {
-        if (vr[k] >= N_INPUTS) {
-            snprintf(c->message, sizeof c->message, "set_real: no such input");
-            return ERROR;
-        }
-        c->in[vr[k]] = value[k];
-    }
-    return OK;
+    return block_set(c->in, N_INPUTS, c->message, sizeof c->message, vr, n, value);
 }
 
 int ground_get_real(void *component, const unsigned int *vr, size_t n, double *value) {
     GroundBlock *c = component;
-    for (size_t k = 0; k < n; k++) {
-        if (vr[k] >= N_OUTPUTS) {
-            snprintf(c->message, sizeof c->message, "get_real: no such output");
-            return ERROR;
-        }
-        value[k] = c->out[vr[k]];
-    }
-    return OK;
+    return block_get(c->out, N_OUTPUTS, c->message, sizeof c->message, vr, n, value);
 }
 
 /* GroundBlock.ground: the outputs at the inputs now (the block has no state). */

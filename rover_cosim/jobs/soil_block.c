@@ -5,14 +5,11 @@
  * Inputs (value references 0 ..): x, y [m], yaw [rad] of the body. Outputs: soilShare[1..6] [1].
  * The functions follow fmi2SetReal, fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the
  * error's text from soil_message). */
-#include <stdio.h>
-
+#include "block_io.h"
 #include "../terramechanics/soil_map.h"
 
 #define HUBS 6
 #define N_INPUTS 3
-#define OK 0
-#define ERROR 3
 
 typedef struct {
     SoilGrid grid;
@@ -23,26 +20,12 @@ typedef struct {
 
 int soil_set_real(void *component, const unsigned int *vr, size_t n, const double *value) {
     SoilBlock *c = component;
-    for (size_t k = 0; k < n; k++) {
-        if (vr[k] >= N_INPUTS) {
-            snprintf(c->message, sizeof c->message, "set_real: no such input");
-            return ERROR;
-        }
-        c->in[vr[k]] = value[k];
-    }
-    return OK;
+    return block_set(c->in, N_INPUTS, c->message, sizeof c->message, vr, n, value);
 }
 
 int soil_get_real(void *component, const unsigned int *vr, size_t n, double *value) {
     SoilBlock *c = component;
-    for (size_t k = 0; k < n; k++) {
-        if (vr[k] >= HUBS) {
-            snprintf(c->message, sizeof c->message, "get_real: no such output");
-            return ERROR;
-        }
-        value[k] = c->out[vr[k]];
-    }
-    return OK;
+    return block_get(c->out, HUBS, c->message, sizeof c->message, vr, n, value);
 }
 
 /* The outputs are the shares under the hubs at the inputs now (the block has no state). */
