@@ -132,6 +132,26 @@ def test_the_reference_wheel_on_the_blended_soil_gives_the_wheel_fmus_forces(fmu
     assert np.abs(_wheel_run(fmus["Wheel"], both, 0.5)["sinkage"] - paper.sinkage).min() > 1e-3
 
 
+def test_on_a_blend_reverse_mirrors_forward(fmus):
+    """Half on each soil, driven backwards (torque, hub speeds and spin negated) the wheel gives the
+    forces of the forward run mirrored (Fx, Tx, Fy, the spin and the signed slip negated, as on one
+    soil: tests/test_fmu_regimes.py) and sinks as deep."""
+    both = {**soil_parameters(PAPER), **soil_parameters(SOFT, "soilB")}
+    names = ["tau", "W", "v_hub", "v_lat", "soilShare"]
+    runs = []
+    for sign in (1.0, -1.0):
+        values = [sign * 30.0, 424.0, sign * 0.5, sign * 0.02, 0.5]
+        signal = np.array([(0.0, *values), (1.0, *values)], dtype=[("time", float)] + [(n, float) for n in names])
+        runs.append(simulate_fmu(str(fmus["Wheel"]), stop_time=1.0, step_size=1e-3, output_interval=0.01,
+                                 input=signal, start_values={"omega": sign * 0.5 / 0.355, **both},
+                                 fmi_type="CoSimulation", output=["Fx", "Fy", "Tx", "slip", "sinkage", "omega"]))
+    forward, backward = runs
+    for name, sign in (("Fx", -1.0), ("Fy", -1.0), ("Tx", -1.0), ("omega", -1.0), ("slip", -1.0), ("sinkage", 1.0)):
+        scale = np.abs(forward[name]).max()
+        np.testing.assert_allclose(backward[name], sign * forward[name], rtol=0, atol=1e-9 * scale, err_msg=name)
+    assert np.abs(forward["Fx"]).max() > 10.0
+
+
 def test_at_rest_on_a_blend_the_wheel_stays_at_rest(fmus):
     """No torque, no hub motion, a load, half on each soil: the wheel does not start to spin and
     the soil pushes it nowhere (the static regime on the blended soil)."""
