@@ -23,7 +23,7 @@ without it (the bowl's slopes a disturbance). The map is written beside the resu
 (``terrain_crater_heightmap.csv``) and read back from there for the runs.
 
 Scenario ``soil_crossing``: the 10 deg side-slope traverse (7 m at 0.3 m/s) from the run's soil
-(the paper's) onto a softer one (``SoilCrossingScenario.soil_b``, HIT-LSS1 of the soil library:
+(the paper's) onto one softer in shear (``SoilCrossingScenario.soil_b``, HIT-LSS1 of the soil library:
 cohesion 0.25 kPa against 0.80, friction angle 31.9 deg against 37.2) beyond a boundary across
 the path at x = 2.5 m, the share of the second soil rising over 0.5 m
 (``terramechanics.terrain.soil_boundary``). The soil map is written beside the results

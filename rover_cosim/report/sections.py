@@ -296,14 +296,14 @@ def terrain_section(simulation: Path) -> list[str]:
                  "pull of the measured loads on the map's slopes under the hubs as a feed-forward; the "
                  "ablation knows only the plane, and the bowl pulls it towards its centre.</p>"),
                 ("<p><b>Soil crossing</b>: the 10° side-slope traverse (7 m at 0.3 m/s) from the paper's soil "
-                 "onto a softer one, HIT-LSS1 of the soil library (cohesion 0.25 kPa against 0.80, friction "
+                 "onto one softer in shear, HIT-LSS1 of the soil library (cohesion 0.25 kPa against 0.80, friction "
                  "angle 31.9° against 37.2°: less lateral force at a slip angle) beyond a boundary across the "
                  "path at x = 2.5 m. A soil participant gives each wheel the share of the second soil under it "
                  "(the wheel's parameters blend from one soil to the other over 0.5 m). The controller identifies "
                  "the second soil's models for the run (the sweeps on SingleWheel.fmu at the rover's loads) and, "
                  "believing the soil map, uses under each wheel the models of the soil there; the ablation "
                  "keeps the paper soil's models everywhere (the slope still compensated), so it under-steers "
-                 "on the softer soil and the rover drifts downhill until the cross-track feedback holds it (going "
+                 "on that soil and the rover drifts downhill until the cross-track feedback holds it (going "
                  "downhill, its motors then do less work per metre).</p>")]
     metrics, agreement = simulation / "terrain_metrics.csv", simulation / "terrain_agreement.csv"
     if not metrics.exists():
