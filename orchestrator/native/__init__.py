@@ -183,6 +183,13 @@ class NativeCalls:
     output_references: list[int]
 
 
+def doubles(values: object) -> ctypes.Array:
+    """``values`` (any array-like) flattened into a C array of doubles for a twin's constructor
+    (one element at least, so that an empty table is still a valid pointer)."""
+    flat = np.ascontiguousarray(values, dtype=float).ravel()
+    return (ctypes.c_double * max(1, flat.size))(*flat.tolist())
+
+
 class NativeBlock:
     """A block's C twin: ``component`` (made by the library) and the library's functions
     ``<prefix>_set_real``, ``<prefix>_get_real``, ``<prefix>_do_step`` (fmi2-shaped: status 0 ok,

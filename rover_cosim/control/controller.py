@@ -26,6 +26,7 @@ import numpy as np
 
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator import native as native_code
+from rover_cosim.orchestrator.native import doubles
 
 from .longitudinal import LongitudinalInverse, read_model
 
@@ -101,11 +102,8 @@ class InverseModelController:
         inverse, model = self.inverse, self.model
         if model.degree not in (1, 2):
             return None  # the Python block reports it
-        real, pointer = ctypes.c_double, ctypes.c_void_p
+        pointer = ctypes.c_void_p
 
-        def doubles(values: object) -> ctypes.Array:
-            flat = np.ascontiguousarray(values, dtype=float).ravel()
-            return (real * max(1, flat.size))(*flat.tolist())
 
         library.controller_new.restype = pointer
         library.controller_new.argtypes = [ctypes.c_int] * 4 + [pointer] * 7

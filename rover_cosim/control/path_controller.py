@@ -36,6 +36,7 @@ import numpy as np
 
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator import native as native_code
+from rover_cosim.orchestrator.native import doubles
 
 from .allocation import allocation_matrix, share
 from .longitudinal import LongitudinalInverse, read_model
@@ -209,11 +210,8 @@ class PathFollowingController:
         terms, slips, loads_ = self.lateral.form.shape()
         if terms > 16:
             return None
-        real, pointer = ctypes.c_double, ctypes.c_void_p
+        pointer = ctypes.c_void_p
 
-        def doubles(values: object) -> ctypes.Array:
-            flat = np.ascontiguousarray(values, dtype=float).ravel()
-            return (real * max(1, flat.size))(*flat.tolist())
 
         library.path_new.restype = pointer
         library.path_new.argtypes = ([pointer] + [ctypes.c_int] * 3 + [pointer] * 6 + [ctypes.c_int, pointer]

@@ -37,6 +37,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from rover_cosim.orchestrator.native import doubles
+
 from .longitudinal import LongitudinalInverse, read_model
 from .path_controller import WHEELS, PathFollowingController
 
@@ -197,11 +199,8 @@ class TerrainPathController(PathFollowingController):
         if self.inverse_b.model.degree not in (1, 2) or self.lateral_b.form.shape()[0] > 16:
             twin.close()
             return None
-        library, real, pointer = twin.library, ctypes.c_double, ctypes.c_void_p
+        library, pointer = twin.library, ctypes.c_void_p
 
-        def doubles(values: object) -> ctypes.Array:
-            flat = np.ascontiguousarray(values, dtype=float).ravel()
-            return (real * max(1, flat.size))(*flat.tolist())
 
         library.path_believe.restype = ctypes.c_int
         library.path_believe.argtypes = ([pointer] + [ctypes.c_int] * 3 + [pointer] * 6 + [ctypes.c_int, pointer]
@@ -228,9 +227,6 @@ class TerrainPathController(PathFollowingController):
         spline: Any = self.ground_map  # a HeightMap (native() checked it)
         pointer = ctypes.c_void_p
 
-        def doubles(values: object) -> ctypes.Array:
-            flat = np.ascontiguousarray(values, dtype=float).ravel()
-            return (ctypes.c_double * max(1, flat.size))(*flat.tolist())
 
         function = twin.library.path_ground_map
         function.restype = ctypes.c_int

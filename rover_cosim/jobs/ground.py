@@ -22,17 +22,13 @@ from typing import Any
 import numpy as np
 
 from rover_cosim.orchestrator import native as native_code
+from rover_cosim.orchestrator.native import doubles
 from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, hub_positions
 
 WHEELS = 6
 #: The participants' C twins (the laws of terramechanics/height_map.h, soil_map.h), for the native stepper.
 GROUND_C_SOURCE = Path(__file__).with_name("ground_block.c")
 SOIL_C_SOURCE = Path(__file__).with_name("soil_block.c")
-
-
-def _doubles(values: object) -> ctypes.Array:
-    flat = np.ascontiguousarray(values, dtype=float).ravel()
-    return (ctypes.c_double * max(1, flat.size))(*flat.tolist())
 BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
 SIGNALS = ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGradientLateral")
 
@@ -70,8 +66,8 @@ class _HubBlock:
         new.restype = ctypes.c_void_p
         new.argtypes = [*map_types, ctypes.c_void_p, ctypes.c_void_p]
         now = getattr(self, "last", None)
-        component = new(*map_arguments, _doubles([self.x_hub, self.y_hub]),
-                        _doubles(now if now is not None else np.zeros(len(self.outputs))))
+        component = new(*map_arguments, doubles([self.x_hub, self.y_hub]),
+                        doubles(now if now is not None else np.zeros(len(self.outputs))))
         if not component:
             raise MemoryError(f"block {self.name!r}: its C twin could not be made (bad sizes or out of memory)")
         return native_code.NativeBlock(library, component, prefix)
@@ -120,8 +116,8 @@ class GroundBlock(_HubBlock):
         spline = self.map
         extent = [spline.x[0], spline.x[-1], spline.y[0], spline.y[-1]]
         return self._twin(GROUND_C_SOURCE, "ground", [ctypes.c_int, ctypes.c_void_p] * 2 + [ctypes.c_void_p] * 2,
-                          spline.knots_x.size, _doubles(spline.knots_x), spline.knots_y.size,
-                          _doubles(spline.knots_y), _doubles(spline.coefficients), _doubles(extent))
+                          spline.knots_x.size, doubles(spline.knots_x), spline.knots_y.size,
+                          doubles(spline.knots_y), doubles(spline.coefficients), doubles(extent))
 
 
 class SoilBlock(_HubBlock):
@@ -150,4 +146,4 @@ class SoilBlock(_HubBlock):
         the native stepper; None where it cannot be compiled (the block then steps in Python)."""
         grid = self.map.grid
         return self._twin(SOIL_C_SOURCE, "soil", [ctypes.c_int] * 2 + [ctypes.c_void_p] * 3, grid.x.size,
-                          grid.y.size, _doubles(grid.x), _doubles(grid.y), _doubles(grid.heights))
+                          grid.y.size, doubles(grid.x), doubles(grid.y), doubles(grid.heights))
