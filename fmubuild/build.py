@@ -41,13 +41,14 @@ from .artifact import (
     input_digest,
     stored_digest,
 )
+from .catalog import fmu_models
 from .omc import build_fmu_omc
 from .platforms import HOST, PLATFORMS, ZIG_FLAGS, host_compiler, host_folder, host_suffix, zig_command, zig_version
 from .platforms import parse as parse_platforms
 
 #: The FMUs ``make fmus`` builds: the classes of the Modelica package's FMU sub-package
-#: (:func:`source.fmu_class`), in its package.order.
-FMU_MODELS = ("SingleWheel", "Rover", "RoverBody", "Wheel", "SteerableRover", "SteerableRoverBody")
+#: (:func:`source.fmu_class`), in its package.order (``catalog.fmu_models``).
+FMU_MODELS = fmu_models()
 
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 FMI3_HEADERS = ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")

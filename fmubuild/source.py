@@ -14,20 +14,9 @@ from pathlib import Path
 
 import pandas as pd
 
-#: The folder that holds the top-level Modelica package (a rumoca source root): ``modelica/`` of
-#: the repository, installed as package data ``rover_cosim/modelica``.
-MODELICA_ROOT = Path(__file__).parent.parent / "modelica"
-#: Name of the top-level Modelica package.
-PACKAGE = "RoverTerramechanics"
-#: Its sub-package of the FMU top levels: the class ``<PACKAGE>.<FMU_PACKAGE>.<name>`` is exported
-#: as ``<name>.fmu`` with the model identifier ``<name>``.
-FMU_PACKAGE = "FMUs"
-
-
-def fmu_class(name: str) -> str:
-    """The qualified Modelica class exported as the FMU ``name`` (``"Wheel"`` ->
-    ``"RoverTerramechanics.FMUs.Wheel"``): the one place that maps an FMU to its class."""
-    return f"{PACKAGE}.{FMU_PACKAGE}.{name}"
+from .catalog import FMU_PACKAGE as FMU_PACKAGE  # noqa: F401 - the package's names, here too
+from .catalog import MODELICA_ROOT, PACKAGE
+from .catalog import fmu_class as fmu_class  # noqa: F401
 
 
 def package_file() -> Path:

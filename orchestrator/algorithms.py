@@ -54,6 +54,12 @@ class Algorithm:
     #: The executors may step its stages on threads or from C (explicit algorithms).
     explicit = True
 
+    @classmethod
+    def of(cls, iteration: Iteration | None = None) -> Algorithm:
+        """The algorithm of a system whose iteration settings are ``iteration`` (only the
+        iterative master has any)."""
+        return cls()
+
     def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
                outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
         """The stages of one communication step, as lists of participant positions."""
@@ -123,6 +129,10 @@ class Iterative(Algorithm):
 
     name = "iterative"
     explicit = False
+
+    @classmethod
+    def of(cls, iteration: Iteration | None = None) -> Algorithm:
+        return cls(iteration)
 
     def __init__(self, iteration: Iteration | None = None):
         self.iteration = iteration or Iteration()
@@ -202,12 +212,13 @@ class Iterative(Algorithm):
                 participant.free_state(state)
 
 
+#: The master algorithms by their name (a system's ``algorithm``; the command line's choices): a
+#: new algorithm is a class above and its entry here.
+ALGORITHMS: dict[str, type[Algorithm]] = {cls.name: cls for cls in (Jacobi, GaussSeidel, Iterative)}
+
+
 def algorithm_of(name: str, iteration: Iteration | None = None) -> Algorithm:
     """The algorithm called ``name`` (a system's ``algorithm``)."""
-    if name == "iterative":
-        return Iterative(iteration)
-    if name == "jacobi":
-        return Jacobi()
-    if name == "gauss-seidel":
-        return GaussSeidel()
-    raise ValueError(f"algorithm {name!r}: expected jacobi, gauss-seidel or iterative")
+    if name not in ALGORITHMS:
+        raise ValueError(f"algorithm {name!r}: expected one of {', '.join(ALGORITHMS)}")
+    return ALGORITHMS[name].of(iteration)

@@ -36,10 +36,10 @@ import fmpy
 
 from rover_cosim.common.units import base_units
 
+from .algorithms import ALGORITHMS
 from .blocks import BLOCK_TYPES, Block
 from .loops import describe, find_loop
 from .model import (
-    ALGORITHMS,
     VARIABLE_TYPES,
     BlockEntry,
     Connection,

@@ -17,7 +17,6 @@ from typing import Any
 
 from .blocks import Block
 
-ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
 #: How an FMU is run: its Co-Simulation interface (it steps itself) or its Model Exchange
 #: interface (the engine integrates it, ``model_exchange``).
 INTERFACES = ("co-simulation", "model-exchange")

@@ -49,10 +49,10 @@ from typing import Any
 
 import tomli_w
 
+from .algorithms import ALGORITHMS
 from .blocks import make_block
 from .builder import SIMULATION_DEFAULTS, SystemBuilder, dependency_graph, optional_inputs
 from .model import (
-    ALGORITHMS,
     INTERFACES,
     BlockEntry,
     Connection,

@@ -209,7 +209,7 @@ def test_simulate_refuses_a_bad_calibration_length(tmp_path):
                            "--out", str(tmp_path / "s"), "--model", str(tmp_path / "none.json")],
                           capture_output=True, text=True, check=False)
     assert done.returncode == 2 and "Traceback" not in done.stderr
-    assert "--calibration 25.0: expected a length in (0, 20) s" in done.stderr
+    assert "--calibration: calibration 25.0 s: expected a length in (0, 20) s" in done.stderr
 
 
 def test_the_path_controller_learns_the_soil_on_the_first_straight(fmu_dir, identified, tmp_path):

@@ -69,9 +69,9 @@ def test_a_python_block_beside_its_system_file_is_found(fmu_dir, fmus, tmp_path,
 
 
 def test_simulate_labels_what_it_prints(simulated, capsys):
-    from rover_cosim.cli import _print_straight
+    from rover_cosim.cli.simulate import print_straight
 
-    _print_straight(simulated)
+    print_straight(simulated)
     out = capsys.readouterr().out
     for label in ("time to reach 0.98 m/s [s]", "final velocity [m/s]", "Rover.fmu", "RoverBody + 6 Wheel",
                   "RMS(Fx - Fx_des), Rover.fmu [N]", "limb"):

@@ -13,6 +13,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -259,14 +260,14 @@ def test_an_import_cut_short_by_a_signal_is_an_interruption_not_a_traceback(monk
         except KeyboardInterrupt as interrupt:
             raise ImportError("initialization failed") from interrupt
 
-    monkeypatch.setitem(cli.COMMANDS, "blocks", import_cut_short)
+    monkeypatch.setitem(cli.COMMANDS, "blocks", replace(cli.COMMANDS["blocks"], run=import_cut_short))
     assert cli.main(["blocks"]) == 130
     assert capsys.readouterr().err == "rover-cosim blocks: interrupted; nothing more written\n"
 
     def import_broken(args):  # noqa: ANN001, ANN202
         raise ImportError("no module named nowhere")
 
-    monkeypatch.setitem(cli.COMMANDS, "blocks", import_broken)
+    monkeypatch.setitem(cli.COMMANDS, "blocks", replace(cli.COMMANDS["blocks"], run=import_broken))
     with pytest.raises(ImportError, match="nowhere"):  # a real import error is not hidden as an interruption
         cli.main(["blocks"])
 

@@ -266,7 +266,7 @@ def test_a_failed_figure_leaves_the_previous_results_whole(tmp_path: Path, monke
 
 
 def test_the_command_lines_channel_names_are_the_readers():
-    from rover_cosim.cli import CHANNEL_NAMES
+    from rover_cosim.cli.testbed_data import CHANNEL_NAMES
     from rover_cosim.identification.testbed_data import CHANNELS
 
     assert CHANNEL_NAMES == tuple(CHANNELS)

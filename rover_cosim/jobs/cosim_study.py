@@ -21,6 +21,7 @@ import pandas as pd
 
 from rover_cosim.common.figures import render
 from rover_cosim.common.outputs import json_bytes, run_record, summary_repr, write_all
+from rover_cosim.orchestrator import algorithms
 from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.examples import example
 from rover_cosim.orchestrator.master import run
@@ -29,7 +30,7 @@ from rover_cosim.orchestrator.system import System, load_system
 from rover_cosim.progress import Stages
 
 STEPS = (1e-3, 2e-3, 5e-3, 10e-3)  # s
-ALGORITHMS = ("jacobi", "gauss-seidel", "iterative")
+ALGORITHMS = tuple(algorithms.ALGORITHMS)  # every master, in the registry's order
 
 
 @dataclass

@@ -52,6 +52,8 @@ def _safe(name: str) -> str:
 def slip_grid(step: float, last: float = 0.9, first: float = 0.0) -> tuple[float, ...]:
     """Slip ratios first, first + step, ..., last [-] (both ends included, the spacing adjusted;
     rounded to 10 decimals). Negative slip: braking."""
+    if step > last - first:
+        raise ValueError(f"slip step={step!r}: expected at most the range's width {last - first:g}")
     count = int(round((last - first) / step)) + 1
     if count > MAX_POINTS:
         raise ValueError(f"slip step {step!r} makes {count:,} slips from {first:g} to {last:g}: more than the "

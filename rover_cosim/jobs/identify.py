@@ -129,6 +129,11 @@ def _lateral_files(out: Path, sweep: SweepOutcome, table: pd.DataFrame, models: 
     }, fit
 
 
+def check_record_interval(record_interval: float, plan: SweepPlan | None = None) -> None:
+    """ValueError unless ``record_interval`` [s] is a whole number of the plan's samples."""
+    steps_between_rows(record_interval, (plan or SweepPlan()).sample_time)
+
+
 def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None = None,
                        lateral_plan: SweepPlan | None = None, workers: int | None = None,
                        scheduler: str | None = None, cache_dir: Path | None = None,
@@ -142,7 +147,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     started = time.perf_counter()
     choice = as_choice(choice)
     plan = replace(plan or SweepPlan(), soil=choice.soil, wheel=choice.wheel)
-    steps_between_rows(record_interval, plan.sample_time)  # a bad interval refused before anything runs
+    check_record_interval(record_interval, plan)  # a bad interval refused before anything runs
     lateral_plan = replace(lateral_plan or LATERAL_PLAN, soil=choice.soil, wheel=choice.wheel)
     cache_dir = cache_dir or out_dir / "cache"
     first, second = len(plan.cases()), len(lateral_plan.cases())

@@ -59,6 +59,12 @@ class SimulationResult:
     rms: dict[str, pd.DataFrame]        # per plant: limb, rms_N (Table 3)
     ablation: pd.DataFrame              # limb, rms_lut_N, rms_fixed_load_N
 
+    def checks_table(self) -> pd.DataFrame:
+        """The checks of each plant (``checks``) by their labels, a column per plant."""
+        plants = {"monolithic": "Rover.fmu", "cosim": "RoverBody + 6 Wheel"}
+        return pd.DataFrame({plants.get(p, p): {CHECKS[k][0]: v for k, v in values.items() if k in CHECKS}
+                             for p, values in self.record["checks"].items()})
+
     def __repr__(self) -> str:
         worst = {plant: f"{float(table['rms_N'].max()):.3g} N" for plant, table in self.rms.items()}
         return summary_repr("SimulationResult", self.files, largest_rms=worst)
@@ -184,6 +190,15 @@ def rms(table: pd.DataFrame) -> pd.DataFrame:
                                    for i in LIMBS]})
 
 
+#: What ``checks`` measures of a run: its key -> (label with unit, format).
+CHECKS = {"time_to_98_percent_s": ("time to reach 0.98 m/s [s]", "{:.2f}"),
+          "max_abs_v_error_after_m_s": ("largest |v - 1 m/s| afterwards [m/s]", "{:.4f}"),
+          "final_v_m_s": ("final velocity [m/s]", "{:.4f}"),
+          "Fz1_min_while_accelerating_N": ("least load, limb 1, accelerating [N]", "{:.1f}"),
+          "Fz3_max_while_accelerating_N": ("largest load, limb 3, accelerating [N]", "{:.1f}"),
+          "Fz_at_start_N": ("load at the start [N]", "{:.1f}")}
+
+
 def checks(table: pd.DataFrame) -> dict[str, Any]:
     v = table["v"].to_numpy()
     reached = np.nonzero(v >= 0.98)[0]
@@ -196,6 +211,15 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
             "Fz1_min_while_accelerating_N": float(fz1.min()) if len(fz1) else None,
             "Fz3_max_while_accelerating_N": float(fz3.max()) if len(fz3) else None,
             "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
+
+
+def check_options(record_interval: float, adapt: Calibration | None = None) -> None:
+    """ValueError naming what of the options the runs cannot take: a record interval that is not a
+    whole number of steps, a calibration that does not end before the run."""
+    steps_between_rows(record_interval, STEP)
+    if adapt is not None and not adapt.duration < STOP_TIME:
+        raise ValueError(f"calibration {adapt.duration!r} s: expected a length in (0, {STOP_TIME:g}) s, shorter than "
+                         f"the {STOP_TIME:g} s run")
 
 
 def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> tuple[ModelSet, str | None]:
@@ -221,7 +245,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     estimated and when it switched in simulation.json's ``adaptation``)."""
     started = time.perf_counter()
     choice = as_choice(choice)
-    steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
+    check_options(record_interval, adapt)  # refused before anything runs
     stages = Stages(progress, 4 if adapt else 3)
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}

@@ -16,6 +16,7 @@ import pandas as pd
 
 from rover_cosim.common.paper import TABLE_3_RMS as PAPER_RMS
 from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.jobs.simulate import CHECKS
 from rover_cosim.terramechanics import Soil, Wheel
 
 from .page import image, missing, provenance, table
@@ -171,13 +172,6 @@ def lateral_section(identification: Path) -> list[str]:
         sections.append(image(identification / name, caption))
     return sections
 
-
-CHECKS = {"time_to_98_percent_s": ("time to reach 0.98 m/s [s]", "{:.2f}"),
-          "max_abs_v_error_after_m_s": ("largest |v - 1 m/s| afterwards [m/s]", "{:.4f}"),
-          "final_v_m_s": ("final velocity [m/s]", "{:.4f}"),
-          "Fz1_min_while_accelerating_N": ("least load, limb 1, accelerating [N]", "{:.1f}"),
-          "Fz3_max_while_accelerating_N": ("largest load, limb 3, accelerating [N]", "{:.1f}"),
-          "Fz_at_start_N": ("load at the start [N]", "{:.1f}")}
 
 
 def closed_loop_section(simulation: Path, paper_soil: bool = True) -> list[str]:

@@ -1,0 +1,86 @@
+"""``rover-cosim identify``: the paper's Sec. 3 on SingleWheel.fmu."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .command import Command
+from .options import add_out, add_quiet, add_soil_options, add_workers, at_least, choice_of, fail, output_folder, path
+
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    add_out(parser, "results/identification")
+    parser.add_argument("--fmu", type=path, default=Path("fmus/SingleWheel.fmu"), help="the test-bed FMU")
+    add_workers(parser)
+    parser.add_argument("--record-interval", type=float, default=0.001,
+                        help="rows kept in runs.csv [s] (a whole number of the sweep's 0.1 ms samples; default "
+                        "0.001; 0.0001: every sample); the fits use every sample")
+    add_soil_options(parser)
+    add_quiet(parser)
+
+
+def is_fmu(fmu: Path) -> bool:
+    """Whether ``fmu`` is an FMU: a zip archive with a modelDescription.xml."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(fmu) as archive:
+            return "modelDescription.xml" in archive.namelist()
+    except (OSError, zipfile.BadZipFile):
+        return False
+
+
+def run(args: argparse.Namespace) -> int:
+    from rover_cosim.jobs.identify import check_record_interval, run_identification
+    from rover_cosim.progress import ProgressBar
+
+    if not output_folder(args.out, "identify", COMMAND.needs_bytes) or (
+            args.cache and not output_folder(args.cache, "identify", 0, "--cache")):
+        return 2
+    if not at_least("identify", ("--workers", args.workers, 1)):
+        return 2
+    try:
+        check_record_interval(args.record_interval)
+    except ValueError as error:
+        fail("identify", f"--record-interval: {error}")
+        return 2
+    if not args.fmu.is_file():
+        fail("identify", f"FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)")
+        return 2
+    if not is_fmu(args.fmu):
+        fail("identify", f"--fmu {args.fmu}: not an FMU (expected a zip archive holding a modelDescription.xml, "
+             "e.g. fmus/SingleWheel.fmu)")
+        return 2
+    choice = choice_of(args, "identify")
+    if choice is None:
+        return 2
+    bar = ProgressBar("sweep", enabled=not args.quiet)
+    try:
+        outcome = run_identification(args.fmu, args.out, workers=args.workers, scheduler=args.scheduler,
+                                     cache_dir=args.cache, progress=bar, choice=choice,
+                                     record_interval=args.record_interval)
+    except (OSError, RuntimeError, ValueError) as error:
+        bar.close()
+        fail("identify", f"{error} (nothing written)")
+        return 1
+    bar.close()
+    for name, sweep in (("sweep", outcome.sweep), ("lateral sweep", outcome.lateral_sweep)):
+        print(f"{name}: {sweep.computed} runs computed, {sweep.cached} from the cache, "
+              f"{len(sweep.failures)} failed, {sweep.wall_seconds:.1f} s")
+    print("Table 1, Fit of Fx [%]:")
+    print(outcome.fit.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
+    print("Lateral model, Fit of Fy [%] (Eq. 15) and largest settled error:")
+    print(outcome.lateral_fit.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
+    for written in outcome.files:
+        print(f"wrote {written}")
+    return 0
+
+
+COMMAND = Command(
+    "identify", help="paper Sec. 3: step-torque sweep on SingleWheel.fmu, LUT and Fx(W, slip) fits, validation at "
+    "275/575/875 N -> results/identification/",
+    summary="Paper Sec. 3: the torque-step sweep on SingleWheel.fmu, the Fx(W, slip) models and Table 1.",
+    examples=("rover-cosim identify --out results/identification",
+              "rover-cosim identify --soil my_soil.toml --out results/my_soil/identification --workers 2"),
+    arguments=arguments, run=run, needs_bytes=80e6)

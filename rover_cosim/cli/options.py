@@ -1,0 +1,228 @@
+"""The argument types and option groups that several commands share, each defined once, and the
+checks of output paths every command makes before its work starts."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+#: Bytes of one file name and of a whole path the file systems take (Linux: NAME_MAX, PATH_MAX).
+NAME_MAX, PATH_MAX = 255, 4096
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Every option's default in its help, unless the help already states it."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if ("default" in text or action.default in (None, argparse.SUPPRESS, False, []) or action.nargs == 0
+                or action.option_strings == []):
+            return text
+        return f"{text} (default: {action.default})"
+
+
+def path_text(text: str) -> str:
+    """A path (or a name standing for one) as given, refused when empty (an empty --out would be
+    the current folder, an empty --soil the paper's) or when the system could not open it for its
+    length: a name of more than NAME_MAX bytes, a path of more than PATH_MAX."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a path or a name (empty)")
+    longest = max((len(os.fsencode(part)) for part in Path(text).parts), default=0)
+    if longest > NAME_MAX or len(os.fsencode(text)) >= PATH_MAX:
+        shown = repr(text) if len(text) <= 60 else f"{text[:40]!r}...{text[-12:]!r} ({len(text)} characters)"
+        raise argparse.ArgumentTypeError(f"{shown}: too long for a file name (expected at most {NAME_MAX} bytes a "
+                                         f"name, {PATH_MAX - 1} a path)")
+    return text
+
+
+def path(text: str) -> Path:
+    """A path option (checked as path_text)."""
+    return Path(path_text(text))
+
+
+def scheduler(text: str) -> str:
+    """A Dask scheduler's address: [PROTOCOL://]HOST:PORT (tcp://10.0.0.5:8786, tls://[::1]:8786)."""
+    import re
+
+    if not re.fullmatch(r"([a-z][a-z0-9+.-]*://)?(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+):\d{1,5}", text):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a Dask scheduler's address, e.g. tcp://host:8786")
+    return text
+
+
+def positive_loads(text: str) -> tuple[float, ...]:
+    """Comma-separated wheel loads [N], each finite and > 0."""
+    try:
+        loads = tuple(float(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"loads={text!r}: expected comma-separated numbers in N, e.g. 100,200") from None
+    bad = [w for w in loads if not (0 < w < float("inf"))]
+    if bad:
+        raise argparse.ArgumentTypeError(f"load={bad[0]!r} N: expected a finite load > 0 N")
+    return loads
+
+
+def numbers(kind: str, low: float, high: float, unit: str) -> Callable[[str], tuple[float, ...]]:
+    """A type of comma-separated numbers in [low, high] (``kind`` names them in messages)."""
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(part) for part in text.split(","))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind}={text!r}: expected comma-separated numbers{unit}") from None
+        bad = [v for v in values if not low <= v <= high]
+        if bad:
+            raise argparse.ArgumentTypeError(f"{kind} {bad[0]!r}: expected a number in [{low:g}, {high:g}]{unit}")
+        return values
+    return parse
+
+
+def figure_formats(text: str) -> tuple[str, ...]:
+    """--figures: comma-separated formats of common.figures.FORMATS."""
+    from rover_cosim.common.figures import FORMATS
+
+    formats = tuple(part.strip().lower() for part in text.split(",") if part.strip())
+    unknown = [f for f in formats if f not in FORMATS]
+    if unknown or not formats:
+        raise argparse.ArgumentTypeError(f"figures={text!r}: expected some of {', '.join(FORMATS)}, comma-separated")
+    return formats
+
+
+def add_soil_options(parser: argparse.ArgumentParser) -> None:
+    """--soil, --wheel and --set: the soil and wheel a command runs on."""
+    parser.add_argument("--soil", type=path_text, default=None, help="soil: a name of the shipped library "
+                        "(rover-cosim soils lists them), a TOML file, or FILE:NAME (default: paper)")
+    parser.add_argument("--wheel", type=path_text, default=None,
+                        help="wheel: a name of the shipped library, a TOML file, or FILE:NAME (default: paper)")
+    parser.add_argument("--set", dest="assignments", action="append", default=[], metavar="KIND.NAME=VALUE",
+                        help="change one value, SI units or *_deg for angles: --set soil.c=500 "
+                        "--set soil.phi_deg=30 --set wheel.b=0.2 (repeatable)")
+
+
+def add_out(parser: argparse.ArgumentParser, default: str, help: str = "output folder") -> None:  # noqa: A002
+    """--out: the command's results folder."""
+    parser.add_argument("--out", type=path, default=Path(default), help=help)
+
+
+def add_fmu_dir(parser: argparse.ArgumentParser, help: str = "where the FMUs are") -> None:  # noqa: A002
+    """--fmu-dir: the folder of the built FMUs."""
+    parser.add_argument("--fmu-dir", type=path, default=Path("fmus"), help=help)
+
+
+def add_model(parser: argparse.ArgumentParser, help: str) -> None:  # noqa: A002
+    """--model: an identified model (model.json)."""
+    parser.add_argument("--model", type=path, default=Path("results/identification/model.json"), help=help)
+
+
+def add_workers(parser: argparse.ArgumentParser) -> None:
+    """--workers, --scheduler and --cache: where a sweep or study runs and what it reuses."""
+    parser.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
+    parser.add_argument("--scheduler", type=scheduler, default=None,
+                        help="run on a Dask cluster, e.g. tcp://host:8786")
+    parser.add_argument("--cache", type=path, default=None, help="run cache (default: <out>/cache)")
+
+
+def add_quiet(parser: argparse.ArgumentParser, help: str = "no progress bar") -> None:  # noqa: A002
+    """-q/--quiet: no progress bar."""
+    parser.add_argument("-q", "--quiet", action="store_true", help=help)
+
+
+def fail(command: str, message: str) -> None:
+    """Say on stderr why ``rover-cosim command`` stops."""
+    print(f"rover-cosim {command}: {message}", file=sys.stderr)
+
+
+def choice_of(args: argparse.Namespace, command: str) -> Any:
+    """The soil and wheel of the command line (terramechanics.library.Choice), or None after saying why not."""
+    from rover_cosim.terramechanics.library import choose
+
+    try:
+        return choose(args.soil, args.wheel, args.assignments)
+    except (ValueError, TypeError) as error:
+        fail(command, str(error))
+        return None
+
+
+def unwritable(target: Path, need_bytes: float = 0) -> str | None:
+    """Why ``target`` (a file to write) cannot be written, or None (common.outputs.output_problem)."""
+    from rover_cosim.common.outputs import output_problem
+
+    return output_problem(target, folder=False, need_bytes=need_bytes)
+
+
+def output_folder(out: Path, command: str, need_bytes: float, option: str = "--out") -> bool:
+    """Whether ``out`` can be an output folder (absent or a writable folder, with room for about
+    ``need_bytes``); else says why."""
+    from rover_cosim.common.outputs import output_problem
+
+    problem = output_problem(out, folder=True, need_bytes=need_bytes)
+    if problem:
+        fail(command, f"{option} {out}: {problem}")
+        return False
+    return True
+
+
+def output_file(target: Path, command: str, need_bytes: float, owns: Callable[[Path], bool], overwrite: bool,
+                option: str) -> bool:
+    """Whether ``target`` (one file) can be written by ``command``: writable, with room, and absent
+    or a previous result of the command (``owns``) unless ``overwrite``; else says why."""
+    problem = unwritable(target, need_bytes) or (None if overwrite else foreign(target, command, owns))
+    if problem:
+        fail(command, f"{option} {target}: {problem}")
+        return False
+    return True
+
+
+def foreign(target: Path, command: str, owns: Callable[[Path], bool]) -> str | None:
+    """Why ``target`` may not be replaced by ``command``'s result without --overwrite (None: it is
+    absent, or a previous result of that command by ``owns``)."""
+    if not target.exists() or target.is_dir():
+        return None
+    try:
+        if owns(target):
+            return None
+    except (OSError, ValueError, KeyError):
+        pass
+    return f"{target} exists and is not a result of rover-cosim {command}: pass --overwrite to replace it"
+
+
+def recorded_by(command: str) -> Callable[[Path], bool]:
+    """``owns`` of a command that writes a JSON record beside its file naming the command."""
+    def owns(target: Path) -> bool:
+        import json
+
+        sidecar = target.with_suffix(".json")
+        return sidecar.is_file() and json.loads(sidecar.read_text()).get("command") == f"rover-cosim {command}"
+    return owns
+
+
+def model_readable(path: Path, command: str) -> bool:
+    """Whether ``path`` is an identified model (read whole, as the command will); else says why."""
+    from rover_cosim.identification.model_set import ModelFileError, ModelSet
+
+    try:
+        ModelSet.read(path)
+    except ModelFileError as error:
+        fail(command, str(error))
+        return False
+    return True
+
+
+def fmu_dir_exists(fmu_dir: Path, command: str) -> bool:
+    """Whether ``fmu_dir`` is a folder; else says to build the FMUs."""
+    if not fmu_dir.is_dir():
+        fail(command, f"--fmu-dir {fmu_dir}: no such folder (build the FMUs with `rover-cosim build-fmus`)")
+        return False
+    return True
+
+
+def at_least(command: str, *options: tuple[str, int | None, int]) -> bool:
+    """Whether each (option, value, least) has value None or >= least; else names the first that has not."""
+    for option, value, least in options:
+        if value is not None and value < least:
+            fail(command, f"{option} {value}: expected >= {least}")
+            return False
+    return True

@@ -1,0 +1,198 @@
+"""``rover-cosim run``: co-simulate a system file, an SSP archive or one FMU."""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from .command import Command
+from .options import add_soil_options, choice_of, fail, foreign, path, path_text, recorded_by, unwritable
+from .systems import EXAMPLES, system_path
+
+
+def _assignment(text: str) -> tuple[str, Any]:
+    """``NAME=VALUE`` of --start: the value as TOML writes it (1.5, 3, true, "text"), else as text."""
+    import tomllib
+
+    name, equals, value = text.partition("=")
+    if not equals or not name.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: expected NAME=VALUE (e.g. h=2.5, on=true, label=\"moon\")")
+    try:
+        return name.strip(), tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        return name.strip(), value.strip()
+
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("system", type=path_text,
+                        help="system file (.toml, or an .ssp archive), one FMU (.fmu: run alone, with its "
+                        "DefaultExperiment unless --stop-time/--step say otherwise), or the name of a shipped "
+                        "example: " + ", ".join(EXAMPLES))
+    parser.add_argument("-o", "--output", type=path, default=None,
+                        help="CSV (full precision) or .parquet to write (default: results/<system name>.csv); a "
+                        ".json sidecar goes beside it")
+    parser.add_argument("--fmu-dir", type=path, default=None,
+                        help="folder for relative FMU paths (default: the system file's folder; fmus/ for examples)")
+    algorithm = parser.add_argument("--algorithm", default=None, help="override the system file's master algorithm")
+    algorithm.choices = _Algorithms()  # after add_argument, which would read them at once
+    parser.add_argument("--step", type=float, default=None, help="override the communication step [s]")
+    parser.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
+    parser.add_argument("--output-interval", type=float, default=None,
+                        help="record a row every so often [s] (a whole number of steps; the last row always)")
+    parser.add_argument("--threads", type=int, default=None,
+                        help="FMUs stepped at the same time (Jacobi; Gauss-Seidel where inputs are ready); "
+                        "default: the system file's, else the number of cores")
+    parser.add_argument("--interface", choices=("co-simulation", "model-exchange"), default=None,
+                        help="one FMU run alone: the interface to run (default: Co-Simulation where it has it; "
+                        "Model Exchange is integrated by CVode)")
+    parser.add_argument("--start", type=_assignment, action="append", metavar="NAME=VALUE",
+                        help="one FMU run alone: a parameter or start value (repeatable; TOML values: 2.5, 3, true, "
+                        "\"text\")")
+    parser.add_argument("--input", type=path, default=None, metavar="CSV",
+                        help="one FMU run alone: input signals, first column time [s], one column per input "
+                        "(continuous Real inputs interpolated, the others held; a repeated time is a step)")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace --output even if it is not a result of rover-cosim run")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_soil_options(parser)
+
+
+class _Algorithms:
+    """The master algorithms' names (orchestrator.algorithms.ALGORITHMS) as argparse's choices, read
+    when they are first asked for: the registry imports the engine, which `rover-cosim --help` need not."""
+
+    def _names(self) -> tuple[str, ...]:
+        from rover_cosim.orchestrator.algorithms import ALGORITHMS
+
+        return tuple(ALGORITHMS)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names()
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names())
+
+
+def _load_system(args: argparse.Namespace, unpack: Path) -> tuple[Any, Path]:
+    """The system of ``rover-cosim run`` with the command line's overrides (SystemFileError if
+    bad); an .ssp archive is unpacked into ``unpack``."""
+    from rover_cosim.orchestrator.builder import replace_settings
+    from rover_cosim.orchestrator.ssp import SspError, load_ssp
+    from rover_cosim.orchestrator.system import SystemFileError, load_system
+
+    system_file, fmu_dir = system_path(args.system, args.fmu_dir)
+    overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
+                                               ("stop_time", args.stop_time), ("threads", args.threads),
+                                               ("output_interval", args.output_interval))
+                 if value is not None}
+    if system_file.suffix.lower() == ".fmu":
+        return _one_fmu(system_file, overrides, args), system_file  # the overrides are its settings
+    given = [flag for flag, value in (("--interface", args.interface), ("--start", args.start),
+                                      ("--input", args.input)) if value]
+    if given:
+        raise SystemFileError(f"{system_file}: {', '.join(given)} apply to one FMU run alone (rover-cosim run "
+                              "model.fmu); a system file gives its FMUs' interface, start values and inputs itself")
+    if system_file.suffix.lower() == ".ssp":
+        try:  # the overrides are settings of the archive's system, checked as its own
+            return load_ssp(system_file, unpack, overrides), system_file
+        except SspError as error:
+            raise SystemFileError(f"{system_file}: {error}") from None
+    system = load_system(system_file, fmu_dir=fmu_dir)
+    if overrides:
+        system = replace_settings(system, name=f"{system_file} (with command-line overrides)", **overrides)
+    return system, system_file
+
+
+def _one_fmu(fmu: Path, settings: dict[str, Any], args: argparse.Namespace) -> Any:
+    """A system of the one FMU ``fmu`` (instance ``model``), every output recorded, the stop time
+    and step from ``settings`` or the FMU's DefaultExperiment, the values of --start and the
+    input file of --input."""
+    from rover_cosim.orchestrator.single import single_fmu_system
+
+    system, notes = single_fmu_system(fmu, settings, interface=args.interface, values=dict(args.start or []),
+                                      input_file=args.input)
+    for note in notes:
+        fail("run", note)
+    return system
+
+
+def run(args: argparse.Namespace) -> int:
+    from rover_cosim.common.scratch import remove_stale_folders, scratch_prefix
+    from rover_cosim.orchestrator.builder import with_parameters
+    from rover_cosim.orchestrator.system import SystemFileError
+    from rover_cosim.terramechanics.library import describe, fmu_parameters
+
+    choice = None
+    if args.soil or args.wheel or args.assignments:
+        choice = choice_of(args, "run")
+        if choice is None:
+            return 2
+    remove_stale_folders()
+    with tempfile.TemporaryDirectory(prefix=scratch_prefix("ssp")) as unpack:
+        try:
+            system, system_file = _load_system(args, Path(unpack))
+        except SystemFileError as error:
+            fail("run", str(error))
+            return 2
+        extra = None
+        if choice is not None:  # the chosen soil and wheel go to every FMU that has them
+            system = with_parameters(system, fmu_parameters(choice.soil, choice.wheel))
+            extra = describe(choice)
+        return _run_system(args, system, system_file, extra)
+
+
+def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra: dict[str, Any] | None) -> int:
+    from rover_cosim.orchestrator.master import RunError
+    from rover_cosim.orchestrator.master import run as run_system
+    from rover_cosim.orchestrator.runs import PartialWriter, sidecar_path, write_run
+    from rover_cosim.progress import ProgressBar
+
+    output = args.output or Path("results") / f"{system_file.stem}.csv"
+    try:
+        sidecar_path(output)
+    except ValueError as error:
+        fail("run", str(error))
+        return 2
+    problem = unwritable(output, _run_bytes(system)) or (None if args.overwrite else foreign(output, "run", OWNS))
+    if problem:  # said before the run, not after it
+        fail("run", f"output {output}: {problem}")
+        return 2
+    bar = ProgressBar(system_file.stem, enabled=not args.quiet)
+    partial = PartialWriter(system, output)
+    try:
+        result = run_system(system, progress=bar, observers=[partial])
+    except RunError as error:
+        bar.close()
+        kept = ""
+        if partial.written:
+            kept = f"; the {len(error.partial)} rows computed before it are in {partial.written[0]} (partial)"
+        fail("run", f"{error} ({output} not written{kept})")
+        return 1
+    bar.close()
+    for written in write_run(system, result, output, extra=extra):
+        print(f"wrote {written}")
+    if result.stopped:
+        print(f"stopped: {result.stopped}")
+    print(f"{result.steps} steps of {system.step:g} s ({system.algorithm}) in {result.wall_seconds:.2f} s")
+    return 0
+
+
+def _run_bytes(system: Any) -> float:
+    """About the bytes of a run's CSV: its rows and recorded columns at ~25 characters a value."""
+    rows = (system.stop_time - system.start_time) / system.step / system.record_every + 2
+    return rows * (len(system.record) + 1) * 25
+
+
+OWNS = recorded_by("run")
+
+COMMAND = Command(
+    "run", help="co-simulate a system file (TOML or SSP) -> CSV + JSON sidecar",
+    summary="Co-simulate a system file, an SSP archive or one FMU; trajectories as CSV (or Parquet) and a JSON "
+    "record.",
+    examples=("rover-cosim run rover_cosim --fmu-dir fmus -o results/rover.csv",
+              "rover-cosim run BouncingBall.fmu --interface model-exchange --stop-time 3 -o ball.csv",
+              "rover-cosim run model.fmu --start gain=2 --input signals.csv -o out.parquet"),
+    arguments=arguments, run=run, owns=OWNS)

@@ -1,0 +1,202 @@
+"""``rover-cosim simulate``: the paper's Sec. 4 closed loop, then the path and terrain scenarios."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from typing import Any
+
+from .command import Command
+from .options import (
+    add_fmu_dir,
+    add_model,
+    add_out,
+    add_quiet,
+    add_soil_options,
+    choice_of,
+    fail,
+    fmu_dir_exists,
+    model_readable,
+    output_folder,
+)
+
+#: The parts of ``simulate`` (--only), in the order they run.
+PARTS = ("straight", "path", "terrain")
+
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    add_out(parser, "results/simulation")
+    add_fmu_dir(parser)
+    add_model(parser, "identified model (from `rover-cosim identify`)")
+    parser.add_argument("--only", choices=PARTS, default=None,
+                        help="only the paper's straight run, only the path following, or only the terrain "
+                             "scenarios (side-slope traverses; default: all three)")
+    parser.add_argument("--allow-model-mismatch", action="store_true",
+                        help="use a model identified on another soil or wheel (refused otherwise; recorded)")
+    parser.add_argument("--adapt", action="store_true",
+                        help="also run the straight run with the adaptive controller: a calibration phase, the "
+                        "soil estimated from the rover's telemetry, the model identified again on SingleWheel.fmu "
+                        "(implies --allow-model-mismatch: the point is a soil the model was not identified on)")
+    parser.add_argument("--calibration", type=float, default=3.0, metavar="SECONDS",
+                        help="with --adapt: the calibration phase's length [s] (default 3)")
+    parser.add_argument("--sinkage-sensor", action="store_true",
+                        help="with --adapt: the rover measures its wheels' sinkage (the estimate uses it)")
+    parser.add_argument("--record-interval", type=float, default=0.01,
+                        help="rows kept in the trajectory files [s] (a whole number of 1 ms steps; default 0.01; "
+                        "0.001: every step); metrics and figures use every step")
+    parser.add_argument("--crossing-soil", default="hit_lss1", metavar="SOIL",
+                        help="the soil crossing's second soil, beyond its boundary: a library name, a TOML file or "
+                        "FILE:NAME (default: hit_lss1)")
+    parser.add_argument("--crossing-belief", default=None, metavar="SOIL",
+                        help="the second soil the soil crossing's controller believes in (its models are identified "
+                        "on it), e.g. the soil.toml of `rover-cosim estimate-soil` (default: --crossing-soil)")
+    add_quiet(parser, "no progress bars")
+    add_soil_options(parser)
+
+
+def _calibration(args: argparse.Namespace) -> Any:
+    """The adaptive run's Calibration of --calibration and --sinkage-sensor (None without --adapt)."""
+    from rover_cosim.control.adaptive import Calibration
+
+    return Calibration(duration=args.calibration, sinkage_sensor=args.sinkage_sensor) if args.adapt else None
+
+
+def _crossing_soils_known(args: argparse.Namespace) -> bool:
+    """Whether the soil crossing's soils (--crossing-soil, --crossing-belief) are known; else says why."""
+    from rover_cosim.terramechanics.library import choose
+
+    for option, name in (("--crossing-soil", args.crossing_soil), ("--crossing-belief", args.crossing_belief)):
+        try:
+            if name is not None:
+                choose(soil=name)
+        except ValueError as error:
+            fail("simulate", f"{option}: {error}")
+            return False
+    return True
+
+
+def run(args: argparse.Namespace) -> int:
+    from rover_cosim.jobs.simulate import check_options
+    from rover_cosim.orchestrator.master import RunError
+    from rover_cosim.orchestrator.system import SystemFileError
+
+    if not output_folder(args.out, "simulate", COMMAND.needs_bytes) or not fmu_dir_exists(args.fmu_dir, "simulate"):
+        return 2
+    try:
+        check_options(args.record_interval)
+    except ValueError as error:
+        fail("simulate", f"--record-interval: {error}")
+        return 2
+    try:
+        calibration = _calibration(args)
+        check_options(args.record_interval, calibration)
+    except ValueError as error:
+        fail("simulate", f"--calibration: {error}")
+        return 2
+    if not model_readable(args.model, "simulate"):
+        return 2
+    choice = choice_of(args, "simulate")
+    if choice is None:
+        return 2
+    if args.only in (None, "terrain") and not _crossing_soils_known(args):
+        return 2
+    try:
+        _runs(args, choice, calibration)
+    except (SystemFileError, RunError, ValueError) as error:
+        fail("simulate", f"{error} (nothing written)")
+        return 1
+    return 0
+
+
+def _runs(args: argparse.Namespace, choice: Any, calibration: Any) -> None:
+    """The runs asked for (``--only``): the paper's straight run, the path following, the terrain
+    scenarios, each writing its files."""
+    from rover_cosim.jobs.path_following import run_path_following
+    from rover_cosim.jobs.simulate import run_simulation
+    from rover_cosim.jobs.terrain import SoilCrossingScenario, run_terrain
+    from rover_cosim.progress import ProgressBar
+
+    allow = args.allow_model_mismatch or args.adapt
+    if args.only in (None, "straight"):
+        bar = ProgressBar("simulate: the paper's straight run", enabled=not args.quiet)
+        straight = run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow,
+                                  progress=bar, record_interval=args.record_interval, adapt=calibration)
+        bar.close()
+        print_straight(straight)
+    if args.only in (None, "path"):
+        bar = ProgressBar("simulate: path following", enabled=not args.quiet)
+        path = run_path_following(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                                  progress=bar, record_interval=args.record_interval)
+        bar.close()
+        _print_path(path)
+    if args.only in (None, "terrain"):
+        bar = ProgressBar("simulate: side-slope traverses", enabled=not args.quiet)
+        crossing = SoilCrossingScenario(soil_b=args.crossing_soil, believed_soil_b=args.crossing_belief)
+        terrain = run_terrain(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                              progress=bar, record_interval=args.record_interval, crossing=crossing)
+        bar.close()
+        _print_terrain(terrain)
+
+
+def _print_files(outcome: Any) -> None:
+    for written in outcome.files:
+        print(f"wrote {written}")
+
+
+def _print_path(outcome: Any) -> None:
+    columns = {"cross_track_rms_m": "cross-track RMS [m]", "cross_track_max_m": "max [m]",
+               "speed_error_max_percent": "speed error [%]"}
+    table = outcome.metrics[["scenario", "run", *columns]].rename(columns=columns)
+    rms = outcome.metrics.filter(like="rms_F")
+    table["largest RMS(Fx - Fx_des) [N]"] = rms.filter(like="rms_Fx").max(axis=1)
+    table["largest RMS(Fy - Fy_des) [N]"] = rms.filter(like="rms_Fy").max(axis=1)
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    _print_files(outcome)
+
+
+def _print_terrain(outcome: Any) -> None:
+    columns = {"side_slope_deg": "side slope [deg]", "cross_track_rms_m": "cross-track RMS [m]",
+               "cross_track_max_m": "max [m]", "heading_error_max_rad": "heading error max [rad]",
+               "energy_per_metre_J_m": "energy [J/m]"}
+    table = outcome.metrics[["scenario", "run", *columns]].rename(columns=columns)
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    _print_files(outcome)
+
+
+def print_straight(outcome: Any) -> None:
+    """What the paper's straight run measured (jobs.simulate.SimulationResult): its checks, Table 3,
+    the adaptive run's estimate, the files."""
+    import pandas as pd
+
+    print("Velocity and loads:")
+    print(outcome.checks_table().to_string(float_format=lambda v: f"{v:.4g}"))
+    table = pd.DataFrame({"limb": outcome.rms["monolithic"]["limb"],
+                          "RMS(Fx - Fx_des), Rover.fmu [N]": outcome.rms["monolithic"]["rms_N"],
+                          "RMS, RoverBody + 6 Wheel [N]": outcome.rms["cosim"]["rms_N"],
+                          "RMS, one model at 424 N [N]": outcome.ablation["rms_fixed_load_N"]})
+    print("Table 3 (limbs 4-6 mirror 1-3):")
+    print(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    adaptation = outcome.record.get("adaptation")
+    if adaptation:
+        soil = adaptation.get("estimated_soil") or {}
+        print(f"Adaptive run: the model switched at {adaptation['switched_at_s']:g} s after "
+              f"{adaptation['samples']} calibration samples ({adaptation['adapt_wall_s']:.1f} s to estimate and "
+              f"identify); estimated c {soil.get('c', float('nan')):.4g} Pa, phi "
+              f"{math.degrees(soil.get('phi', float('nan'))):.3g} deg, k_phi {soil.get('kphi', float('nan')):.4g}, "
+              f"n {soil.get('n', float('nan')):.3g}, k_x {soil.get('kx', float('nan')):.3g} m; largest "
+              f"RMS(Fx - Fx_des) after the calibration {max(adaptation['rms_after_calibration_N']):.3f} N "
+              f"(nominal model: {max(adaptation['rms_after_calibration_nominal_model_N']):.3f} N)")
+    _print_files(outcome)
+
+
+def result_sets(args: argparse.Namespace) -> int | None:
+    """One result set per part run (each writes its files into the folder as one set)."""
+    return 1 if args.only else len(PARTS)
+
+
+COMMAND = Command(
+    "simulate", help="paper Sec. 4: closed-loop rover, 20 s, on Rover.fmu and on RoverBody + 6 Wheel; then the "
+    "steerable rover following a turn and a lane change -> results/simulation/",
+    summary="Paper Sec. 4: the closed-loop rover on Rover.fmu and RoverBody + 6 Wheel, then path following.",
+    examples=("rover-cosim simulate --out results/simulation", "rover-cosim simulate --only straight --quiet"),
+    arguments=arguments, run=run, needs_bytes=60e6, result_sets=result_sets)
