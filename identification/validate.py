@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
 import pandas as pd
 
 from rover_cosim.common.paper import TABLE_1_FIT, TARGET_VELOCITY
@@ -73,7 +72,3 @@ def validate(bed: WheelTestBed, models: dict[str, IdentifiedModel],
             detail.append(entry)
         runs[load] = run
     return Validation(runs, pd.DataFrame(fits), pd.DataFrame(detail))
-
-
-def settled_errors(detail: pd.DataFrame, label: str) -> np.ndarray:
-    return (detail[f"Fx_{label}_N"] - detail["Fx_plant_N"]).to_numpy()

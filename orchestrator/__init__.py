@@ -11,7 +11,8 @@ The system model (data):
 
 Running it:
 - ``blocks``: Python blocks (sources; the protocol user blocks follow);
-- ``participants``: the participant protocol and its two kinds, FMU (FMPy's FMI 2.0 slave) and
+- ``participants``: the participant protocol and its two kinds, FMU (FMPy's FMI 2.0 and 3.0 Co-Simulation
+  and Model Exchange instances) and
   Python block; ``unpacking``: each run's temporary folder of unpacked FMUs;
 - ``wiring``: slots of the value vector, which participant reads what;
 - ``algorithms``: Jacobi, Gauss-Seidel, iterative (which participant steps when, seeing what);

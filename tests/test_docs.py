@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import tomllib
@@ -79,3 +80,48 @@ def test_the_readme_python_quick_start_runs_and_prints_physical_values():
     numbers = [float(word) for word in result.stdout.replace(",", " ").split() if word.replace(".", "").isdigit()]
     pull, torque, sinkage_mm = numbers
     assert 0 < pull < 424 and 0 < torque < 424 * 0.355 and 1 < sinkage_mm < 355
+
+
+#: File names the "To change …" and "To add …" tables of the design pages may name.
+_NAMED_FILE = re.compile(r"`([\w./-]+\.(?:py|mo|c|h|toml|json|order|md))`")
+
+
+def _repository_files() -> list[Path]:
+    skipped = {".git", ".venv", "results", "site", "fmus", "node_modules", ".pytest_cache", ".mypy_cache"}
+    return [path for path in REPOSITORY.rglob("*") if path.is_file()
+            and not skipped & set(path.relative_to(REPOSITORY).parts)]
+
+
+def test_every_file_the_change_tables_name_exists():
+    """The design pages' "To change …, touch these files" and "To add …" tables name files by their
+    path from the repository, from the Modelica package or by their name alone (a C twin beside its
+    block); each must be there, so that a renamed or removed file cannot leave a table pointing
+    nowhere."""
+    files = _repository_files()
+    names = {path.name for path in files}
+    tails = {path.relative_to(REPOSITORY).as_posix() for path in files}
+    pages = sorted((REPOSITORY / "docs" / "design").glob("*.md"))
+    missing, named = [], 0
+    for page in pages:
+        text = page.read_text()
+        for part in re.split(r"^## ", text, flags=re.MULTILINE):
+            if not part.startswith(("To change", "To add")):
+                continue
+            for rows in re.findall(r"^\|.*\|$", part, flags=re.MULTILINE):
+                for name in _NAMED_FILE.findall(rows):
+                    named += 1
+                    if "/" not in name:
+                        found = name in names
+                    else:
+                        found = any(tail == name or tail.endswith("/" + name) for tail in tails)
+                    if not found and not name.startswith("../"):
+                        missing.append(f"{page.name}: {name}")
+    assert named > 40, f"only {named} files named: the tables were not found"
+    assert not missing, missing
+
+
+def test_the_design_pages_say_how_to_add_a_command_a_scenario_an_fmu_and_a_soil_field():
+    text = (REPOSITORY / "docs" / "design" / "development.md").read_text()
+    table = text.split("## To add", 1)[1].split("\n## ", 1)[0]
+    for row in ("| a command", "| a terrain scenario", "| an FMU", "| a soil field"):
+        assert row in table, row

@@ -1,8 +1,9 @@
-/* The contract between a generated model and the rover-cosim FMI 2.0 runtime.
+/* The contract between a generated model and the rover-cosim FMI runtime (one core under the FMI
+ * 2.0 and FMI 3.0 API layers).
  *
  * fmubuild generates, per model, model_casadi.c (CasADi's C code of the functions below) and
  * model_data.c (sizes, value-reference layout, defaults: the ModelInfo below). The runtime
- * (core.h: instance.c, state.c, cosim.c, ode23s.c, and the API layer fmi2_api.c) is the same for every model.
+ * (core.h: instance.c, state.c, cosim.c, ode23s.c, and the API layers fmi2_api.c, fmi3_api.c) is the same for every model.
  *
  * Real value references are indices into one array laid out as
  *   [parameters | states | derivatives | inputs | observed | memories | tolerance, maxStep | statistics]

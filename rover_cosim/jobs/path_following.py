@@ -26,7 +26,6 @@ results/simulation/
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,7 +34,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
+from rover_cosim.common.outputs import json_bytes, summary_repr
 from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.control import path_figures
 from rover_cosim.control.adaptive import AdaptivePathController, Calibration
@@ -43,13 +42,11 @@ from rover_cosim.control.path import Path as ReferencePath
 from rover_cosim.control.path_controller import PATHS, PathFollowingController
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder
-from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
-from rover_cosim.orchestrator.runs import system_record
-from rover_cosim.progress import Stages
 from rover_cosim.terramechanics import Soil, Wheel
-from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
+from rover_cosim.terramechanics.library import Choice, as_choice
 
+from .campaign import Campaign
 from .plants import add_plant_fmu, add_rover
 from .simulate import RECORD_INTERVAL, adapter_for, checked_models, connect_telemetry, models_of, soil_and_wheel_of
 
@@ -214,40 +211,30 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``.
     ``straight`` [m]: the straights before and after each path's curve (10 m; shorter ones keep
     the curve and shorten the run)."""
-    started = time.perf_counter()
     choice = as_choice(choice)
     steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
     scenario_path(next(iter(SCENARIOS)), straight)  # a bad length refused before anything runs
     fmu_dir = Path(fmu_dir).resolve()
     tables: dict[tuple[str, str], pd.DataFrame] = {}
-    walls: dict[str, float] = {}
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     builds = {"inverse": lambda s: monolithic_system(fmu_dir, models, s, choice=choice, straight=straight),
               "cosim": lambda s: cosim_system(fmu_dir, models, s, choice, straight),
               "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice, straight)}
-    stages = Stages(progress, len(scenarios) * len(builds))
-    systems: dict[str, Any] = {}
-    for i, scenario in enumerate(scenarios):
-        for j, (label, build) in enumerate(builds.items()):
-            system = build(scenario)
-            systems[f"{scenario}/{label}"] = system_record(system)
-            outcome = run(system, progress=stages.stage(i * len(builds) + j))
+    campaign = Campaign("rover-cosim simulate (path following)", len(scenarios) * len(builds), progress)
+    for scenario in scenarios:
+        for label, build in builds.items():
+            outcome = campaign.run(f"{scenario}/{label}", build(scenario))
             tables[scenario, label] = trajectories(outcome.data, cosim=label == "cosim")
-            walls[f"{scenario}/{label}"] = outcome.wall_seconds
     rows = [{"scenario": s, "run": label, "target_speed_m_s": SCENARIOS[s], **metrics(tables[s, label], SCENARIOS[s])}
             for s in scenarios for label in builds]
     metric_table = pd.DataFrame(rows)
     agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"],
                                                                 SCENARIOS[s])} for s in scenarios])
-    record = run_record("rover-cosim simulate (path following)",
-                        {"scenarios": {s: {"target_speed_m_s": SCENARIOS[s], "stop_time_s": stop_time(s, straight)}
-                                       for s in scenarios}, "straight_m": straight, "step_s": STEP, "model": str(model),
-                         "algorithm": "gauss-seidel", "record_interval_s": record_interval})
-    record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
-                   "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
-                   "model_mismatch": mismatch, "systems": systems,
-                   "wall_seconds": time.perf_counter() - started,
-                   "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
+    record = campaign.record(
+        {"scenarios": {s: {"target_speed_m_s": SCENARIOS[s], "stop_time_s": stop_time(s, straight)} for s in scenarios},
+         "straight_m": straight, "model": str(model), "record_interval_s": record_interval},
+        fmu_dir=fmu_dir, fmus=FMUS, model=model, choice=choice, mismatch=mismatch,
+        metrics=metric_table.to_dict("records"), agreement=agreement_table.to_dict("records"))
     out = Path(out_dir)
     suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic"}
     files = {out / f"path_{s}{suffix[label]}.csv": csv_bytes(every(table, record_interval, STEP), "%.8g")
@@ -260,5 +247,5 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     })
     for s in scenarios:
         files[out / f"path_wheels_{s}.png"] = path_figures.wheels(tables[s, "inverse"], s)
-    write_all(files, folder=out, stale=("path_*",))  # the straight run's files stay
-    return PathResult(sorted(files), tables, metric_table, agreement_table, record)
+    written = campaign.write(out, files, stale=("path_*",))  # the straight run's files stay
+    return PathResult(written, tables, metric_table, agreement_table, record)

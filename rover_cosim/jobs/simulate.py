@@ -13,7 +13,6 @@ results/simulation/
 from __future__ import annotations
 
 import tempfile
-import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -22,7 +21,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
+from rover_cosim.common.outputs import json_bytes, summary_repr
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
 from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.control.adaptive import AdaptiveController, Calibration
@@ -32,13 +31,11 @@ from rover_cosim.identification.model_set import ModelMismatch, ModelSet
 from rover_cosim.identification.online import Adaptation, adapt_model
 from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.orchestrator.builder import SystemBuilder
-from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
-from rover_cosim.orchestrator.runs import system_record
-from rover_cosim.progress import Stages
 from rover_cosim.terramechanics import Soil, Wheel
-from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe
+from rover_cosim.terramechanics.library import Choice, as_choice, choose
 
+from .campaign import Campaign
 from .plants import add_plant_fmu, add_rover, wire_hub
 
 STOP_TIME = 20.0  # s
@@ -243,32 +240,22 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     [s] (the metrics and figures use every step). ``adapt``: also the run with the adaptive
     controller and that calibration (trajectories_adaptive.csv, rms_adaptive.csv, and what it
     estimated and when it switched in simulation.json's ``adaptation``)."""
-    started = time.perf_counter()
     choice = as_choice(choice)
     check_options(record_interval, adapt)  # refused before anything runs
-    stages = Stages(progress, 4 if adapt else 3)
+    campaign = Campaign("rover-cosim simulate", 4 if adapt else 3, progress)
     results: dict[str, Any] = {}
     tables: dict[str, pd.DataFrame] = {}
-    walls: dict[str, float] = {}
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
-    systems: dict[str, Any] = {}
-    for k, (plant, build) in enumerate((("monolithic", monolithic_system), ("cosim", cosim_system))):
-        system = build(fmu_dir, models, choice)
-        systems[plant] = system_record(system)
-        outcome = run(system, progress=stages.stage(k))
-        tables[plant] = trajectories(outcome.data, plant)
-        walls[plant] = outcome.wall_seconds
+    for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
+        tables[plant] = trajectories(campaign.run(plant, build(fmu_dir, models, choice)).data, plant)
         results[plant] = checks(tables[plant])
-    ablation = rms(trajectories(run(monolithic_system(fmu_dir, models, choice, fixed_load=STATIC_LOAD),
-                                    progress=stages.stage(2)).data, "monolithic"))
+    ablation = rms(trajectories(campaign.run("fixed_load_ablation", monolithic_system(
+        fmu_dir, models, choice, fixed_load=STATIC_LOAD)).data, "monolithic"))
     adaptation = None
     if adapt is not None:
         system = adaptive_system(fmu_dir, models, choice, calibration=adapt)
-        systems["adaptive"] = system_record(system)
-        outcome = run(system, progress=stages.stage(3))
-        tables["adaptive"] = trajectories(outcome.data, "monolithic")
-        walls["adaptive"] = outcome.wall_seconds
+        tables["adaptive"] = trajectories(campaign.run("adaptive", system).data, "monolithic")
         results["adaptive"] = checks(tables["adaptive"])
         block = next(b.block for b in system.blocks if b.name == "ctrl")
         after = tables["adaptive"][tables["adaptive"]["time"] >= adapt.duration]
@@ -278,15 +265,12 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     rms_mono, rms_cosim = rms(tables["monolithic"]), rms(tables["cosim"])
     ablation_table = pd.DataFrame({"limb": list(LIMBS), "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})
-    record = run_record("rover-cosim simulate", {"stop_time_s": STOP_TIME, "step_s": STEP, "model": str(model),
-                                                  "record_interval_s": record_interval,
-                                                  "algorithm": "gauss-seidel", "fixed_load_ablation_N": STATIC_LOAD})
-    record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in ("Rover", "RoverBody", "Wheel")},
-                   "model_sha256": file_sha256(model), "run_wall_seconds": walls,
-                   **describe(choice or choose()), "model_mismatch": mismatch, "systems": systems,
-                   "wall_seconds": time.perf_counter() - started, "checks": results,
-                   "rms_N": {"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
-                             "fixed_load_ablation": ablation["rms_N"].tolist()}})
+    record = campaign.record({"stop_time_s": STOP_TIME, "model": str(model), "record_interval_s": record_interval,
+                              "fixed_load_ablation_N": STATIC_LOAD},
+                             fmu_dir=fmu_dir, fmus=("Rover", "RoverBody", "Wheel"), model=model, choice=choice,
+                             mismatch=mismatch, checks=results,
+                             rms_N={"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
+                                    "fixed_load_ablation": ablation["rms_N"].tolist()})
     if adaptation is not None:
         record["adaptation"] = adaptation
     out = Path(out_dir)
@@ -305,6 +289,6 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
         files[out / "trajectories_adaptive.csv"] = csv_bytes(every(tables["adaptive"], record_interval, STEP), "%.8g")
         files[out / "rms_adaptive.csv"] = rms(tables["adaptive"]).to_csv(index=False, float_format="%.4f").encode()
         files[out / "fig10_closed_loop_adaptive.png"] = fig10(tables["adaptive"], "Rover.fmu, adaptive controller")
-    write_all(files, folder=out, stale=("fig10_*", "fig_tracking.*", "*_adaptive.*"))  # path following's stay
-    return SimulationResult(sorted(files), record, tables, {"monolithic": rms_mono, "cosim": rms_cosim},
+    written = campaign.write(out, files, stale=("fig10_*", "fig_tracking.*", "*_adaptive.*"))  # the paths' stay
+    return SimulationResult(written, record, tables, {"monolithic": rms_mono, "cosim": rms_cosim},
                             ablation_table)

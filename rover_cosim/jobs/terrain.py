@@ -57,16 +57,15 @@ from __future__ import annotations
 
 import hashlib
 import math
-import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
+from rover_cosim.common.outputs import file_sha256, json_bytes
 from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.control.path import Line
 from rover_cosim.control.path import Path as ReferencePath
@@ -75,15 +74,13 @@ from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.identification.online import identify_lateral_on_soil, identify_on_soil, sweep_loads
 from rover_cosim.identification.sweep import SweepPlan
 from rover_cosim.orchestrator.builder import SystemBuilder
-from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
-from rover_cosim.orchestrator.runs import system_record
-from rover_cosim.progress import Stages
 from rover_cosim.terramechanics import PlaneTerrain, Soil, Wheel
-from rover_cosim.terramechanics.library import Choice, as_choice, choose, describe, soil_parameters
+from rover_cosim.terramechanics.library import Choice, as_choice, choose, soil_parameters
 from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, crater, soil_boundary
 
 from . import terrain_figures
+from .campaign import Campaign
 from .ground import SIGNALS, GroundBlock, SoilBlock
 from .path_following import BODY, STEP, WHEELS, PathResult, agreement, connect_controller, trajectories
 from .path_following import metrics as path_metrics
@@ -92,38 +89,102 @@ from .simulate import RECORD_INTERVAL, checked_models, models_of
 
 SPEED = 0.3          # m/s, the traverse's target speed
 TRAVERSE = 6.0       # m, the traverse's length (20 s at 0.3 m/s: the ablation settles in about 15 s)
-SLOPES = {"slope_traverse_10": 10.0, "slope_traverse_20": 20.0}  # scenario -> side slope [deg]
 RUNS = ("inverse", "cosim", "kinematic", "unaware")
+#: N: the loads the second soil's models are identified around (the rover's per-wheel loads on the
+#: crossing's slope, 1570 kg x 1.62 m/s² / 6 = 424 N, shifted by the roll and the pitch)
+CROSSING_LOADS = (300.0, 550.0)
+FMUS = ("SteerableRover", "SteerableRoverBody", "Wheel")
+G = 1.62             # m/s², the rover's gravity (RoverParameters.g, the FMUs' default)
+MASS = 1570.0        # kg, RoverParameters.M
+
+
+class TerrainScenario:
+    """A terrain scenario: a straight traverse along +x of ``length`` [m] at ``speed`` [m/s] on a
+    ground plane with a side slope of ``side_slope_deg``, the runs it has (of RUNS), and what it adds
+    to the ground (``prepare``) and to the record (``details``). A new scenario is a subclass (or an
+    instance of one) and its entry in ``scenarios``."""
+
+    name: str
+    runs: tuple[str, ...]
+    length: float
+    speed: float
+
+    @property
+    def side_slope_deg(self) -> float:
+        """deg: the side slope (the valley to the right of the path)."""
+        return 0.0
+
+    def plane(self) -> PlaneTerrain:
+        """The ground plane."""
+        return PlaneTerrain.side_slope(self.side_slope_deg, valley="right") if self.side_slope_deg else PlaneTerrain()
+
+    def prepare(self, out: Path, fmu_dir: Path, choice: Choice, models: ModelSet) -> Prepared:
+        """The ground of the runs (written maps are read back from their bytes: the runs use the files)."""
+        return Prepared(Ground(self.plane()), {}, None)
+
+    def details(self) -> dict[str, Any]:
+        """What the record says of the scenario besides its ground, speed, length and stop time."""
+        return {}
 
 
 @dataclass(frozen=True)
-class CraterScenario:
-    """The crater scenario: path ``length`` [m] along x at ``speed`` [m/s], a crater of ``depth`` [m]
-    and ``radius`` [m] centred at ``centre`` [m] (``terramechanics.terrain.crater``)."""
+class SlopeScenario(TerrainScenario):
+    """A traverse across a side slope of ``slope_deg`` [deg]; its ablation kinematic steering (the
+    downhill pull left to the cross-track feedback); on the co-simulated rover too if ``cosim``."""
 
+    name: str
+    slope_deg: float
+    length: float = TRAVERSE
+    speed: float = SPEED
+    cosim: bool = True
+
+    @property
+    def runs(self) -> tuple[str, ...]:  # type: ignore[override]
+        return ("inverse", "cosim", "kinematic") if self.cosim else ("inverse", "kinematic")
+
+    @property
+    def side_slope_deg(self) -> float:
+        return self.slope_deg
+
+
+@dataclass(frozen=True)
+class CraterScenario(TerrainScenario):
+    """The crater scenario: path ``length`` [m] along x at ``speed`` [m/s], a crater of ``depth`` [m]
+    and ``radius`` [m] centred at ``centre`` [m] (``terramechanics.terrain.crater``), given hub by
+    hub by the ground participant; the ablation ``unaware``: the controller without the map."""
+
+    name: ClassVar[str] = "crater"  # type: ignore[misc]
+    runs: ClassVar[tuple[str, ...]] = ("inverse", "cosim", "unaware")  # type: ignore[misc]
     length: float = 20.0
     speed: float = 1.0
     centre: tuple[float, float] = (10.0, -2.5)
     depth: float = 0.12
     radius: float = 4.0
 
+    def prepare(self, out: Path, fmu_dir: Path, choice: Choice, models: ModelSet) -> Prepared:
+        files = {out / "terrain_crater_heightmap.csv": crater_map(self).write("")}
+        height_map = _read_back(files[out / "terrain_crater_heightmap.csv"])
+        height_map.source = "crater (terrain_crater_heightmap.csv)"
+        return Prepared(Ground(self.plane(), height_map), files, None)
+
+    def details(self) -> dict[str, Any]:
+        return {"crater": asdict(self)}
+
 
 CRATER = CraterScenario()
 
 
 @dataclass(frozen=True)
-class SoilCrossingScenario:
+class SoilCrossingScenario(TerrainScenario):
     """The soil-crossing scenario: a straight traverse of ``length`` [m] at ``speed`` [m/s] across a
     side slope of ``slope_deg`` [deg], from the run's soil onto ``soil_b`` (a name of the soil
     library) beyond a boundary across the path at x = ``boundary`` [m], the share of ``soil_b``
     rising over ``width`` [m] (``terramechanics.terrain.soil_boundary``); the controller that
-    believes the map takes ``believed_soil_b`` for the second soil."""
+    believes the map takes ``believed_soil_b`` for the second soil; the ablation ``unaware``: the
+    controller believing the first soil everywhere."""
 
-    def believed(self) -> Soil:
-        """The second soil the controller believes in."""
-        return choose(soil=self.believed_soil_b or self.soil_b).soil
-
-
+    name: ClassVar[str] = "soil_crossing"  # type: ignore[misc]
+    runs: ClassVar[tuple[str, ...]] = ("inverse", "cosim", "unaware")  # type: ignore[misc]
     length: float = 7.0
     speed: float = 0.3
     slope_deg: float = 10.0
@@ -135,15 +196,51 @@ class SoilCrossingScenario:
     #: ``rover-cosim estimate-soil``); None: the true one, ``soil_b``
     believed_soil_b: str | None = None
 
+    def believed(self) -> Soil:
+        """The second soil the controller believes in."""
+        return choose(soil=self.believed_soil_b or self.soil_b).soil
+
+    @property
+    def side_slope_deg(self) -> float:
+        return self.slope_deg
+
+    def check(self) -> None:
+        """ValueError naming a soil of the scenario that is not known (before anything runs)."""
+        choose(soil=self.soil_b)
+        self.believed()
+
+    def prepare(self, out: Path, fmu_dir: Path, choice: Choice, models: ModelSet) -> Prepared:
+        path = out / "terrain_soil_crossing_soilmap.csv"
+        files = {path: soil_map_of(choice.soil, self).write("")}
+        soil_map = _read_back(files[path], lambda name: SoilMap.read(name, choice.soil, choose(soil=self.soil_b).soil))
+        soil_map.source = f"{self.soil_b} beyond x = {self.boundary:g} m"
+        model_b = identify_second_soil(fmu_dir / "SingleWheel.fmu", self.believed(), choice.wheel,
+                                       models.model().degree)
+        files[out / "terrain_soil_crossing_model_b.json"] = model_b.to_json()
+        return Prepared(Ground(self.plane(), None, soil_map), files, model_b)
+
+    def details(self) -> dict[str, Any]:
+        chosen = choose(soil=self.soil_b)
+        return {"soil_crossing": {**asdict(self), "soil_b_values": asdict(chosen.soil),
+                                  "soil_b_title": chosen.soil_entry.get("title"),
+                                  "soil_b_source": chosen.soil_entry.get("source"),
+                                  "believed_soil_b_values": asdict(self.believed())}}
+
 
 SOIL_CROSSING = SoilCrossingScenario()
-SCENARIOS = (*SLOPES, "crater", "soil_crossing")
-#: N: the loads the second soil's models are identified around (the rover's per-wheel loads on the
-#: crossing's slope, 1570 kg x 1.62 m/s² / 6 = 424 N, shifted by the roll and the pitch)
-CROSSING_LOADS = (300.0, 550.0)
-FMUS = ("SteerableRover", "SteerableRoverBody", "Wheel")
-G = 1.62             # m/s², the rover's gravity (RoverParameters.g, the FMUs' default)
-MASS = 1570.0        # kg, RoverParameters.M
+
+
+def terrain_scenarios(length: float | None = None, crater_scenario: CraterScenario = CRATER,
+              crossing: SoilCrossingScenario = SOIL_CROSSING) -> dict[str, TerrainScenario]:
+    """The terrain scenarios by name, in the order they run: the side-slope traverses of ``length``
+    [m] (None: TRAVERSE; the co-simulated rover only on the steeper one, for time), the crater, the
+    soil crossing."""
+    slope_length = TRAVERSE if length is None else length
+    traverse_path(slope_length)  # a bad length refused before anything runs
+    listed: tuple[TerrainScenario, ...] = (
+        SlopeScenario("slope_traverse_10", 10.0, slope_length, cosim=False),
+        SlopeScenario("slope_traverse_20", 20.0, slope_length), crater_scenario, crossing)
+    return {scenario.name: scenario for scenario in listed}
 
 
 class TerrainResult(PathResult):
@@ -151,25 +248,9 @@ class TerrainResult(PathResult):
     terrain_*.csv columns), terrain_metrics.csv, terrain_agreement.csv and the record."""
 
 
-def terrain_of(scenario: str, crossing: SoilCrossingScenario = SOIL_CROSSING) -> PlaneTerrain:
-    """The ground plane of ``scenario``: a side slope, the valley to the right of the path along +x
-    (the crater: level)."""
-    if scenario not in SCENARIOS:
-        raise ValueError(f"scenario = {scenario!r}: expected one of {list(SCENARIOS)}")
-    if scenario == "soil_crossing":
-        return PlaneTerrain.side_slope(crossing.slope_deg, valley="right")
-    return PlaneTerrain.side_slope(SLOPES[scenario], valley="right") if scenario in SLOPES else PlaneTerrain()
-
-
 def crater_map(scenario: CraterScenario = CRATER) -> HeightMap:
     """The crater scenario's height map."""
     return crater(scenario.centre, scenario.depth, scenario.radius, rim=0.0)
-
-
-def speed_of(scenario: str, crater_scenario: CraterScenario = CRATER,
-             crossing: SoilCrossingScenario = SOIL_CROSSING) -> float:
-    """m/s: the scenario's target speed."""
-    return {"crater": crater_scenario.speed, "soil_crossing": crossing.speed}.get(scenario, SPEED)
 
 
 def soil_map_of(soil: Soil, crossing: SoilCrossingScenario = SOIL_CROSSING) -> SoilMap:
@@ -213,6 +294,15 @@ class Ground:
                 + ("" if self.soil_map is None else f",\n{self.soil_map.source}"))
 
 
+class Prepared(NamedTuple):
+    """What a scenario drives on, with the files that describe it (maps written beside the results)
+    and the models of a second soil its controller believes in (None: none)."""
+
+    ground: Ground
+    files: dict[Path, bytes]
+    model_b: ModelSet | None
+
+
 def traverse_path(length: float = TRAVERSE) -> ReferencePath:
     """The straight traverse of ``length`` [m] along +x from the origin."""
     if not (math.isfinite(length) and length > 0):
@@ -223,6 +313,11 @@ def traverse_path(length: float = TRAVERSE) -> ReferencePath:
 def stop_time(length: float = TRAVERSE, speed: float = SPEED) -> float:
     """s: until the reference point reaches the end of the traverse (to the step)."""
     return float(np.floor(traverse_path(length).length / speed / STEP) * STEP)
+
+
+#: The scenarios' names, and the side slopes' angles [deg] by name.
+SCENARIOS = tuple(terrain_scenarios())
+SLOPES = {s.name: s.slope_deg for s in terrain_scenarios().values() if isinstance(s, SlopeScenario)}
 
 
 def _radius(choice: Choice | None) -> float:
@@ -345,101 +440,66 @@ def metrics(table: pd.DataFrame, speed: float = SPEED) -> dict[str, float]:
     return row
 
 
-def runs_of(scenario: str, runs: tuple[str, ...]) -> tuple[str, ...]:
-    """The runs of ``scenario`` among ``runs``: the slopes' ablation is kinematic steering, the
-    crater's the identified models with the map unknown to the controller (``unaware``); the
-    co-simulated rover on the steeper slope and the crater (not again on the 10 deg slope: time)."""
-    left_out = {"kinematic" if scenario in ("crater", "soil_crossing") else "unaware"} | (
-        {"cosim"} if scenario == "slope_traverse_10" else set())
-    return tuple(r for r in runs if r not in left_out)
-
-
 def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str, ...] = SCENARIOS,
                 choice: Choice | Soil | Wheel | None = None, *, allow_model_mismatch: bool = False,
                 progress: Callable[[float], None] | None = None, record_interval: float = RECORD_INTERVAL,
                 length: float | None = None, runs: tuple[str, ...] = RUNS,
                 crater_scenario: CraterScenario = CRATER,
                 crossing: SoilCrossingScenario = SOIL_CROSSING) -> TerrainResult:
-    """Every scenario with the runs of ``runs`` it has (``runs_of``: ``inverse`` and ``cosim`` with
-    compensation, the ablation ``kinematic`` or, for the crater, ``unaware``) on the soil and wheel
-    of ``choice`` (default: the paper's); writes every file (all or none). ``length`` [m]: the slope traverses' length
-    (None: 6 m; the tests run shorter ones); ``crater_scenario``: the crater's path and bowl;
-    ``crossing``: the soil crossing's path, slope and soils."""
-    started = time.perf_counter()
+    """Every scenario of ``scenarios`` (names of ``terrain_scenarios``) with the runs of ``runs`` it
+    has (``inverse`` and ``cosim`` with compensation, the ablation ``kinematic`` or ``unaware``) on
+    the soil and wheel of ``choice`` (default: the paper's); writes every file (all or none).
+    ``length`` [m]: the slope traverses' length (None: 6 m; the tests run shorter ones);
+    ``crater_scenario``: the crater's path and bowl; ``crossing``: the soil crossing's path, slope
+    and soils."""
     choice = as_choice(choice)
     steps_between_rows(record_interval, STEP)  # a bad interval refused before anything runs
-    slope_length = TRAVERSE if length is None else length
-    traverse_path(slope_length)
-    unknown = [s for s in scenarios if s not in SCENARIOS] + [r for r in runs if r not in RUNS]
+    table = terrain_scenarios(length, crater_scenario, crossing)
+    unknown = [s for s in scenarios if s not in table] + [r for r in runs if r not in RUNS]
     if unknown or not scenarios or "inverse" not in runs:
-        raise ValueError(f"scenarios {scenarios!r}, runs {runs!r}: expected scenarios of {list(SCENARIOS)} and runs "
+        raise ValueError(f"scenarios {scenarios!r}, runs {runs!r}: expected scenarios of {list(table)} and runs "
                          f"of {RUNS} with 'inverse' among them")
+    chosen = [table[name] for name in scenarios]
+    for scenario in chosen:  # e.g. the soils of a crossing named before anything runs
+        check = getattr(scenario, "check", None)
+        if check is not None:
+            check()
     fmu_dir = Path(fmu_dir).resolve()
     out = Path(out_dir)
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
-    if "soil_crossing" in scenarios:  # its soils named before anything runs
-        choose(soil=crossing.soil_b)
-        crossing.believed()
-    plan = [(s, label) for s in scenarios for label in runs_of(s, runs)]
-    speeds = {s: speed_of(s, crater_scenario, crossing) for s in scenarios}
-    lengths = {s: _length(s, slope_length, crater_scenario, crossing) for s in scenarios}
-    model_b = None
-    stages = Stages(progress, len(plan))
+    plan = [(scenario, label) for scenario in chosen for label in runs if label in scenario.runs]
+    campaign = Campaign("rover-cosim simulate (terrain)", len(plan), progress)
     tables: dict[tuple[str, str], pd.DataFrame] = {}
-    walls: dict[str, float] = {}
-    systems: dict[str, Any] = {}
-    grounds: dict[str, Ground] = {}
+    prepared: dict[str, Prepared] = {}
     files: dict[Path, bytes] = {}
-    for k, (scenario, label) in enumerate(plan):
-        if scenario not in grounds:
-            height_map = soil_map = None
-            if scenario == "crater":  # written, then read back: the runs use the file's map
-                files[out / "terrain_crater_heightmap.csv"] = crater_map(crater_scenario).write("")
-                height_map = _read_back(files[out / "terrain_crater_heightmap.csv"])
-                height_map.source = "crater (terrain_crater_heightmap.csv)"
-            if scenario == "soil_crossing":  # the same for the soil map
-                path = out / "terrain_soil_crossing_soilmap.csv"
-                files[path] = soil_map_of((choice or choose()).soil, crossing).write("")
-                soil_map = _read_back(files[path], lambda name: SoilMap.read(name, (choice or choose()).soil,
-                                                                             choose(soil=crossing.soil_b).soil))
-                soil_map.source = f"{crossing.soil_b} beyond x = {crossing.boundary:g} m"
-                model_b = identify_second_soil(fmu_dir / "SingleWheel.fmu", crossing.believed(),
-                                               (choice or choose()).wheel, models.model().degree)
-                files[out / "terrain_soil_crossing_model_b.json"] = model_b.to_json()
-            grounds[scenario] = Ground(terrain_of(scenario, crossing), height_map, soil_map)
-        ground = grounds[scenario]
-        system = traverse_system(fmu_dir, models, ground.plane, label, choice, lengths[scenario],
-                                 speed=speeds[scenario], height_map=ground.map, soil_map=ground.soil_map,
-                                 model_b=model_b if ground.soil_map is not None else None)
-        systems[f"{scenario}/{label}"] = system_record(system)
-        outcome = run(system, progress=stages.stage(k))
-        table = trajectories(outcome.data, cosim=label == "cosim")
-        table["z_ground"] = ground.height(table["x"], table["y"])
-        tables[scenario, label] = table
-        walls[f"{scenario}/{label}"] = outcome.wall_seconds
-    metric_table = pd.DataFrame([{"scenario": s, "run": label, "side_slope_deg": _side_slope(s, crossing),
-                                  "target_speed_m_s": speeds[s], **metrics(tables[s, label], speeds[s])}
+    for scenario, label in plan:
+        if scenario.name not in prepared:
+            prepared[scenario.name] = scenario.prepare(out, fmu_dir, choice, models)
+            files.update(prepared[scenario.name].files)
+        ground, model_b = prepared[scenario.name].ground, prepared[scenario.name].model_b
+        system = traverse_system(fmu_dir, models, ground.plane, label, choice, scenario.length,
+                                 speed=scenario.speed, height_map=ground.map, soil_map=ground.soil_map,
+                                 model_b=model_b)
+        data = campaign.run(f"{scenario.name}/{label}", system).data
+        trajectory = trajectories(data, cosim=label == "cosim")
+        trajectory["z_ground"] = ground.height(trajectory["x"], trajectory["y"])
+        tables[scenario.name, label] = trajectory
+    metric_table = pd.DataFrame([{"scenario": s.name, "run": label, "side_slope_deg": s.side_slope_deg,
+                                  "target_speed_m_s": s.speed, **metrics(tables[s.name, label], s.speed)}
                                  for s, label in plan])
-    agreement_table = pd.DataFrame([{"scenario": s, **agreement(tables[s, "inverse"], tables[s, "cosim"], speeds[s])}
-                                    for s in scenarios if (s, "cosim") in tables])
-    record = run_record("rover-cosim simulate (terrain)",
-                        {"scenarios": {s: {"terrain": vars(terrain_of(s, crossing)),
-                                           "side_slope_deg": _side_slope(s, crossing),
-                                           "target_speed_m_s": speeds[s], "length_m": lengths[s],
-                                           "stop_time_s": stop_time(lengths[s], speeds[s]),
-                                           **({"crater": asdict(crater_scenario)} if s == "crater" else {}),
-                                           **({"soil_crossing": {**asdict(crossing), **_second_soil(crossing)}}
-                                              if s == "soil_crossing" else {})}
-                                       for s in scenarios},
-                         "step_s": STEP, "model": str(model), "runs": list(runs),
-                         "algorithm": "gauss-seidel", "record_interval_s": record_interval})
-    record.update({"fmus": {name: file_sha256(fmu_dir / f"{name}.fmu") for name in FMUS},
-                   "model_sha256": file_sha256(model), "run_wall_seconds": walls, **describe(choice or choose()),
-                   "model_mismatch": mismatch, "systems": systems, "wall_seconds": time.perf_counter() - started,
-                   "metrics": metric_table.to_dict("records"), "agreement": agreement_table.to_dict("records")})
-    if model_b is not None:
-        model_b_bytes = files[out / "terrain_soil_crossing_model_b.json"]
-        record["soil_crossing_model_b_sha256"] = hashlib.sha256(model_b_bytes).hexdigest()
+    agreement_table = pd.DataFrame([{"scenario": s.name, **agreement(tables[s.name, "inverse"],
+                                                                     tables[s.name, "cosim"], s.speed)}
+                                    for s in chosen if (s.name, "cosim") in tables])
+    record = campaign.record(
+        {"scenarios": {s.name: {"terrain": vars(s.plane()), "side_slope_deg": s.side_slope_deg,
+                                "target_speed_m_s": s.speed, "length_m": s.length,
+                                "stop_time_s": stop_time(s.length, s.speed), **s.details()} for s in chosen},
+         "model": str(model), "runs": list(runs), "record_interval_s": record_interval},
+        fmu_dir=fmu_dir, fmus=FMUS, model=model, choice=choice, mismatch=mismatch,
+        metrics=metric_table.to_dict("records"), agreement=agreement_table.to_dict("records"))
+    for name, ready in prepared.items():
+        if ready.model_b is not None:
+            record[f"{name}_model_b_sha256"] = hashlib.sha256(ready.model_b.to_json()).hexdigest()
     suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic", "unaware": "_unaware"}
     files.update({out / f"terrain_{s}{suffix[label]}.csv": csv_bytes(every(table, record_interval, STEP), "%.8g")
                   for (s, label), table in tables.items()})
@@ -447,30 +507,14 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
         out / "terrain_metrics.csv": metric_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "terrain_agreement.csv": agreement_table.to_csv(index=False, float_format="%.5g").encode(),
         out / "terrain_xy.png": terrain_figures.paths_over_terrain(
-            {s: (traverse_path(lengths[s]), grounds[s]) for s in scenarios}, tables),
+            {s.name: (traverse_path(s.length), prepared[s.name].ground) for s in chosen}, tables),
         out / "terrain.json": json_bytes(record),
     })
-    for s in scenarios:
-        files[out / f"terrain_wheels_{s}.png"] = terrain_figures.wheels(
-            {label: tables[s, label] for label in runs_of(s, runs) if label != "cosim"}, s)
-    write_all(files, folder=out, stale=("terrain_*",))  # the straight run's and the paths' files stay
-    return TerrainResult(sorted(files), tables, metric_table, agreement_table, record)
-
-
-def _length(scenario: str, slope_length: float, crater_scenario: CraterScenario = CRATER,
-            crossing: SoilCrossingScenario = SOIL_CROSSING) -> float:
-    return {"crater": crater_scenario.length, "soil_crossing": crossing.length}.get(scenario, slope_length)
-
-
-def _side_slope(scenario: str, crossing: SoilCrossingScenario = SOIL_CROSSING) -> float:
-    """deg: the scenario's side slope."""
-    return crossing.slope_deg if scenario == "soil_crossing" else SLOPES.get(scenario, 0.0)
-
-
-def _second_soil(crossing: SoilCrossingScenario) -> dict[str, Any]:
-    chosen = choose(soil=crossing.soil_b)
-    return {"soil_b_values": asdict(chosen.soil), "soil_b_title": chosen.soil_entry.get("title"),
-            "soil_b_source": chosen.soil_entry.get("source"), "believed_soil_b_values": asdict(crossing.believed())}
+    for s in chosen:
+        files[out / f"terrain_wheels_{s.name}.png"] = terrain_figures.wheels(
+            {label: tables[s.name, label] for label in runs if label in s.runs and label != "cosim"}, s.name)
+    written = campaign.write(out, files, stale=("terrain_*",))  # the straight run's and the paths' files stay
+    return TerrainResult(written, tables, metric_table, agreement_table, record)
 
 
 def _read_back(text: bytes, reader: Callable[[Path], Any] = HeightMap.read) -> Any:
@@ -485,6 +529,6 @@ def _read_back(text: bytes, reader: Callable[[Path], Any] = HeightMap.read) -> A
 
 
 __all__ = ["BODY", "CRATER", "RUNS", "SCENARIOS", "SLOPES", "SOIL_CROSSING", "SPEED", "TRAVERSE", "Ground",
-           "TerrainResult", "CraterScenario", "SoilCrossingScenario", "identify_second_soil", "soil_map_of",
-           "crater_map", "metrics", "motor_energy", "run_terrain", "speed_of", "stop_time",
-           "terrain_of", "traverse_path", "traverse_system"]
+           "TerrainResult", "TerrainScenario", "SlopeScenario", "CraterScenario", "SoilCrossingScenario", "Prepared",
+           "identify_second_soil", "soil_map_of", "crater_map", "metrics", "motor_energy", "run_terrain", "stop_time",
+           "terrain_scenarios", "traverse_path", "traverse_system"]

@@ -1,0 +1,73 @@
+"""The skeleton the closed-loop jobs share (simulate's straight run, the path following, the terrain
+scenarios): their runs stepped one after the other, each with its share of the progress; what each
+system was and how long it ran; the record's common part, with the master's algorithm and step read
+from the systems that ran; the files written as one set, all or none.
+
+A job builds its systems and makes tables of the runs' data; the campaign does the rest::
+
+    campaign = Campaign("rover-cosim simulate", runs=3, progress=progress)
+    data = campaign.run("monolithic", system).data
+    record = campaign.record(parameters, fmu_dir=..., fmus=(...), model=..., choice=..., mismatch=None)
+    files = campaign.write(out, {out / "x.csv": ...}, stale=("x_*",))
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Collection, Mapping
+from pathlib import Path
+from typing import Any
+
+from rover_cosim.common.outputs import file_sha256, run_record, write_all
+from rover_cosim.orchestrator.master import run
+from rover_cosim.orchestrator.model import System
+from rover_cosim.orchestrator.recorder import RunResult
+from rover_cosim.orchestrator.runs import system_record
+from rover_cosim.progress import Stages
+from rover_cosim.terramechanics.library import Choice, describe
+
+
+class Campaign:
+    """The runs of one job (``runs``: how many it plans, for the progress) and what they record."""
+
+    def __init__(self, command: str, runs: int, progress: Callable[[float], None] | None = None):
+        self.command = command
+        self.started = time.perf_counter()
+        self.stages = Stages(progress, runs)
+        self.ran: dict[str, System] = {}
+        self.systems: dict[str, Any] = {}
+        self.walls: dict[str, float] = {}
+
+    def run(self, key: str, system: System) -> RunResult:
+        """Run ``system`` (recorded as ``key``) with the next share of the progress."""
+        self.systems[key] = system_record(system)
+        outcome = run(system, progress=self.stages.stage(len(self.ran)))
+        self.ran[key] = system
+        self.walls[key] = outcome.wall_seconds
+        return outcome
+
+    def settings(self) -> dict[str, Any]:
+        """The master's settings of the systems that ran: the algorithm and the step [s], one value
+        where every run shares it, else one per run."""
+        found: dict[str, Any] = {}
+        for name, read in (("algorithm", lambda s: s.algorithm), ("step_s", lambda s: s.step)):
+            values = {key: read(system) for key, system in self.ran.items()}
+            found[name] = next(iter(values.values())) if len(set(values.values())) == 1 else values
+        return found
+
+    def record(self, parameters: Mapping[str, Any], *, fmu_dir: Path, fmus: Collection[str], model: Path,
+               choice: Choice, mismatch: str | None, **results: Any) -> dict[str, Any]:
+        """The job's record: ``parameters`` with the master's settings (``settings``); the FMUs'
+        and the model's SHA-256; the soil and wheel; the systems; the wall times; then ``results``."""
+        record: dict[str, Any] = run_record(self.command, {**parameters, **self.settings()})
+        record.update({"fmus": {name: file_sha256(Path(fmu_dir) / f"{name}.fmu") for name in fmus},
+                       "model_sha256": file_sha256(model), "run_wall_seconds": self.walls, **describe(choice),
+                       "model_mismatch": mismatch, "systems": self.systems,
+                       "wall_seconds": time.perf_counter() - self.started, **results})
+        return record
+
+    def write(self, out: Path, files: Mapping[Path, bytes], stale: Collection[str] = ()) -> list[Path]:
+        """Write ``files`` into the results folder ``out`` as one set (``stale``: patterns of the
+        job's earlier files to remove); the files, sorted."""
+        write_all(files, folder=Path(out), stale=stale)
+        return sorted(files)
