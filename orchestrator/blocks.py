@@ -4,7 +4,9 @@ The interface is small and mirrors an FMU slave at a fixed communication step:
 
 - ``inputs`` and ``outputs``: variable names; ``units``: optional unit per variable (checked
   against the FMU variables a block is connected to);
-- ``start(t0, u0) -> y0``: outputs at the start time, given the inputs there;
+- ``start(t0, u0, h) -> y0``: outputs at the start time, given the inputs there; ``h`` [s] is the
+  run's communication step (a block that discretises a law at the step learns it here; a block
+  written as ``start(t0, u0)`` still runs, without being told);
 - ``step(t, h, u) -> y``: advance from ``t`` to ``t + h`` with the inputs ``u`` (the values the
   master algorithm makes available: at ``t`` for Jacobi, possibly at ``t + h`` for upstream
   participants under Gauss-Seidel) and return the outputs at ``t + h``.
@@ -43,7 +45,7 @@ class Block(Protocol):
     @property
     def units(self) -> Mapping[str, str]: ...
 
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray: ...
+    def start(self, t0: float, u0: np.ndarray, h: float) -> np.ndarray: ...
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray: ...
 
@@ -61,7 +63,7 @@ class Source:
     def value(self, t: float) -> float:
         raise NotImplementedError
 
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
         return np.array([self.value(t0)])
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
@@ -191,7 +193,7 @@ class CsvInput:
         interpolated = self.values[k] + weight * (self.values[k + 1] - self.values[k])
         return np.where(self.held, self.values[k], interpolated)
 
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
         return self.values_at(t0)
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
@@ -218,6 +220,17 @@ def register_factory(factory: str) -> None:
     if not isinstance(factory, str) or ":" not in factory:
         raise ValueError(f"{factory!r}: expected \"module:callable\"")
     REGISTERED_FACTORIES.add(factory)
+
+
+def takes_step(block: object) -> bool:
+    """Whether ``block.start`` takes the communication step (``start(t0, u0, h)``); a block written
+    for the earlier protocol, ``start(t0, u0)``, is started without it."""
+    try:
+        parameters = list(inspect.signature(block.start).parameters.values())  # type: ignore[attr-defined]
+    except (AttributeError, TypeError, ValueError):
+        return False
+    positional = [p for p in parameters if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    return len(positional) >= 3 or any(p.kind == p.VAR_POSITIONAL for p in parameters)
 
 
 def make_block(name: str, kind: str, params: Mapping[str, Any], folder: Path | None = None) -> Block:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .blocks import takes_step
 from .system import Port, System
 
 
@@ -70,7 +71,8 @@ class _Execution:
     def block_values(self, t: float) -> dict[Port, float]:
         outputs: dict[Port, float] = {}
         for name, block in self.blocks.items():
-            values = block.start(t, np.zeros(0))
+            step = (self.system.step,) if takes_step(block) else ()
+            values = block.start(t, np.zeros(0), *step)
             outputs.update({Port(name, o): float(v) for o, v in zip(block.outputs, values)})
         return outputs
 

@@ -89,7 +89,7 @@ def participants_of(system: System, wiring: Wiring,
             fmu.configure(ports.inputs, ports.outputs)
             by_name[entry.name] = fmu
         for block in system.blocks:
-            participant = BlockParticipant(block.name, block.block)
+            participant = BlockParticipant(block.name, block.block, system.step)
             stack.callback(participant.close)
             by_name[block.name] = participant
         yield [by_name[name] for name in system.order]

@@ -34,7 +34,7 @@ from fmpy.fmi2 import (
 )
 from fmpy.fmi3 import FMU3Model, FMU3Slave
 
-from .blocks import Block
+from .blocks import Block, takes_step
 from .fmi_access import Exchange, StringTable, set_by_name
 from .model import FmuEntry, Value
 from .native import NativeBlock, NativeCalls, function_address
@@ -94,9 +94,11 @@ class BlockParticipant:
 
     iterative_start = False
 
-    def __init__(self, name: str, block: Block):
+    def __init__(self, name: str, block: Block, step: float | None = None):
         self.name = name
         self.block = block
+        #: s, the run's communication step, told to a block whose ``start`` takes it
+        self.step = step if takes_step(block) else None
         self.inputs = list(block.inputs)
         self.outputs = list(block.outputs)
         self.last = np.zeros(len(self.outputs))
@@ -154,7 +156,11 @@ class BlockParticipant:
         """Nothing to do: a block starts in ``initial_outputs``."""
 
     def initial_outputs(self, t0: float, u: np.ndarray) -> np.ndarray:
-        self.last = self._call("start", lambda: self.block.start(t0, u), t0)
+        step = self.step
+        if step is not None:
+            self.last = self._call("start", lambda: self.block.start(t0, u, step), t0)
+        else:  # a block of the earlier protocol, start(t0, u0)
+            self.last = self._call("start", lambda: self.block.start(t0, u), t0)  # type: ignore[call-arg]
         return self.last
 
     def exit_initialization(self, t0: float, u: np.ndarray) -> np.ndarray:

@@ -244,7 +244,7 @@ class _LateWithoutTwin:
     def __init__(self) -> None:
         self.t, self.asked = 0.0, 0
 
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+    def start(self, t0: float, u0: np.ndarray, h: float) -> np.ndarray:
         return np.array([20.0])
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:

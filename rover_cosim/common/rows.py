@@ -6,6 +6,8 @@ import csv
 import io
 import math
 import os
+import re
+from collections.abc import Iterable
 
 import numpy as np
 import pandas as pd
@@ -39,3 +41,14 @@ def csv_bytes(table: pd.DataFrame, float_format: str) -> bytes:
     csv.writer(header, lineterminator=os.linesep).writerow([str(c) for c in table.columns])
     row = ",".join([float_format] * table.shape[1]) + os.linesep
     return (header.getvalue() + "".join(row % tuple(line) for line in values.tolist())).encode()
+
+
+def indices(columns: Iterable[str], stem: str) -> range:
+    """The numbers 1..N of the columns ``<stem>[i]`` (recorded data) or ``<stem>_<i>`` (a trajectory
+    table) among ``columns``: the wheels a run had."""
+    columns = list(columns)
+    pattern = re.compile(rf"{re.escape(stem)}(?:\[(\d+)\]|_(\d+))")
+    found = [int(match.group(1) or match.group(2)) for match in map(pattern.fullmatch, columns) if match]
+    if not found:
+        raise ValueError(f"no columns {stem}[i] or {stem}_i among {list(columns)[:8]}...")
+    return range(1, max(found) + 1)

@@ -44,12 +44,13 @@ from typing import Any
 
 import numpy as np
 
+from rover_cosim.common.paper import WHEELS
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.identification.online import Adaptation
 from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.orchestrator import native as native_code
 
-from .controller import WHEELS, InverseModelController
+from .controller import InverseModelController
 from .longitudinal import LongitudinalInverse
 from .path import Path as ReferencePath
 from .path_controller import PathFollowingController
@@ -248,6 +249,9 @@ class AdaptiveController(Calibrating, InverseModelController):
         InverseModelController.__init__(self, name, model, **options)
         if options.get("fixed_load"):
             raise ValueError(f"block {name!r}: fixed_load: the adaptive controller uses the measured loads")
+        if self.wheels != WHEELS:
+            raise ValueError(f"block {name!r}: wheels = {self.wheels!r}: the adaptive controller drives the paper's "
+                             f"rover ({WHEELS} limbs placed by x_limb)")
         self._setup_calibration(adapter, radius, inertia, calibration)
         spins = [f"omega[{i}]" for i in range(1, WHEELS + 1)]
         sinkages = [f"sinkage[{i}]" for i in range(1, WHEELS + 1)] if calibration.sinkage_sensor else []

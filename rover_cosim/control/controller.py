@@ -24,41 +24,40 @@ from pathlib import Path
 
 import numpy as np
 
+from rover_cosim.common.paper import WHEELS
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator import native as native_code
 from rover_cosim.orchestrator.native import doubles
 
 from .longitudinal import LongitudinalInverse, read_model
 
-WHEELS = 6
 #: The block's C twin (same arithmetic, same results), for the native stepper.
 C_SOURCE = Path(__file__).with_name("inverse_controller.c")
 
 
 class InverseModelController:
-    """Orchestrator block: inputs x, v, W[1..6]; outputs tau[1..6], Fx_des[1..6], F_all.
-    ``model``: the identified models (a ModelSet, or the model.json to read)."""
+    """Orchestrator block: inputs x, v, W[1..N]; outputs tau[1..N], Fx_des[1..N], F_all, for a rover of
+    N = ``wheels`` wheels (the job reads N from the plant; the paper's rover has six), each asked
+    for F_all / N (Eq. 16). ``model``: the identified models (a ModelSet, or the model.json to read)."""
 
     def __init__(self, name: str, model: ModelSet | str, mass: float = 1570.0, v_target: float = 1.0, kv: float = 1.0,
                  kp: float = 0.001, a_max: float = 0.1, wn: float = 342.0, step: float = 1e-3,
-                 fixed_load: float | None = None, model_label: str | None = None):
+                 fixed_load: float | None = None, model_label: str | None = None, wheels: int = WHEELS):
         _, self.model, self.model_label = read_model(model, name, model_label)
-        for key, value in (("mass", mass), ("a_max", a_max), ("wn", wn), ("step", step)):
+        for key, value in (("mass", mass), ("a_max", a_max), ("wn", wn), ("step", step), ("wheels", wheels)):
             if not value > 0:
                 raise ValueError(f"block {name!r}: {key} = {value!r}: expected > 0")
-        self.name = name
+        self.name, self.wheels = name, int(wheels)
         self.mass, self.v_target, self.kv, self.kp, self.a_max = mass, v_target, kv, kp, a_max
         self.fixed_load = fixed_load
-        self.inputs = ("x", "v", *[f"W[{i}]" for i in range(1, WHEELS + 1)])
-        self.outputs = (*[f"tau[{i}]" for i in range(1, WHEELS + 1)], *[f"Fx_des[{i}]" for i in range(1, WHEELS + 1)],
-                        "F_all")
-        self.units = {"x": "m", "v": "m/s", "F_all": "N",
-                      **{f"W[{i}]": "N" for i in range(1, WHEELS + 1)},
-                      **{f"tau[{i}]": "N.m" for i in range(1, WHEELS + 1)},
-                      **{f"Fx_des[{i}]": "N" for i in range(1, WHEELS + 1)}}
+        limbs = range(1, self.wheels + 1)
+        self.inputs = ("x", "v", *[f"W[{i}]" for i in limbs])
+        self.outputs = (*[f"tau[{i}]" for i in limbs], *[f"Fx_des[{i}]" for i in limbs], "F_all")
+        self.units = {"x": "m", "v": "m/s", "F_all": "N", **{f"W[{i}]": "N" for i in limbs},
+                      **{f"tau[{i}]": "N.m" for i in limbs}, **{f"Fx_des[{i}]": "N" for i in limbs}}
         self.step_size = step
-        self.inverse = LongitudinalInverse(self.model, WHEELS, wn, step, name)
-        self.torque = np.zeros(WHEELS)
+        self.inverse = LongitudinalInverse(self.model, self.wheels, wn, step, name)
+        self.torque = np.zeros(self.wheels)
 
     # --- the inverse model ----------------------------------------------------------------------
     def slips_for_forces(self, loads: np.ndarray, forces: np.ndarray) -> np.ndarray:
@@ -75,15 +74,24 @@ class InverseModelController:
 
     def _outputs(self, t: float, u: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
         x, v = u[0], u[1]
-        loads = np.full(WHEELS, float(self.fixed_load)) if self.fixed_load else np.asarray(u[2:2 + WHEELS], float)
+        n = self.wheels
+        loads = np.full(n, float(self.fixed_load)) if self.fixed_load else np.asarray(u[2:2 + n], float)
         force_all = self._demand(t, x, v)
-        forces = np.full(WHEELS, force_all / WHEELS)  # Eq. (16)
+        forces = np.full(self.wheels, force_all / self.wheels)  # Eq. (16)
         self.torque = self.inverse.torques(loads, forces, advance, step)
         return np.concatenate([self.torque, forces, [force_all]])
 
     # --- the block interface --------------------------------------------------------------------
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
+        """The outputs at the start; ``h`` [s]: the run's communication step (the law's filter is
+        discretised at it; None: at the ``step`` it was made with)."""
+        if h is not None:
+            self.use_step(h)
         return self._outputs(t0, u0, advance=False)
+
+    def use_step(self, h: float) -> None:
+        """Step at the communication step ``h`` [s]: the law's filter discretised at it."""
+        self.step_size = self.inverse.set_step(h)
 
     def get_state(self) -> tuple[np.ndarray, np.ndarray]:
         """The filter's state and the last torques (for masters that repeat a step)."""
@@ -111,7 +119,7 @@ class InverseModelController:
                     float(self.fixed_load) if self.fixed_load else 0.0]
         loads, torques, settled, log_t, coefficients = inverse.tables()
         component = library.controller_new(
-            WHEELS, len(loads), len(torques), model.degree, doubles(settings), doubles(loads), doubles(torques),
+            self.wheels, len(loads), len(torques), model.degree, doubles(settings), doubles(loads), doubles(torques),
             doubles(settled), doubles(log_t), doubles(coefficients), doubles(inverse.filter_state))
         if not component:
             sizes = f"{len(loads)} loads x {len(torques)} torques"

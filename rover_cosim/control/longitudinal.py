@@ -41,8 +41,8 @@ class LongitudinalInverse:
     exactly for the held step ``step`` [s]."""
 
     def __init__(self, model: IdentifiedModel, wheels: int, wn: float, step: float, name: str = "controller"):
-        self.model, self.name, self.wn, self.step = model, name, wn, step
-        self.ad, self.bd = self.discretised(step)
+        self.model, self.name, self.wn = model, name, wn
+        self.set_step(step)
         self.filter_state = np.zeros((wheels, 2))
         # The tables as plain Python floats (see the module docstring).
         self._inverse = [float(v) for v in 1.0 / np.asarray(model.loads, float)]   # decreasing
@@ -51,6 +51,15 @@ class LongitudinalInverse:
         self._settled = [[float(v) for v in row] for row in np.asarray(model.gain) * model.torques[None, :]]
         self._log_t = [[float(v) for v in row] for row in np.log(np.asarray(model.time_constant, float))]
         self._coefficients = [[float(v) for v in row] for row in model.fx_coefficients]
+
+    def set_step(self, step: float) -> float:
+        """Discretise the filter at the communication step ``step`` [s] (a block learns the run's
+        step at its start); ``step``."""
+        if not (math.isfinite(step) and step > 0):
+            raise ValueError(f"{self.name}: step = {step!r} s: expected a finite step > 0")
+        self.step = step
+        self.ad, self.bd = self.discretised(step)
+        return step
 
     def tables(self) -> tuple[list[float], list[float], list[list[float]], list[list[float]], list[list[float]]]:
         """The law's tables, for the controller's C twin: 1/W of the loads

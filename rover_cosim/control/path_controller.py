@@ -34,6 +34,7 @@ from pathlib import Path as FilePath
 
 import numpy as np
 
+from rover_cosim.common.paper import WHEELS  # the six limbs of the paper's rover, placed by x_limb and y_limb
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator import native as native_code
 from rover_cosim.orchestrator.native import doubles
@@ -42,7 +43,6 @@ from .allocation import allocation_matrix, share
 from .longitudinal import LongitudinalInverse, read_model
 from .path import Path, lane_change_path, turn_path
 
-WHEELS = 6
 PATHS = {"turn": turn_path, "lane_change": lane_change_path}
 MAX_STEER = math.radians(45.0)    # rad: steering range
 MAX_SLIP_ANGLE = math.radians(30.0)  # rad: the lateral model's identified range
@@ -190,8 +190,16 @@ class PathFollowingController:
         torque = self._torques(np.array(loads), fx_des, advance, step)
         return np.concatenate([torque, steer, fx_des, fy_des, signals])
 
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
+        """The outputs at the start; ``h`` [s]: the run's communication step (the law's filter is
+        discretised at it; None: at the ``step`` it was made with)."""
+        if h is not None:
+            self.use_step(h)
         return self._outputs(t0, u0, advance=False)
+
+    def use_step(self, h: float) -> None:
+        """Step at the communication step ``h`` [s]: the law's filter discretised at it."""
+        self.step_size = self.inverse.set_step(h)
 
     def get_state(self) -> tuple[np.ndarray, np.ndarray, int | None]:
         """The filter's state, the last steering and the path index (for masters that repeat a step)."""

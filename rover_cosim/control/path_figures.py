@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.rows import indices
 from rover_cosim.identification.figures import png_bytes
 
 from .path import Path
@@ -46,8 +47,9 @@ def path_xy(paths: dict[str, Path], tables: dict[tuple[str, str], pd.DataFrame])
 def wheels(table: pd.DataFrame, scenario: str) -> bytes:
     """Per wheel against time: Fx with Fx_des, Fy with Fy_des, slip angle and steering, load."""
     fig, axes = plt.subplots(4, 1, figsize=(10, 12), sharex=True)
-    colors = plt.cm.tab10(np.arange(6))
-    for i, color in zip(range(1, 7), colors):
+    numbers = indices(table.columns, "Fz")
+    colors = plt.cm.tab10(np.arange(len(numbers)) % 10)
+    for i, color in zip(numbers, colors):
         axes[0].plot(table["time"], table[f"Fx_{i}"], color=color, lw=1, label=f"wheel {i}")
         axes[0].plot(table["time"], table[f"Fx_des_{i}"], color=color, lw=1, ls="--")
         axes[1].plot(table["time"], table[f"Fy_{i}"], color=color, lw=1, label=f"wheel {i}")

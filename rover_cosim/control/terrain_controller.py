@@ -113,6 +113,12 @@ class TerrainPathController(PathFollowingController):
             raise TypeError(f"block {name!r}: ground_map = {ground_map!r}: expected a HeightMap or None")
         self.terrain, self.g, self.ground_map = terrain, float(g), ground_map
 
+    def use_step(self, h: float) -> None:
+        """Step at ``h`` [s]: both soils' filters discretised at it."""
+        super().use_step(h)
+        if self.soil_map is not None:
+            self.inverse_b.set_step(h)
+
     @property
     def plain(self) -> bool:
         """Level ground without a map: nothing to feed forward."""

@@ -21,6 +21,7 @@ import pandas as pd
 
 from rover_cosim.common.figures import render
 from rover_cosim.common.outputs import json_bytes, run_record, summary_repr, write_all
+from rover_cosim.common.rows import indices
 from rover_cosim.orchestrator import algorithms
 from rover_cosim.orchestrator.builder import replace_settings
 from rover_cosim.orchestrator.examples import example
@@ -63,8 +64,9 @@ def coupling_errors(fmu_dir: Path, steps: tuple[float, ...] = STEPS, stop_time: 
                         progress=stages.stage(2 * k + 1))
         cosim = cosim_run.data
         dv = (cosim["body.v"] - mono["rover.v"]).to_numpy()
-        dfz = np.max([np.abs(cosim[f"wheel{i}.Fz"] - mono[f"rover.Fz[{i}]"]).max() for i in range(1, 7)])
-        dfx = np.max([np.abs(cosim[f"wheel{i}.Fx"] - mono[f"rover.Fx[{i}]"]).max() for i in range(1, 7)])
+        wheels = indices(mono.columns, "rover.Fz")
+        dfz = np.max([np.abs(cosim[f"wheel{i}.Fz"] - mono[f"rover.Fz[{i}]"]).max() for i in wheels])
+        dfx = np.max([np.abs(cosim[f"wheel{i}.Fx"] - mono[f"rover.Fx[{i}]"]).max() for i in wheels])
         rows.append({
             "algorithm": algorithm,
             "step_s": step,

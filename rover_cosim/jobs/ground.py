@@ -25,7 +25,6 @@ from rover_cosim.orchestrator import native as native_code
 from rover_cosim.orchestrator.native import doubles
 from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, hub_positions
 
-WHEELS = 6
 #: The participants' C twins (the laws of terramechanics/height_map.h, soil_map.h), for the native stepper.
 GROUND_C_SOURCE = Path(__file__).with_name("ground_block.c")
 SOIL_C_SOURCE = Path(__file__).with_name("soil_block.c")
@@ -72,7 +71,7 @@ class _HubBlock:
             raise MemoryError(f"block {self.name!r}: its C twin could not be made (bad sizes or out of memory)")
         return native_code.NativeBlock(library, component, prefix)
 
-    def start(self, t0: float, u0: np.ndarray) -> np.ndarray:
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
         self.last = self.values(u0)
         return self.last
 
@@ -92,11 +91,11 @@ class GroundBlock(_HubBlock):
         super().__init__(name, height_map, x_limb, y_limb)
         self.map: HeightMap
         self.inputs: tuple[str, ...] = BODY
-        self.outputs: tuple[str, ...] = tuple(f"{s}[{i}]" for s in SIGNALS for i in range(1, WHEELS + 1))
+        self.outputs: tuple[str, ...] = tuple(f"{s}[{i}]" for s in SIGNALS for i in range(1, len(self.x_hub) + 1))
         units = {"groundHeight": "m", "groundHeightRate": "m/s", "groundGradientAlong": "1",
                  "groundGradientLateral": "1"}
         self.units = {"x": "m", "y": "m", "yaw": "rad", "v": "m/s", "vy": "m/s", "yawRate": "rad/s",
-                      **{f"{s}[{i}]": units[s] for s in SIGNALS for i in range(1, WHEELS + 1)}}
+                      **{f"{s}[{i}]": units[s] for s in SIGNALS for i in range(1, len(self.x_hub) + 1)}}
 
     def ground(self, u: np.ndarray) -> np.ndarray:
         """The outputs for the body state ``u`` (the inputs)."""
@@ -132,7 +131,7 @@ class SoilBlock(_HubBlock):
         super().__init__(name, soil_map, x_limb, y_limb)
         self.map: SoilMap
         self.inputs: tuple[str, ...] = BODY[:3]
-        self.outputs: tuple[str, ...] = tuple(f"soilShare[{i}]" for i in range(1, WHEELS + 1))
+        self.outputs: tuple[str, ...] = tuple(f"soilShare[{i}]" for i in range(1, len(self.x_hub) + 1))
         self.units = {"x": "m", "y": "m", "yaw": "rad", **{name: "1" for name in self.outputs}}
 
     def shares(self, u: np.ndarray) -> np.ndarray:

@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import json_bytes, summary_repr
-from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
+from rover_cosim.common.rows import csv_bytes, every, indices, steps_between_rows
 from rover_cosim.control import path_figures
 from rover_cosim.control.adaptive import AdaptivePathController, Calibration
 from rover_cosim.control.path import Path as ReferencePath
@@ -47,11 +47,10 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice
 
 from .campaign import Campaign
-from .plants import add_plant_fmu, add_rover
+from .plants import add_plant_fmu, add_rover, hubs
 from .simulate import RECORD_INTERVAL, adapter_for, checked_models, connect_telemetry, models_of, soil_and_wheel_of
 
 STEP = 1e-3  # s
-WHEELS = range(1, 7)
 SCENARIOS = {"turn": 0.5, "lane_change": 1.0}  # path -> target speed [m/s]
 STRAIGHT = 10.0  # m, the straights before and after each path's curve
 BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
@@ -88,14 +87,15 @@ def stop_time(scenario: str, straight: float = STRAIGHT) -> float:
 def controller(models: ModelSet, scenario: str, steering: str, straight: float = STRAIGHT) -> PathFollowingController:
     """The path-following controller block ``ctrl`` of ``scenario``."""
     return PathFollowingController("ctrl", models, path=scenario_path(scenario, straight),
-                                   v_target=SCENARIOS[scenario], steering=steering, step=STEP)
+                                   v_target=SCENARIOS[scenario], steering=steering)
 
 
-def connect_controller(builder: SystemBuilder, body: str, wheel: Any) -> None:
-    """Body state, loads and slip angles to the controller (``wheel(i, name)``: a wheel output)."""
+def connect_controller(builder: SystemBuilder, body: str, wheel: Any, wheels: range) -> None:
+    """Body state, loads and slip angles to the controller (``wheel(i, name)``: an output of wheel
+    ``i`` of ``wheels``)."""
     for name in BODY:
         builder.connect(f"{body}.{name}", f"ctrl.{name}")
-    for i in WHEELS:
+    for i in wheels:
         builder.connect(wheel(i, "Fz"), f"ctrl.W[{i}]").connect(wheel(i, "slipAngle"), f"ctrl.slipAngle[{i}]")
 
 
@@ -111,11 +111,12 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, stee
     """``scenario`` on SteerableRover.fmu, started rolling at its speed."""
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} ({steering})", scenario, straight)
-    start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
+    wheels = hubs(Path(fmu_dir) / "SteerableRover.fmu")
+    start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in wheels}}
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
     builder.add_block("ctrl", controller(models_of(model), scenario, steering, straight))
-    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
-    for i in WHEELS:
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", wheels)
+    for i in wheels:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
     return builder.build()
 
@@ -131,16 +132,17 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice
     wheel = soil_and_wheel_of(models)[1]
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} (adaptive)", scenario, straight)
-    start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in WHEELS}}
+    wheels = hubs(Path(fmu_dir) / "SteerableRover.fmu")
+    start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in wheels}}
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
     block = AdaptivePathController("ctrl", models, adapter_for(models, fmu_dir, cache_dir, lateral=True),
                                    radius=wheel.r, inertia=wheel.J, calibration=calibration,
-                                   path=scenario_path(scenario, straight), v_target=speed, step=STEP)
+                                   path=scenario_path(scenario, straight), v_target=speed)
     builder.add_block("ctrl", block)
-    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
-    for i in WHEELS:
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", wheels)
+    for i in wheels:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
-    connect_telemetry(builder, "rover", calibration, ("pitch", "roll"))
+    connect_telemetry(builder, "rover", calibration, ("pitch", "roll"), wheels)
     return builder.build()
 
 
@@ -154,11 +156,12 @@ def cosim_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: C
     steerable_rover_cosim.toml), started rolling at its speed, the controller first in the order."""
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} (cosim)", scenario, straight)
-    wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(WHEELS),
+    limbs = hubs(Path(fmu_dir) / "SteerableRoverBody.fmu")
+    wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(limbs),
                        choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": speed / _radius(choice)})
     builder.add_block("ctrl", controller(models_of(model), scenario, "inverse", straight))
-    connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
-    for i, wheel in zip(WHEELS, wheels):
+    connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}", limbs)
+    for i, wheel in zip(limbs, wheels):
         builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
         builder.connect(f"ctrl.steer[{i}]", f"body.steer[{i}]")
     return builder.simulation(order=["ctrl", "body", *wheels]).build()
@@ -175,7 +178,7 @@ def trajectories(data: pd.DataFrame, cosim: bool) -> pd.DataFrame:
 
     table = {"time": data["time"], **{name: data[f"{body}.{name}"] for name in BODY}}
     table.update({name: data[f"ctrl.{name}"] for name in ("s", "s_ref", "cross_track", "heading_error")})
-    for i in WHEELS:
+    for i in indices(data.columns, "ctrl.tau"):
         table.update({f"{name}_{i}": data[wheel(i, name)] for name in PER_WHEEL})
     return pd.DataFrame(table)
 
@@ -185,9 +188,10 @@ def metrics(table: pd.DataFrame, speed: float) -> dict[str, float]:
     row = {"cross_track_rms_m": float(np.sqrt(np.mean(table["cross_track"] ** 2))),
            "cross_track_max_m": float(np.abs(table["cross_track"]).max()),
            "speed_error_max_percent": float(100 * np.abs(np.hypot(table["v"], table["vy"]) - speed).max() / speed)}
-    for i in WHEELS:
+    wheels = indices(table.columns, "Fx_des")
+    for i in wheels:
         row[f"rms_Fx_{i}_N"] = float(np.sqrt(np.mean((table[f"Fx_{i}"] - table[f"Fx_des_{i}"]) ** 2)))
-    for i in WHEELS:
+    for i in wheels:
         row[f"rms_Fy_{i}_N"] = float(np.sqrt(np.mean((table[f"Fy_{i}"] - table[f"Fy_des_{i}"]) ** 2)))
     return row
 
@@ -195,10 +199,11 @@ def metrics(table: pd.DataFrame, speed: float) -> dict[str, float]:
 def agreement(mono: pd.DataFrame, cosim: pd.DataFrame, speed: float) -> dict[str, float]:
     """Monolithic against co-simulated: speed [% of the target], loads [% of the static load],
     path [m] (largest distance between the two positions at the same time)."""
-    static = float(np.mean([mono[f"Fz_{i}"].iloc[0] for i in WHEELS]))
+    wheels = indices(mono.columns, "Fz")
+    static = float(np.mean([mono[f"Fz_{i}"].iloc[0] for i in wheels]))
     return {"speed_max_difference_percent": float(100 * np.abs(mono["v"] - cosim["v"]).max() / speed),
             "load_max_difference_percent": float(100 * max(np.abs(mono[f"Fz_{i}"] - cosim[f"Fz_{i}"]).max()
-                                                           for i in WHEELS) / static),
+                                                           for i in wheels) / static),
             "path_max_difference_m": float(np.hypot(mono["x"] - cosim["x"], mono["y"] - cosim["y"]).max())}
 
 

@@ -10,7 +10,9 @@ force ``Fy``).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
+from functools import cache
 from pathlib import Path
 
 from rover_cosim.orchestrator.builder import SystemBuilder
@@ -59,3 +61,27 @@ def add_rover(builder: SystemBuilder, body_fmu: str | Path, wheel_fmu: str | Pat
     if wire:
         wire_hubs(builder, body, names, lateral=lateral)
     return names
+
+
+def hubs(fmu: str | Path) -> range:
+    """The hub numbers 1..N of a rover FMU (Rover, RoverBody, SteerableRover, SteerableRoverBody):
+    N is the largest index of its indexed variables (``tau[i]``, ``Fz[i]``, ``W[i]``, ...), so the
+    number of wheels comes from the model, not from a constant of ours."""
+    path = Path(fmu)
+    return range(1, _largest_index(str(path.resolve()), path.stat().st_mtime_ns) + 1)
+
+
+@cache
+def _largest_index(path: str, mtime_ns: int) -> int:
+    from fmpy import read_model_description
+
+    names = (variable.name for variable in read_model_description(path).modelVariables)
+    found = [int(match.group(1)) for match in map(_INDEXED.fullmatch, names) if match]
+    if not found:
+        raise ValueError(f"{path}: no indexed variables (tau[i], Fz[i], ...): expected a rover FMU with a hub per "
+                         "wheel")
+    return max(found)
+
+
+#: An indexed variable's name: ``name[i]``.
+_INDEXED = re.compile(r"[A-Za-z_]\w*\[(\d+)\]")

@@ -22,8 +22,8 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import json_bytes, summary_repr
-from rover_cosim.common.paper import STATIC_WHEEL_LOAD, WHEELS
-from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
+from rover_cosim.common.paper import STATIC_WHEEL_LOAD
+from rover_cosim.common.rows import csv_bytes, every, indices, steps_between_rows
 from rover_cosim.control.adaptive import AdaptiveController, Calibration
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
@@ -36,13 +36,12 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, choose
 
 from .campaign import Campaign
-from .plants import add_plant_fmu, add_rover, wire_hub
+from .plants import add_plant_fmu, add_rover, hubs, wire_hub
 
 STOP_TIME = 20.0  # s
 STEP = 1e-3       # s
 #: s, the rows the trajectory files keep by default (the runs step at STEP; metrics use every step)
 RECORD_INTERVAL = 1e-2
-LIMBS = range(1, WHEELS + 1)
 STATIC_LOAD = STATIC_WHEEL_LOAD  # N, the fixed load of the ablation
 
 
@@ -73,8 +72,9 @@ def models_of(model: ModelSet | Path) -> ModelSet:
 
 
 def controller(models: ModelSet, **options: Any) -> InverseModelController:
-    """The paper's controller block ``ctrl`` at the run's step (``options``: its keyword arguments)."""
-    return InverseModelController("ctrl", models, **{"step": STEP, **options})
+    """The paper's controller block ``ctrl`` (``options``: its keyword arguments); the run tells it
+    its step at the start."""
+    return InverseModelController("ctrl", models, **options)
 
 
 def _closed_loop(name: str) -> SystemBuilder:
@@ -84,10 +84,11 @@ def _closed_loop(name: str) -> SystemBuilder:
 def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
     """The closed loop on Rover.fmu (``options``: the controller's keyword arguments)."""
     builder = _closed_loop("closed loop (monolithic)")
+    limbs = hubs(Path(fmu_dir) / "Rover.fmu")
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
-    builder.add_block("ctrl", controller(models_of(model), **options))
+    builder.add_block("ctrl", controller(models_of(model), **{"wheels": len(limbs), **options}))
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
-    for i in LIMBS:
+    for i in limbs:
         builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
     return builder.build()
 
@@ -132,21 +133,22 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
     builder = _closed_loop("closed loop (adaptive)")
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
     block = AdaptiveController("ctrl", models, adapter, radius=wheel.r, inertia=wheel.J,
-                               calibration=calibration, **{"step": STEP, **options})
+                               calibration=calibration, **options)
     builder.add_block("ctrl", block)
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
-    for i in LIMBS:
+    for i in hubs(Path(fmu_dir) / "Rover.fmu"):
         builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
-    connect_telemetry(builder, "rover", calibration, ("pitch",))
+    connect_telemetry(builder, "rover", calibration, ("pitch",), hubs(Path(fmu_dir) / "Rover.fmu"))
     return builder.build()
 
 
-def connect_telemetry(builder: SystemBuilder, plant: str, calibration: Calibration, angles: tuple[str, ...]) -> None:
+def connect_telemetry(builder: SystemBuilder, plant: str, calibration: Calibration, angles: tuple[str, ...],
+                      limbs: range) -> None:
     """The telemetry of an adaptive controller ``ctrl`` from the monolithic ``plant``: the body's
-    ``angles``, each wheel's spin, and its sinkage where the rover has a sensor."""
+    ``angles``, each wheel's (of ``limbs``) spin, and its sinkage where the rover has a sensor."""
     for angle in angles:
         builder.connect(f"{plant}.{angle}", f"ctrl.{angle}")
-    for i in LIMBS:
+    for i in limbs:
         builder.connect(f"{plant}.omega[{i}]", f"ctrl.omega[{i}]")
         if calibration.sinkage_sensor:
             builder.connect(f"{plant}.sinkage[{i}]", f"ctrl.sinkage[{i}]")
@@ -155,11 +157,12 @@ def connect_telemetry(builder: SystemBuilder, plant: str, calibration: Calibrati
 def cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
     """The closed loop on RoverBody + 6 Wheel (``options``: the controller's keyword arguments)."""
     builder = _closed_loop("closed loop (cosim)")
-    wheels = add_rover(builder, Path(fmu_dir) / "RoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", WHEELS, choice,
+    limbs = hubs(Path(fmu_dir) / "RoverBody.fmu")
+    wheels = add_rover(builder, Path(fmu_dir) / "RoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(limbs), choice,
                        wire=False)
-    builder.add_block("ctrl", controller(models_of(model), **options))
+    builder.add_block("ctrl", controller(models_of(model), **{"wheels": len(limbs), **options}))
     builder.connect("body.x", "ctrl.x").connect("body.v", "ctrl.v")
-    for i, wheel in zip(LIMBS, wheels):
+    for i, wheel in zip(limbs, wheels):
         wire_hub(builder, "body", wheel, i)
         builder.connect(f"body.W[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"{wheel}.tau")
         builder.connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
@@ -173,7 +176,7 @@ def trajectories(data: pd.DataFrame, plant: str) -> pd.DataFrame:
     else:
         body, wheel = "body", lambda i, name: f"wheel{i}.{name}"
     table = {"time": data["time"], "x": data[f"{body}.x"], "v": data[f"{body}.v"]}
-    for i in LIMBS:
+    for i in indices(data.columns, "ctrl.tau"):
         table[f"tau_{i}"] = data[f"ctrl.tau[{i}]"]
         for name in ("Tx", "Fz", "sinkage", "slip", "Fx"):
             table[f"{name}_{i}"] = data[wheel(i, name)]
@@ -182,9 +185,10 @@ def trajectories(data: pd.DataFrame, plant: str) -> pd.DataFrame:
 
 
 def rms(table: pd.DataFrame) -> pd.DataFrame:
-    return pd.DataFrame({"limb": list(LIMBS),
+    limbs = indices(table.columns, "Fx_des")
+    return pd.DataFrame({"limb": list(limbs),
                          "rms_N": [float(np.sqrt(np.mean((table[f"Fx_{i}"] - table[f"Fx_des_{i}"]) ** 2)))
-                                   for i in LIMBS]})
+                                   for i in limbs]})
 
 
 #: What ``checks`` measures of a run: its key -> (label with unit, format).
@@ -263,7 +267,7 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
                       "rms_after_calibration_nominal_model_N":
                           rms(tables["monolithic"][tables["monolithic"]["time"] >= adapt.duration])["rms_N"].tolist()}
     rms_mono, rms_cosim = rms(tables["monolithic"]), rms(tables["cosim"])
-    ablation_table = pd.DataFrame({"limb": list(LIMBS), "rms_lut_N": rms_mono["rms_N"],
+    ablation_table = pd.DataFrame({"limb": rms_mono["limb"], "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})
     record = campaign.record({"stop_time_s": STOP_TIME, "model": str(model), "record_interval_s": record_interval,
                               "fixed_load_ablation_N": STATIC_LOAD},

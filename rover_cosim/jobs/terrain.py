@@ -66,7 +66,7 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes
-from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
+from rover_cosim.common.rows import csv_bytes, every, indices, steps_between_rows
 from rover_cosim.control.path import Line
 from rover_cosim.control.path import Path as ReferencePath
 from rover_cosim.control.terrain_controller import TerrainPathController
@@ -82,9 +82,9 @@ from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, crater, soil_
 from . import terrain_figures
 from .campaign import Campaign
 from .ground import SIGNALS, GroundBlock, SoilBlock
-from .path_following import BODY, STEP, WHEELS, PathResult, agreement, connect_controller, trajectories
+from .path_following import BODY, STEP, PathResult, agreement, connect_controller, trajectories
 from .path_following import metrics as path_metrics
-from .plants import add_plant_fmu, add_rover
+from .plants import add_plant_fmu, add_rover, hubs
 from .simulate import RECORD_INTERVAL, checked_models, models_of
 
 SPEED = 0.3          # m/s, the traverse's target speed
@@ -324,27 +324,29 @@ def _radius(choice: Choice | None) -> float:
     return (choice.wheel if choice else Wheel()).r
 
 
-def _add_ground(builder: SystemBuilder, body: str, height_map: HeightMap | None) -> list[str]:
-    """The ground participant on ``body``'s hubs (none without a map); its name in a list."""
+def _add_ground(builder: SystemBuilder, body: str, height_map: HeightMap | None, hubs: range) -> list[str]:
+    """The ground participant on ``body``'s ``hubs`` (none without a map); its name in a list."""
     if height_map is None:
         return []
     builder.add_block("ground", GroundBlock("ground", height_map))
     for name in BODY:
         builder.connect(f"{body}.{name}", f"ground.{name}")
     for signal in SIGNALS:
-        for i in WHEELS:
+        for i in hubs:
             builder.connect(f"ground.{signal}[{i}]", f"{body}.{signal}[{i}]")
     return ["ground"]
 
 
-def _add_soil(builder: SystemBuilder, body: str, soil_map: SoilMap | None, share_of: Callable[[int], str]) -> list[str]:
-    """The soil participant on ``body``'s hubs (none without a map) feeding ``share_of(i)``; its name in a list."""
+def _add_soil(builder: SystemBuilder, body: str, soil_map: SoilMap | None, share_of: Callable[[int], str],
+              hubs: range) -> list[str]:
+    """The soil participant on ``body``'s ``hubs`` (none without a map) feeding ``share_of(i)``; its
+    name in a list."""
     if soil_map is None:
         return []
     builder.add_block("soil", SoilBlock("soil", soil_map))
     for name in BODY[:3]:
         builder.connect(f"{body}.{name}", f"soil.{name}")
-    for i in WHEELS:
+    for i in hubs:
         builder.connect(f"soil.soilShare[{i}]", share_of(i))
     return ["soil"]
 
@@ -384,35 +386,37 @@ def traverse_system(fmu_dir: Path, model: ModelSet | Path, terrain: PlaneTerrain
     spin = speed / _radius(choice)
     believes_soil = soil_map is not None and run_ in ("inverse", "cosim")
     block = TerrainPathController("ctrl", models_of(model), path=traverse_path(length), v_target=speed,
-                                    steering="kinematic" if run_ == "kinematic" else "inverse", step=STEP,
+                                    steering="kinematic" if run_ == "kinematic" else "inverse",
                                     terrain=None if run_ == "unaware" and soil_map is None else terrain, g=G,
                                     mass=MASS, ground_map=height_map if run_ in ("inverse", "cosim") else None,
                                     soil_map=soil_map if believes_soil else None,
                                     model_b=model_b if believes_soil else None)
     soil_b = soil_parameters(soil_map.soil_b, "soilB") if soil_map is not None else {}
     if run_ == "cosim":
+        limbs = hubs(Path(fmu_dir) / "SteerableRoverBody.fmu")
         wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu",
-                           len(WHEELS), choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": spin})
+                           len(limbs), choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": spin})
         builder.set_parameters("body", terrain.fmu_parameters())
         builder.add_block("ctrl", block)
-        connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}")
-        for i, wheel in zip(WHEELS, wheels):
+        connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}", limbs)
+        for i, wheel in zip(limbs, wheels):
             builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
             builder.connect(f"ctrl.steer[{i}]", f"body.steer[{i}]")
             if soil_b:
                 builder.set_parameters(wheel, soil_b)
-        ground = _add_ground(builder, "body", height_map)
-        soil = _add_soil(builder, "body", soil_map, lambda i: f"{wheels[i - 1]}.soilShare")
+        ground = _add_ground(builder, "body", height_map, limbs)
+        soil = _add_soil(builder, "body", soil_map, lambda i: f"{wheels[i - 1]}.soilShare", limbs)
         return builder.simulation(order=["ctrl", "body", *ground, *soil, *wheels]).build()
+    limbs = hubs(Path(fmu_dir) / "SteerableRover.fmu")
     add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice,
-                  {"v": speed, **{f"omega[{i}]": spin for i in WHEELS}})
+                  {"v": speed, **{f"omega[{i}]": spin for i in limbs}})
     builder.set_parameters("rover", {**terrain.fmu_parameters(), **soil_b})
     builder.add_block("ctrl", block)
-    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]")
-    for i in WHEELS:
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", limbs)
+    for i in limbs:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
-    ground = _add_ground(builder, "rover", height_map)
-    soil = _add_soil(builder, "rover", soil_map, lambda i: f"rover.soilShare[{i}]")
+    ground = _add_ground(builder, "rover", height_map, limbs)
+    soil = _add_soil(builder, "rover", soil_map, lambda i: f"rover.soilShare[{i}]", limbs)
     if ground or soil:
         builder.simulation(order=["ctrl", "rover", *ground, *soil])
     return builder.build()
@@ -420,7 +424,7 @@ def traverse_system(fmu_dir: Path, model: ModelSet | Path, terrain: PlaneTerrain
 
 def motor_energy(table: pd.DataFrame) -> float:
     """J: the motors' work on the wheels, the time integral of sum_i tau_i omega_i (trapezoid)."""
-    power = sum(table[f"tau_{i}"].to_numpy() * table[f"omega_{i}"].to_numpy() for i in WHEELS)
+    power = sum(table[f"tau_{i}"].to_numpy() * table[f"omega_{i}"].to_numpy() for i in indices(table.columns, "tau"))
     return float(np.trapezoid(power, table["time"].to_numpy()))
 
 
@@ -433,7 +437,7 @@ def metrics(table: pd.DataFrame, speed: float = SPEED) -> dict[str, float]:
     row["heading_error_max_rad"] = float(np.abs(table["heading_error"]).max())
     steady = table[table["time"] >= table["time"].iloc[-1] / 2]
     for name, unit in (("slip", "1"), ("slipAngle", "rad"), ("sinkage", "m"), ("Fz", "N")):
-        for i in WHEELS:
+        for i in indices(table.columns, name):
             row[f"mean_{name}_{i}_{unit}"] = float(steady[f"{name}_{i}"].mean())
     distance = float(table["s"].iloc[-1] - table["s"].iloc[0])
     row["energy_per_metre_J_m"] = motor_energy(table) / distance if distance > 0 else math.nan

@@ -11,6 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.rows import indices
 from rover_cosim.control.path import Path
 from rover_cosim.identification.figures import png_bytes
 
@@ -85,10 +86,11 @@ def wheels(tables: dict[str, pd.DataFrame], scenario: str) -> bytes:
     names = (("slip", "slip [-]", 1.0), ("slipAngle", "slip angle [deg]", 180 / np.pi),
              ("sinkage", "sinkage [mm]", 1000.0), ("Fz", "load Fz [N]", 1.0), ("Fy", "lateral force Fy [N]", 1.0))
     fig, axes = plt.subplots(len(names), 1, figsize=(10, 14), sharex=True)
-    colors = plt.cm.tab10(np.arange(6))
     for label, table in tables.items():
+        numbers = indices(table.columns, "Fz")
+        colors = plt.cm.tab10(np.arange(len(numbers)) % 10)
         for ax, (name, _, scale) in zip(axes, names):
-            for i, color in zip(range(1, 7), colors):
+            for i, color in zip(numbers, colors):
                 ax.plot(table["time"], scale * table[f"{name}_{i}"], STYLES[label], color=color, lw=1,
                         label=f"wheel {i}" if label == next(iter(tables)) else None)
     for ax, (_, ylabel, _) in zip(axes, names):
