@@ -20,10 +20,13 @@ BACKEND ?= auto
 SOIL ?= paper
 WHEEL ?= paper
 SOIL_OPTIONS := --soil $(SOIL) --wheel $(WHEEL)
-FMU_NAMES := SingleWheel Rover RoverBody Wheel SteerableRover SteerableRoverBody
+# The FMUs are the classes of modelica/RoverTerramechanics/FMUs (its package.order): build-fmus without
+# names builds them all; FMUS=Wheel,Rover (space- or comma-separated) builds some.
+FMUS ?=
 # binaries/ folders of the FMUs: host (this machine's, by cc), all (linux64 for glibc 2.17, win64,
 # darwin64, aarch64-linux, aarch64-darwin; cross-compiled by zig from PyPI) or a comma-separated list.
 PLATFORMS ?= host
+comma := ,
 
 # The virtualenv is (re)installed when pyproject.toml changes; the stamp records success.
 $(STAMP): pyproject.toml
@@ -46,11 +49,11 @@ fig3: $(STAMP)
 ## fmus: FMI 2.0 FMUs (ME + CS) of the Modelica models -> fmus/*.fmu (skipped when up to date);
 ## PLATFORMS=all adds the binaries of every host (see PLATFORMS above)
 fmus: $(STAMP)
-	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) --platforms $(PLATFORMS) $(FMU_NAMES)
+	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) --platforms $(PLATFORMS) $(subst $(comma), ,$(FMUS))
 
 ## fmus3: the same models as FMI 3.0 FMUs (ME + CS) -> fmus/fmi3/*.fmu (PLATFORMS as for fmus)
 fmus3: $(STAMP)
-	$(VENV)/bin/rover-cosim build-fmus --out fmus/fmi3 --backend builtin --fmi-version 3 --platforms $(PLATFORMS) $(FMU_NAMES)
+	$(VENV)/bin/rover-cosim build-fmus --out fmus/fmi3 --backend builtin --fmi-version 3 --platforms $(PLATFORMS) $(subst $(comma), ,$(FMUS))
 
 ## identify: paper Sec. 3 (sweep on SingleWheel.fmu, LUT, Fx fits, Table 1) -> results/identification/
 identify: fmus

@@ -82,3 +82,30 @@ def test_the_modelica_records_declare_the_ranges_of_the_python_table():
                               float(found["max"]) if "max" in found else None)
     for field, bounds in RANGES.items():
         assert declared[MODELICA_NAMES.get(field, field)] == bounds, field
+
+
+def test_the_soil_record_is_the_python_soil_and_the_wheel_blends_every_field():
+    """One table of soil fields: terramechanics.Soil. The Modelica record SoilParameters declares the
+    same fields in the same order, with the units of parameters.UNITS, and RigidWheel blends each of
+    them, once, as (1 - soilShare) soil.F + soilShare soilB.F (the exporter cannot yet translate a
+    function returning a record, so the blend is written field by field there: this test is what
+    keeps it whole when a field is added)."""
+    import re
+    from dataclasses import fields
+    from pathlib import Path
+
+    from rover_cosim.terramechanics import Soil
+    from rover_cosim.terramechanics.library import MODELICA_NAMES
+    from rover_cosim.terramechanics.parameters import UNITS
+
+    package = Path(__file__).resolve().parents[1] / "modelica" / "RoverTerramechanics"
+    record = (package / "Parameters" / "SoilParameters.mo").read_text()
+    declared = re.findall(r"parameter Real (\w+)\(unit=\"([^\"]*)\"", record)
+    python = [MODELICA_NAMES.get(f.name, f.name) for f in fields(Soil)]
+    assert [name for name, _ in declared] == python
+    modelica_units = {"N/m^(n+1)": "N/m2", "N/m^(n+2)": "N/m3", "kg/m^3": "kg/m3", "m/s^2": "m/s2"}
+    for field, (name, unit) in zip(fields(Soil), declared):
+        assert modelica_units.get(UNITS[field.name], UNITS[field.name]) == unit, name
+    wheel = (package / "Components" / "RigidWheel.mo").read_text()
+    blended = re.findall(r"(\w+)=\(1 - soilShare\)\*soil\.(\w+) \+ soilShare\*soilB\.(\w+)", wheel)
+    assert sorted(blended) == sorted((name, name, name) for name in python)

@@ -77,13 +77,21 @@ def test_fmu_models_translate_with_their_interfaces(name: str, inputs: list[str]
 FMU_VARIABLES = json.loads((Path(__file__).parent / "fmu_variables.json").read_text())
 
 
+def public_variables(name: str) -> list[list[str]]:
+    """The FMU ``name``'s parameters, inputs and outputs as [name, causality, variability], in the
+    order of its value references."""
+    layout = codegen.layout(translate(source.load(source.fmu_class(name)), name))
+    return [[v.name, v.causality, v.variability] for v in layout.variables
+            if v.causality in ("parameter", "input", "output")]
+
+
 @pytest.mark.parametrize("name", build.FMU_MODELS)
 def test_the_public_variables_of_each_fmu_are_those_it_always_had(name: str):
     """What a user of the FMU sees by name: the exporter's variable layout (the model description's
     ModelVariables) of the class the FMU is built from, against the captured list."""
-    layout = codegen.layout(translate(source.load(source.fmu_class(name)), name))
-    public = [[v.name, v.causality, v.variability] for v in layout.variables
-              if v.causality in ("parameter", "input", "output")]
+    public = public_variables(name)
+    assert name in FMU_VARIABLES, (f"{name}: a new FMU, its variables not pinned yet: pin them with "
+                                   f"`python tests/test_translate.py {name}` (writes tests/fmu_variables.json)")
     expected = FMU_VARIABLES[name]
     missing = [v for v in expected if v not in public]
     added = [v for v in public if v not in expected]
@@ -136,3 +144,16 @@ def test_unsupported_constructs_get_a_clear_error_naming_the_source_line(case: s
     assert expected in message
     assert "omc" in message
     assert "Bad.mo:" in message
+
+
+if __name__ == "__main__":  # `python tests/test_translate.py NAME...`: pin the variables of new FMUs
+    import sys
+
+    for new in sys.argv[1:]:
+        if new in FMU_VARIABLES:
+            sys.exit(f"{new}: already pinned; a change of its variables is a change of its interface: edit the "
+                     "pin deliberately, and say so in the CHANGELOG")
+        FMU_VARIABLES[new] = public_variables(new)
+    pins = [f"  {json.dumps(name)}: [\n" + ",\n".join(f"    {json.dumps(v)}" for v in variables) + "\n  ]"
+            for name, variables in FMU_VARIABLES.items()]
+    (Path(__file__).parent / "fmu_variables.json").write_text("{\n" + ",\n".join(pins) + "\n}\n")
