@@ -36,8 +36,9 @@ from rover_cosim.terramechanics.library import Choice, choose, describe
 
 from . import figures
 from .metrics import RMS_FLOOR
-from .runs import EXTRA_FMUS, FMUS, RunSpec, cache_key, compute_run, fingerprint, nominal_values, read_cached, split
+from .runs import RunSpec, cache_key, compute_run, fingerprint, nominal_values, read_cached, split
 from .sampling import sample_table
+from .scenarios import RUN_SCENARIOS
 from .sensitivity import OUTPUTS, sensitivity
 from .study import ADAPTED, Study
 
@@ -240,7 +241,7 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     if not model.is_file():
         raise FileNotFoundError(f"identified model {model} not found (make it with `rover-cosim identify`)")
     for scenario in study.scenarios:
-        for name in (FMUS[scenario], *EXTRA_FMUS.get(scenario, ())):
+        for name in RUN_SCENARIOS[scenario].fmus:
             if not (fmu_dir / name).is_file():
                 raise FileNotFoundError(f"FMU {fmu_dir / name} not found (build them with `rover-cosim build-fmus`)")
     study.check_calibration()
@@ -252,7 +253,7 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
                             f"{study.wheel})")
     if samples is None:
         samples = sample_table(study, nominal_values(study, nominal_choice, fmu_dir))
-    names = sorted({*FMUS.values(), *(n for extra in EXTRA_FMUS.values() for n in extra)})
+    names = sorted({name for scenario in RUN_SCENARIOS.values() for name in scenario.fmus})
     hashes = fingerprint({name: file_sha256(fmu_dir / name) for name in names if (fmu_dir / name).is_file()},
                          file_sha256(model), nominal_choice)
     cache = Path(cache_dir) if cache_dir is not None else out / "cache"

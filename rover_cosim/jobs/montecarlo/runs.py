@@ -35,21 +35,14 @@ from rover_cosim.orchestrator.master import run
 from rover_cosim.orchestrator.model import System
 from rover_cosim.terramechanics.library import DEGREES, Choice, vary
 
-from .. import path_following, simulate
-from .metrics import ADAPTED, ADAPTED_PATH, ESTIMATED, PATH, STRAIGHT, path_metrics, straight_metrics
+from .. import simulate
+from .metrics import ESTIMATED
+from .scenarios import PATH_SCENARIO as PATH_SCENARIO  # noqa: F401 - where users found it
+from .scenarios import RUN_SCENARIOS
 from .study import Study, StudyError
 
 #: Bumped when a metric's definition changes: every cached run is then computed again.
 METRICS_VERSION = 4
-#: The path scenario of a study: the lane change at 1.0 m/s (the paper's speed).
-PATH_SCENARIO = "lane_change"
-#: The FMU of each scenario (in fmu_dir).
-FMUS = {"straight": "Rover.fmu", "path": "SteerableRover.fmu", "straight_adapted": "Rover.fmu",
-        "path_adapted": "SteerableRover.fmu"}
-#: FMUs a scenario needs besides its plant: the adaptive controllers identify their models again on SingleWheel.fmu.
-EXTRA_FMUS = {"straight_adapted": ("SingleWheel.fmu",), "path_adapted": ("SingleWheel.fmu",)}
-COLUMNS = {"straight": [*STRAIGHT, "wall_s"], "path": [*PATH, "wall_s"], "straight_adapted": [*ADAPTED, "wall_s"],
-           "path_adapted": [*ADAPTED_PATH, "wall_s"]}
 
 
 #: (name, value) pairs of a sample.
@@ -61,7 +54,7 @@ class RunSpec:
     """Everything a worker needs for one run (it travels to other processes)."""
 
     sample: int
-    scenario: str                               # "straight" or "path"
+    scenario: str                               # a name of scenarios.RUN_SCENARIOS
     fmu_dir: str
     model: ModelSet                             # the identified models, read once by the study
     stop_time: float                            # s
@@ -99,11 +92,11 @@ def nominal_values(study: Study, choice: Choice, fmu_dir: Path) -> dict[str, flo
     """Each study parameter's nominal value: the soil library's (the soil the model was identified
     on), or the start value the FMU of every scenario has; StudyError for a name no FMU has."""
     values: dict[str, float] = {}
-    starts = {scenario: fmu_starts(Path(fmu_dir) / FMUS[scenario]) for scenario in study.scenarios}
+    starts = {scenario: fmu_starts(Path(fmu_dir) / RUN_SCENARIOS[scenario].fmu) for scenario in study.scenarios}
     for name in study.names:
         value = library_value(name, choice)
         if value is None:
-            lacking = [FMUS[s] for s in study.scenarios if name not in starts[s]]
+            lacking = [RUN_SCENARIOS[s].fmu for s in study.scenarios if name not in starts[s]]
             if lacking:
                 raise StudyError(f"parameter {name!r}: not a parameter of {', '.join(lacking)}; expected soil.NAME, "
                                  "wheel.NAME or one of the FMU's parameters (e.g. rover.M)")
@@ -125,8 +118,9 @@ def split(values: dict[str, float], nominal: bool) -> tuple[Values, Values]:
 def cache_key(fingerprint: dict[str, Any], scenario: str, stop_time: float,
               changes: Values, parameters: Values, calibration: Calibration = Calibration()) -> str:
     """The run's cache key (hex): ``fingerprint`` holds the FMUs', the model's and the nominal soil's."""
-    content = {"fingerprint": fingerprint, "scenario": scenario, "fmu": fingerprint["fmus"][FMUS[scenario]],
-               "extra_fmus": [fingerprint["fmus"].get(name) for name in EXTRA_FMUS.get(scenario, ())],
+    content = {"fingerprint": fingerprint, "scenario": scenario,
+               "fmu": fingerprint["fmus"][RUN_SCENARIOS[scenario].fmu],
+               "extra_fmus": [fingerprint["fmus"].get(name) for name in RUN_SCENARIOS[scenario].extra_fmus],
                "stop_time": stop_time, "step": simulate.STEP, "changes": [list(c) for c in changes],
                "parameters": [list(p) for p in parameters], "calibration": asdict(calibration),
                "metrics_version": METRICS_VERSION}
@@ -140,18 +134,8 @@ def fingerprint(fmu_hashes: dict[str, str], model_hash: str, nominal: Choice) ->
 
 def plant(spec: RunSpec) -> System:
     """The run's system: the scenario's plant and controller on the sample's soil, wheel and parameters."""
-    choice, fmu_dir = spec.choice(), Path(spec.fmu_dir)
-    if spec.scenario == "straight":
-        system = simulate.monolithic_system(fmu_dir, spec.model, choice)
-    elif spec.scenario == "straight_adapted":
-        system = simulate.adaptive_system(fmu_dir, spec.model, choice, calibration=spec.calibration,
-                                          cache_dir=Path(spec.target).parent / "adaptation")
-    elif spec.scenario == "path_adapted":
-        system = path_following.adaptive_system(fmu_dir, spec.model, PATH_SCENARIO, choice,
-                                                calibration=spec.calibration,
-                                                cache_dir=Path(spec.target).parent / "adaptation")
-    else:
-        system = path_following.monolithic_system(fmu_dir, spec.model, PATH_SCENARIO, "inverse", choice)
+    system = RUN_SCENARIOS[spec.scenario].system(Path(spec.fmu_dir), spec.model, spec.choice(), spec.calibration,
+                                                 Path(spec.target).parent / "adaptation")
     builder = SystemBuilder.from_system(system, f"Monte Carlo sample {spec.sample} ({spec.scenario})")
     builder.simulation(stop_time=spec.stop_time).set_parameters("rover", dict(spec.parameters))
     return builder.build()
@@ -171,18 +155,15 @@ def adaptation_metrics(system: System) -> dict[str, float]:
 
 def simulate_run(spec: RunSpec) -> dict[str, float | bool]:
     """The run's metrics (raises on a sample the soil library or the FMU refuses)."""
+    scenario = RUN_SCENARIOS[spec.scenario]
     system = plant(spec)
     outcome = run(system)
     window = spec.calibration.duration
-    adapted = spec.scenario.endswith("_adapted")
+    adapted = scenario.adapted_from is not None
     if adapted:  # after its own calibration, longer on a rover that crawls
         block = next(b.block for b in system.blocks if b.name == "ctrl")
         window = block.calibrated_until or window  # type: ignore[attr-defined]
-    if spec.scenario.startswith("straight"):
-        row = straight_metrics(simulate.trajectories(outcome.data, "monolithic"), calibration=window)
-    else:
-        table = path_following.trajectories(outcome.data, cosim=False)
-        row = path_metrics(table, path_following.metrics(table, path_following.SCENARIOS[PATH_SCENARIO]), window)
+    row = scenario.metrics(outcome.data, window)
     if adapted:
         row.update(adaptation_metrics(system))
     row["wall_s"] = outcome.wall_seconds
@@ -203,5 +184,5 @@ def compute_run(spec: RunSpec) -> tuple[int, str, str | None, float]:
 def read_cached(spec: RunSpec) -> tuple[dict[str, Any] | None, str | None]:
     """(the run's metrics, None) from a whole cache file; (None, why not) for a damaged one;
     (None, None) when there is none."""
-    data, problem = read_run(Path(spec.target), 1, COLUMNS[spec.scenario], exact=True)
+    data, problem = read_run(Path(spec.target), 1, [*RUN_SCENARIOS[spec.scenario].columns, "wall_s"], exact=True)
     return (None, problem) if data is None else (data.iloc[0].to_dict(), None)

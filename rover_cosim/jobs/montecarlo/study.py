@@ -49,11 +49,14 @@ from rover_cosim.control.adaptive import Calibration
 from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import DEGREES
 
-#: Scenarios a study can run: "straight" (paper Sec. 4, Rover.fmu), "path" (lane change,
-#: SteerableRover.fmu), and each with the adaptive controller ("straight_adapted", "path_adapted").
-SCENARIOS = ("straight", "path", "straight_adapted", "path_adapted")
+from .scenarios import ADAPTIVE_VARIANT, RUN_SCENARIOS
+
+#: Scenarios a study can run (``scenarios.RUN_SCENARIOS``): "straight" (paper Sec. 4, Rover.fmu),
+#: "path" (lane change, SteerableRover.fmu), and each with the adaptive controller ("straight_adapted",
+#: "path_adapted").
+SCENARIOS = tuple(RUN_SCENARIOS)
 #: The scenario ``--adapt`` adds beside each that has an adaptive variant.
-ADAPTED = {"straight": "straight_adapted", "path": "path_adapted"}
+ADAPTED = ADAPTIVE_VARIANT
 #: Shipped studies (``--study NAME`` or a file).
 STUDIES = Path(__file__).with_name("studies")
 KINDS = {"uniform": ("lower", "upper"), "normal": ("mean", "std"), "lognormal": ("median", "sigma")}
@@ -113,11 +116,7 @@ class Study:
 
     def stop_time_of(self, scenario: str) -> float:
         """s: how long a run of ``scenario`` lasts (the path's: until its reference reaches the end)."""
-        if scenario.startswith("straight"):
-            return self.stop_time
-        from rover_cosim.jobs import path_following
-
-        return self.path_stop_time or path_following.stop_time("lane_change")
+        return RUN_SCENARIOS[scenario].stop_time(self.stop_time, self.path_stop_time)
 
     def check_calibration(self) -> None:
         """StudyError unless every adapted scenario's run lasts longer than its calibration."""
