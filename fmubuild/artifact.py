@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
 
-from . import source
+from . import catalog
 
 RUNTIME = Path(__file__).parent / "runtime"
 #: The runtime's files in an FMU: the core (core.h, instance.c, state.c, cosim.c, ode23s) and the API
@@ -37,7 +37,7 @@ class BuildResult:
 def input_digest(name: str) -> str:
     """Digest of everything a built-in FMU of ``name`` is made from."""
     digest = hashlib.sha256(name.encode())
-    files = sorted((source.MODELICA_ROOT / source.PACKAGE).rglob("*")) + sorted(Path(__file__).parent.glob("*.py"))
+    files = sorted((catalog.MODELICA_ROOT / catalog.PACKAGE).rglob("*")) + sorted(Path(__file__).parent.glob("*.py"))
     files += [RUNTIME / f for f in sorted({*RUNTIME_FILES, *RUNTIME_FILES_3})]
     for path in files:
         if path.is_file():

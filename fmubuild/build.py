@@ -30,7 +30,7 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from . import codegen, description, description3, ode, prefix, source
+from . import catalog, codegen, description, description3, ode, prefix, source
 from .artifact import (
     BUILD_RECORD,
     CFLAGS,
@@ -125,8 +125,8 @@ def _class_documentation(name: str) -> str:
     import re
 
     parts = []
-    for qualified in (source.fmu_class(name), f"{source.PACKAGE}.Parameters.SoilParameters",
-                      f"{source.PACKAGE}.Parameters.WheelParameters"):
+    for qualified in (source.fmu_class(name), f"{catalog.PACKAGE}.Parameters.SoilParameters",
+                      f"{catalog.PACKAGE}.Parameters.WheelParameters"):
         text = source.class_file(qualified).read_text()
         found = re.search(r'info="(.*?)"\)', text, re.S)
         if found:

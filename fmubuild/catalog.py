@@ -20,7 +20,7 @@ FMU_PACKAGE = "FMUs"
 def fmu_class(name: str) -> str:
     """The qualified Modelica class exported as the FMU ``name`` (``"Wheel"`` ->
     ``"RoverTerramechanics.FMUs.Wheel"``): the one place that maps an FMU to its class."""
-    return f"{PACKAGE}.{FMU_PACKAGE}.{name}"
+    return f"{PACKAGE}.{FMU_PACKAGE}.{name}"  # read when called: a test may point the module elsewhere
 
 
 @cache

@@ -14,22 +14,24 @@ from pathlib import Path
 
 import pandas as pd
 
-from .catalog import FMU_PACKAGE as FMU_PACKAGE  # noqa: F401 - the package's names, here too
-from .catalog import MODELICA_ROOT, PACKAGE
+from . import catalog
+from .catalog import FMU_PACKAGE as FMU_PACKAGE  # noqa: F401 - the package's names, read here too (catalog owns them)
+from .catalog import MODELICA_ROOT as MODELICA_ROOT  # noqa: F401
+from .catalog import PACKAGE as PACKAGE  # noqa: F401
 from .catalog import fmu_class as fmu_class  # noqa: F401
 
 
 def package_file() -> Path:
     """The top-level ``package.mo`` of RoverTerramechanics."""
-    return MODELICA_ROOT / PACKAGE / "package.mo"
+    return catalog.MODELICA_ROOT / catalog.PACKAGE / "package.mo"
 
 
 def class_files() -> dict[str, Path]:
     """Every class of the package by qualified name, mapped to the file that defines it
     (``package.mo`` for packages)."""
     files: dict[str, Path] = {}
-    for path in sorted((MODELICA_ROOT / PACKAGE).rglob("*.mo")):
-        parts = path.relative_to(MODELICA_ROOT).with_suffix("").parts
+    for path in sorted((catalog.MODELICA_ROOT / catalog.PACKAGE).rglob("*.mo")):
+        parts = path.relative_to(catalog.MODELICA_ROOT).with_suffix("").parts
         if parts[-1] == "package":
             parts = parts[:-1]
         files[".".join(parts)] = path
@@ -40,7 +42,7 @@ def class_file(name: str) -> Path:
     """The file defining the class ``name`` (qualified, e.g. ``RoverTerramechanics.FMUs.Rover``)."""
     files = class_files()
     if name not in files:
-        raise ValueError(f"model {name!r}: no such class in {MODELICA_ROOT / PACKAGE}; "
+        raise ValueError(f"model {name!r}: no such class in {catalog.MODELICA_ROOT / catalog.PACKAGE}; "
                          f"expected one of {sorted(files)}")
     return files[name]
 
@@ -51,7 +53,7 @@ def load(name: str):  # -> rumoca.Model (rumoca has no type stubs)
     import rumoca
 
     class_file(name)  # a clear error for an unknown class before rumoca's own
-    session = rumoca.Session(roots=[str(MODELICA_ROOT)])
+    session = rumoca.Session(roots=[str(catalog.MODELICA_ROOT)])
     return session.load(str(package_file()), model=name)
 
 

@@ -219,6 +219,6 @@ ALGORITHMS: dict[str, type[Algorithm]] = {cls.name: cls for cls in (Jacobi, Gaus
 
 def algorithm_of(name: str, iteration: Iteration | None = None) -> Algorithm:
     """The algorithm called ``name`` (a system's ``algorithm``)."""
-    if name not in ALGORITHMS:
+    if not isinstance(name, str) or name not in ALGORITHMS:
         raise ValueError(f"algorithm {name!r}: expected one of {', '.join(ALGORITHMS)}")
     return ALGORITHMS[name].of(iteration)

@@ -269,7 +269,7 @@ class SystemBuilder:
 
     def _check_switches(self) -> None:
         values, where = self._settings.values, self._settings.where
-        if values["algorithm"] not in ALGORITHMS:
+        if not isinstance(values["algorithm"], str) or values["algorithm"] not in ALGORITHMS:
             raise self.error(f"{where} algorithm", f"{values['algorithm']!r}: expected one of {', '.join(ALGORITHMS)}")
         self._iteration()
         allow = values["allow_algebraic_loops"]

@@ -26,7 +26,7 @@ from fmpy.fmi2 import (
 )
 from fmpy.validation import validate_fmu
 
-from rover_cosim.fmubuild import build, source
+from rover_cosim.fmubuild import build, catalog, source
 from rover_cosim.fmubuild.expressions import UnsupportedConstruct
 from rover_cosim.terramechanics import Wheel, slip_ratio, wheel_forces, wheel_state
 
@@ -555,8 +555,8 @@ def test_unsupported_construct_is_rejected_and_leaves_the_output_folder_untouche
     (root / "Bad" / "FMUs" / "package.mo").write_text(BAD_FMUS)
     (root / "Bad" / "FMUs" / "SingleWheel.mo").write_text(BAD_MODEL)
     (root / "Bad" / "FMUs" / "package.order").write_text("SingleWheel\n")
-    monkeypatch.setattr(source, "MODELICA_ROOT", root)
-    monkeypatch.setattr(source, "PACKAGE", "Bad")
+    monkeypatch.setattr(catalog, "MODELICA_ROOT", root)  # the package's location and name live there
+    monkeypatch.setattr(catalog, "PACKAGE", "Bad")
     out = tmp_path / "fmus"
     out.mkdir()
     (out / "SingleWheel.fmu").write_bytes(b"previous build")

@@ -135,10 +135,22 @@ def test_the_closed_loop_with_the_c_twin_is_the_python_closed_loop(fmu_dir, mode
 
 
 def test_a_failing_c_twin_is_named_with_its_message(fmu_dir, model):
-    system = short(monolithic_system(fmu_dir, model, step=5e-4), 0.1)  # made for a shorter step than the system's
-    with pytest.raises(RunError, match=r"ctrl \(block\): step at t = 0 s failed: communication step 0.001 s: "
-                                       r"expected at most its step = 0.0005 s") as info:
-        run(system)
+    """Limb 1's load falls to 0 N within the first step (a step source in place of the rover's Fz[1]):
+    the controller's C twin refuses it, and the run names the block, the call, the time and why."""
+    from rover_cosim.orchestrator.blocks import Step
+    from rover_cosim.orchestrator.builder import SystemBuilder
+
+    builder = SystemBuilder("a load that vanishes").simulation(stop_time=0.1, step=1e-3)
+    builder.add_fmu("rover", fmu_dir / "Rover.fmu")
+    builder.add_block("load1", Step("load1", -424.0, time=5e-4, offset=424.0, unit="N"))
+    builder.add_block("ctrl", InverseModelController("ctrl", str(model)))
+    builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v").connect("load1.y", "ctrl.W[1]")
+    for i in range(1, 7):
+        if i > 1:
+            builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]")
+        builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
+    with pytest.raises(RunError, match=r"ctrl \(block\): step at t = 0 s failed: loads = 0 N: expected > 0") as info:
+        run(builder.build())
     assert len(info.value.partial) == 1  # the start only
 
 
