@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from .command import Command
-from .options import add_fmu_dir, add_out, add_quiet, fail, fmu_dir_exists, output_folder
+from .options import add_fmu_dir, add_out, add_quiet, fail, fmu_dir_exists, output_folder, print_written, with_progress
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -18,7 +18,6 @@ def run(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.cosim_study import systems, write_cosim_study
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
-    from rover_cosim.progress import ProgressBar
 
     if not output_folder(args.out, "cosim-study", COMMAND.needs_bytes) or not fmu_dir_exists(args.fmu_dir,
                                                                                              "cosim-study"):
@@ -28,17 +27,13 @@ def run(args: argparse.Namespace) -> int:
     except SystemFileError as error:
         fail("cosim-study", f"--fmu-dir {args.fmu_dir}: {error}")
         return 2
-    bar = ProgressBar("cosim-study", enabled=not args.quiet)
-    try:
-        outcome = write_cosim_study(args.fmu_dir, args.out, progress=bar)
-    except (SystemFileError, RunError) as error:
-        bar.close()
-        fail("cosim-study", f"{error} (nothing written)")
+    outcome = with_progress("cosim-study", "cosim-study", args.quiet,
+                            lambda bar: write_cosim_study(args.fmu_dir, args.out, progress=bar),
+                            (SystemFileError, RunError))
+    if outcome is None:
         return 1
-    bar.close()
     print(outcome.table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-    for written in outcome.files:
-        print(f"wrote {written}")
+    print_written(outcome.files)
     return 0
 
 

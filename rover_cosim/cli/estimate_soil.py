@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from .command import Command
-from .options import add_out, fail, output_folder, path, path_text
+from .options import add_out, fail, output_folder, path, path_text, print_written
 
 
 def _names(text: str) -> tuple[str, ...]:
@@ -76,8 +76,7 @@ def run(args: argparse.Namespace) -> int:
         fail("estimate-soil", f"{error} (nothing written)")
         return 1
     print(outcome.estimate.summary())
-    for written in outcome.files:
-        print(f"wrote {written}")
+    print_written(outcome.files)
     return 0
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from .command import Command
-from .options import add_out, add_soil_options, choice_of, fail, output_folder
+from .options import add_out, add_soil_options, choice_of, fail, output_folder, print_written
 
 
 def _slip_step(text: str) -> float:
@@ -57,8 +57,7 @@ def run(args: argparse.Namespace) -> int:
         fail("fig3", f"{error} (the soil cannot carry the wheel here: look at its moduli and the loads; nothing "
              "written)")
         return 1
-    for written_path in written:
-        print(f"wrote {written_path}")
+    print_written(written)
     return 0
 
 

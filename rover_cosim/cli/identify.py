@@ -6,7 +6,20 @@ import argparse
 from pathlib import Path
 
 from .command import Command
-from .options import add_out, add_quiet, add_soil_options, add_workers, at_least, choice_of, fail, output_folder, path
+from .options import (
+    add_out,
+    add_quiet,
+    add_soil_options,
+    add_workers,
+    at_least,
+    choice_of,
+    fail,
+    option_ok,
+    output_folder,
+    path,
+    print_written,
+    with_progress,
+)
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -33,17 +46,12 @@ def is_fmu(fmu: Path) -> bool:
 
 def run(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.identify import check_record_interval, run_identification
-    from rover_cosim.progress import ProgressBar
 
     if not output_folder(args.out, "identify", COMMAND.needs_bytes) or (
             args.cache and not output_folder(args.cache, "identify", 0, "--cache")):
         return 2
-    if not at_least("identify", ("--workers", args.workers, 1)):
-        return 2
-    try:
-        check_record_interval(args.record_interval)
-    except ValueError as error:
-        fail("identify", f"--record-interval: {error}")
+    if not at_least("identify", ("--workers", args.workers, 1)) or not option_ok(
+            "identify", "--record-interval", lambda: check_record_interval(args.record_interval)):
         return 2
     if not args.fmu.is_file():
         fail("identify", f"FMU {args.fmu} not found (build them with `rover-cosim build-fmus`)")
@@ -55,16 +63,11 @@ def run(args: argparse.Namespace) -> int:
     choice = choice_of(args, "identify")
     if choice is None:
         return 2
-    bar = ProgressBar("sweep", enabled=not args.quiet)
-    try:
-        outcome = run_identification(args.fmu, args.out, workers=args.workers, scheduler=args.scheduler,
-                                     cache_dir=args.cache, progress=bar, choice=choice,
-                                     record_interval=args.record_interval)
-    except (OSError, RuntimeError, ValueError) as error:
-        bar.close()
-        fail("identify", f"{error} (nothing written)")
+    outcome = with_progress("identify", "sweep", args.quiet, lambda bar: run_identification(
+        args.fmu, args.out, workers=args.workers, scheduler=args.scheduler, cache_dir=args.cache, progress=bar,
+        choice=choice, record_interval=args.record_interval), (OSError, RuntimeError, ValueError))
+    if outcome is None:
         return 1
-    bar.close()
     for name, sweep in (("sweep", outcome.sweep), ("lateral sweep", outcome.lateral_sweep)):
         print(f"{name}: {sweep.computed} runs computed, {sweep.cached} from the cache, "
               f"{len(sweep.failures)} failed, {sweep.wall_seconds:.1f} s")
@@ -72,8 +75,7 @@ def run(args: argparse.Namespace) -> int:
     print(outcome.fit.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
     print("Lateral model, Fit of Fy [%] (Eq. 15) and largest settled error:")
     print(outcome.lateral_fit.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
-    for written in outcome.files:
-        print(f"wrote {written}")
+    print_written(outcome.files)
     return 0
 
 

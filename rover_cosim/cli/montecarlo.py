@@ -17,6 +17,8 @@ from .options import (
     model_readable,
     output_folder,
     path_text,
+    print_written,
+    with_progress,
 )
 
 #: Bytes of the study's files besides its runs, and of each run's.
@@ -45,7 +47,6 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
-    from rover_cosim.progress import ProgressBar
 
     if not at_least("montecarlo", ("--workers", args.workers, 1), ("--runs", args.runs, 1), ("--seed", args.seed, 0)):
         return 2
@@ -61,16 +62,12 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if not model_readable(args.model, "montecarlo"):
         return 2
-    bar = ProgressBar("montecarlo", enabled=not args.quiet)
-    try:
-        outcome = run_montecarlo(study, args.fmu_dir, args.model, args.out, workers=args.workers,
-                                 scheduler=args.scheduler, cache_dir=args.cache, progress=bar,
-                                 allow_model_mismatch=args.allow_model_mismatch)
-    except (OSError, RuntimeError, ValueError) as error:
-        bar.close()
-        fail("montecarlo", f"{error} (nothing written)")
+    outcome = with_progress("montecarlo", "montecarlo", args.quiet, lambda bar: run_montecarlo(
+        study, args.fmu_dir, args.model, args.out, workers=args.workers, scheduler=args.scheduler,
+        cache_dir=args.cache, progress=bar, allow_model_mismatch=args.allow_model_mismatch),
+        (OSError, RuntimeError, ValueError))
+    if outcome is None:
         return 1
-    bar.close()
     _print_outcome(outcome)
     if len(outcome.runs) and outcome.summary["runs_failed"] == len(outcome.runs):
         fail("montecarlo", f"every run failed (see {args.out / 'failures.csv'})")
@@ -105,8 +102,7 @@ def _print_outcome(outcome: Any) -> None:
         print(ranking.sort_values("rank")[["rank", "parameter", "prcc", "p_value", "distance_spearman",
                                            "distance_p_value", "strongest"]]
               .to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-    for written in outcome.files:
-        print(f"wrote {written}")
+    print_written(outcome.files)
 
 
 COMMAND = Command(

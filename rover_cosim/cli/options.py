@@ -6,9 +6,11 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
+
+Outcome = TypeVar("Outcome")
 
 #: Bytes of one file name and of a whole path the file systems take (Linux: NAME_MAX, PATH_MAX).
 NAME_MAX, PATH_MAX = 255, 4096
@@ -225,4 +227,37 @@ def at_least(command: str, *options: tuple[str, int | None, int]) -> bool:
         if value is not None and value < least:
             fail(command, f"{option} {value}: expected >= {least}")
             return False
+    return True
+
+
+def print_written(files: Iterable[Path]) -> None:
+    """Say each file a command wrote."""
+    for written in files:
+        print(f"wrote {written}")
+
+
+def with_progress(command: str, title: str, quiet: bool, job: Callable[[Callable[[float], None]], Outcome],
+                  errors: tuple[type[Exception], ...]) -> Outcome | None:
+    """``job(progress)`` under a progress bar titled ``title`` (drawn unless ``quiet``); None after
+    saying why it failed with one of ``errors`` (the work failed: nothing written)."""
+    from rover_cosim.progress import ProgressBar
+
+    bar = ProgressBar(title, enabled=not quiet)
+    try:
+        outcome = job(bar)
+    except errors as error:
+        bar.close()
+        fail(command, f"{error} (nothing written)")
+        return None
+    bar.close()
+    return outcome
+
+
+def option_ok(command: str, option: str, check: Callable[[], object]) -> bool:
+    """Whether ``check()`` (a job's own check of a value) passes; else says why, naming ``option``."""
+    try:
+        check()
+    except ValueError as error:
+        fail(command, f"{option}: {error}")
+        return False
     return True

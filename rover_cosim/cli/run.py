@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from .command import Command
-from .options import add_soil_options, choice_of, fail, foreign, path, path_text, recorded_by, unwritable
+from .options import add_soil_options, choice_of, fail, foreign, path, path_text, print_written, recorded_by, unwritable
 from .systems import EXAMPLES, system_path
 
 
@@ -172,8 +172,7 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
         fail("run", f"{error} ({output} not written{kept})")
         return 1
     bar.close()
-    for written in write_run(system, result, output, extra=extra):
-        print(f"wrote {written}")
+    print_written(write_run(system, result, output, extra=extra))
     if result.stopped:
         print(f"stopped: {result.stopped}")
     print(f"{result.steps} steps of {system.step:g} s ({system.algorithm}) in {result.wall_seconds:.2f} s")

@@ -17,7 +17,9 @@ from .options import (
     fail,
     fmu_dir_exists,
     model_readable,
+    option_ok,
     output_folder,
+    print_written,
 )
 
 #: The parts of ``simulate`` (--only), in the order they run.
@@ -82,17 +84,10 @@ def run(args: argparse.Namespace) -> int:
 
     if not output_folder(args.out, "simulate", COMMAND.needs_bytes) or not fmu_dir_exists(args.fmu_dir, "simulate"):
         return 2
-    try:
-        check_options(args.record_interval)
-    except ValueError as error:
-        fail("simulate", f"--record-interval: {error}")
+    if not option_ok("simulate", "--record-interval", lambda: check_options(args.record_interval)) or not option_ok(
+            "simulate", "--calibration", lambda: check_options(args.record_interval, _calibration(args))):
         return 2
-    try:
-        calibration = _calibration(args)
-        check_options(args.record_interval, calibration)
-    except ValueError as error:
-        fail("simulate", f"--calibration: {error}")
-        return 2
+    calibration = _calibration(args)
     if not model_readable(args.model, "simulate"):
         return 2
     choice = choice_of(args, "simulate")
@@ -138,11 +133,6 @@ def _runs(args: argparse.Namespace, choice: Any, calibration: Any) -> None:
         _print_terrain(terrain)
 
 
-def _print_files(outcome: Any) -> None:
-    for written in outcome.files:
-        print(f"wrote {written}")
-
-
 def _print_path(outcome: Any) -> None:
     columns = {"cross_track_rms_m": "cross-track RMS [m]", "cross_track_max_m": "max [m]",
                "speed_error_max_percent": "speed error [%]"}
@@ -151,7 +141,7 @@ def _print_path(outcome: Any) -> None:
     table["largest RMS(Fx - Fx_des) [N]"] = rms.filter(like="rms_Fx").max(axis=1)
     table["largest RMS(Fy - Fy_des) [N]"] = rms.filter(like="rms_Fy").max(axis=1)
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-    _print_files(outcome)
+    print_written(outcome.files)
 
 
 def _print_terrain(outcome: Any) -> None:
@@ -160,7 +150,7 @@ def _print_terrain(outcome: Any) -> None:
                "energy_per_metre_J_m": "energy [J/m]"}
     table = outcome.metrics[["scenario", "run", *columns]].rename(columns=columns)
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-    _print_files(outcome)
+    print_written(outcome.files)
 
 
 def print_straight(outcome: Any) -> None:
@@ -186,7 +176,7 @@ def print_straight(outcome: Any) -> None:
               f"n {soil.get('n', float('nan')):.3g}, k_x {soil.get('kx', float('nan')):.3g} m; largest "
               f"RMS(Fx - Fx_des) after the calibration {max(adaptation['rms_after_calibration_N']):.3f} N "
               f"(nominal model: {max(adaptation['rms_after_calibration_nominal_model_N']):.3f} N)")
-    _print_files(outcome)
+    print_written(outcome.files)
 
 
 def result_sets(args: argparse.Namespace) -> int | None:

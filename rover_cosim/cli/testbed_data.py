@@ -5,7 +5,17 @@ from __future__ import annotations
 import argparse
 
 from .command import Command
-from .options import add_soil_options, choice_of, fail, numbers, output_file, path, positive_loads, recorded_by
+from .options import (
+    add_soil_options,
+    choice_of,
+    fail,
+    numbers,
+    output_file,
+    path,
+    positive_loads,
+    print_written,
+    recorded_by,
+)
 
 #: The measured channels of single-wheel data, named here without importing the estimator (it
 #: imports SciPy: seconds before --help; tests/test_soil_estimation.py keeps them equal to
@@ -72,8 +82,7 @@ def run(args: argparse.Namespace) -> int:
         return 2
     print(f"{outcome.data.rows} rows ({', '.join(outcome.data.channels)}) on soil {choice.soil_name}, wheel "
           f"{choice.wheel_name}, noise {args.noise:g} of each channel's range (seed {args.seed})")
-    for written in outcome.files:
-        print(f"wrote {written}")
+    print_written(outcome.files)
     return 0
 
 
