@@ -44,6 +44,14 @@ class Stepping(Protocol):
 START_SUBSTEPS = 10
 
 
+def sources(participants: Sequence[Participant], inputs: Sequence[np.ndarray]) -> list[int]:
+    """The positions of the sources: blocks without inputs (functions of time: a csv input, a step,
+    a ramp). Every participant sees a source's value at the communication point it steps from, as
+    FMPy gives an FMU its inputs, under every master: the masters step the sources after the others."""
+    return [i for i, (p, slots) in enumerate(zip(participants, inputs)) if isinstance(p, BlockParticipant)
+            and not len(slots)]
+
+
 class Algorithm:
     """An explicit algorithm is a list of stages stepped one after the other each communication
     step; the participants of a stage see the values as they were when the stage began."""
@@ -93,17 +101,21 @@ class GaussSeidel(Algorithm):
 
     def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
                outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
+        last = sources(participants, inputs)  # stepped after the others: they see their value at t
+        order = [i for i in range(len(participants)) if i not in last] + last
         if threads > 1:
-            return independent_runs(participants, inputs, outputs)
-        return [[i] for i in range(len(participants))]
+            return independent_runs(participants, inputs, outputs, order)
+        return [[i] for i in order]
 
 
 def independent_runs(participants: Sequence[Participant], inputs: Sequence[np.ndarray],
-                     outputs: Sequence[np.ndarray]) -> list[list[int]]:
-    """The order cut into runs of FMUs that read none of each other's outputs (blocks alone)."""
+                     outputs: Sequence[np.ndarray], order: Sequence[int] | None = None) -> list[list[int]]:
+    """``order`` (default: the participants' own) cut into runs of FMUs that read none of each
+    other's outputs (blocks alone)."""
     groups: list[list[int]] = []
     written: set[int] = set()
-    for i, participant in enumerate(participants):
+    for i in (range(len(participants)) if order is None else order):
+        participant = participants[i]
         reads = set(inputs[i].tolist())
         if (groups and not isinstance(participant, BlockParticipant) and len(groups[-1]) >= 1
                 and not isinstance(participants[groups[-1][0]], BlockParticipant) and not reads & written):
@@ -140,9 +152,13 @@ class Iterative(Algorithm):
         self.steps = 0
         self.exchanged = np.zeros(0, int)
         self.holds: list[str] = []
+        self.sources: list[int] = []
 
     def prepare(self, execution: Stepping) -> None:
         inputs = execution.inputs
+        # The sources step once, after the iteration: within it every participant sees their
+        # value at t, held over the step (slope 0), as FMPy gives an FMU its inputs.
+        self.sources = sources(execution.participants, inputs)
         exchanged = np.unique(np.concatenate([slots for slots in inputs if len(slots)] or [np.zeros(0, int)]))
         self.exchanged = exchanged.astype(int)
         # FMUs that can interpolate inputs get them linearly from t to the guess at t + h; other
@@ -163,14 +179,20 @@ class Iterative(Algorithm):
         pieces = START_SUBSTEPS if self.steps == 0 else 1
         for piece in range(pieces):
             self._iterate(execution, values, t + piece * h / pieces, h / pieces)
+        for i in self.sources:
+            participant = execution.participants[i]
+            participant.do_step(t, h, values[execution.inputs[i]])
+            values[execution.outputs[i]] = participant.get_outputs(t + h)
         self.steps += 1
 
     def _pass(self, execution: Stepping, start: np.ndarray, guess: np.ndarray, t: float, h: float) -> np.ndarray:
         """One pass over the participants in order; returns the new values."""
         clock = time.perf_counter
         new = guess.copy()  # filled in order: later participants see this pass's outputs
-        for participant, inputs, outputs, hold, discrete in zip(execution.participants, execution.inputs,
-                                                                execution.outputs, self.holds, self.discrete):
+        for k, (participant, inputs, outputs, hold, discrete) in enumerate(zip(
+                execution.participants, execution.inputs, execution.outputs, self.holds, self.discrete)):
+            if k in self.sources:
+                continue
             begin = clock()
             if hold == "interpolate":
                 held = np.where(discrete, new[inputs], start[inputs])

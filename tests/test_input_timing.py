@@ -1,0 +1,122 @@
+"""Input timing (issue 44): a participant sees an input signal (a source: a csv input, a step, a
+ramp) at the communication point it steps from, as FMPy gives an FMU its inputs, under every
+master and whatever the Gauss-Seidel order. Checked on own C FMUs whose exact answer is known, an
+integrator x' = u (FMI 2.0, tests/fmus/integrator.c) and the bouncing ball's v' = a - g with g = 0
+(FMI 3.0, tests/fmus/ball3.c), row for row against FMPy's simulate_fmu on the same FMU and input."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import fmpy
+import numpy as np
+import pytest
+from ball_fmus import build_ball3
+from integrator_fmu import build_integrator
+
+from rover_cosim.orchestrator import SystemBuilder, run
+from rover_cosim.orchestrator.blocks import CsvInput, Step
+
+STEP, STOP = 0.1, 1.0
+#: t [s], u, k: u steps from 0 to 1 at 0.5 s (a repeated time), k with it (held: an Integer)
+STEP_INPUT = [(0.0, 0.0, 0), (0.5, 0.0, 0), (0.5, 1.0, 1), (1.0, 1.0, 1)]
+#: u = t, k rising 0 -> 3 (held between the rows)
+RAMP_INPUT = [(0.0, 0.0, 0), (1.0, 1.0, 3)]
+INPUTS = {"step": STEP_INPUT, "ramp": RAMP_INPUT}
+MASTERS = ("gauss-seidel", "jacobi", "iterative")
+
+
+def _built(built: Path | str) -> Path:
+    if isinstance(built, str):
+        pytest.skip(f"the test FMU cannot be built here: {built}")
+    return built
+
+
+@pytest.fixture(scope="module")
+def integrator(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return _built(build_integrator(tmp_path_factory.mktemp("integrator")))
+
+
+@pytest.fixture(scope="module")
+def ball3(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return _built(build_ball3(tmp_path_factory.mktemp("ball3")))
+
+
+def _csv(folder: Path, rows: list[tuple[float, float, int]], names: tuple[str, str] = ("u", "k")) -> Path:
+    path = folder / "input.csv"
+    path.write_text(f"time,{names[0]},{names[1]}\n" + "".join(f"{t},{u},{k}\n" for t, u, k in rows))
+    return path
+
+
+def _fmpy(fmu: Path, rows: list[tuple[float, float, int]], names: tuple[str, str], interface: str,
+          **options: object) -> np.ndarray:
+    signals = np.array(rows, dtype=[("time", float), (names[0], float), (names[1], np.int32)])
+    return fmpy.simulate_fmu(str(fmu), fmi_type=interface, input=signals, stop_time=STOP, output_interval=STEP,
+                             **options)
+
+
+def _ours(fmu: Path, csv: Path, master: str, interface: str, outputs: tuple[str, ...], order_first: bool = False,
+          **starts: float) -> dict[str, np.ndarray]:
+    builder = SystemBuilder("input timing").simulation(stop_time=STOP, step=STEP, algorithm=master)
+    builder.add_fmu("model", fmu, interface=interface, start=starts or None)
+    builder.add_block("input", CsvInput("input", csv, hold=("k",), types={"k": "Integer"}))
+    builder.connect("input.u", "model.u").connect("input.k", "model.k")
+    builder.record(*[f"model.{name}" for name in outputs], replace=True)
+    if order_first:  # the source before the FMU in the Gauss-Seidel order: it still gives its value at t
+        builder.simulation(order=["input", "model"])
+    data = run(builder.build()).data
+    return {"time": data["time"].to_numpy(), **{name: data[f"model.{name}"].to_numpy() for name in outputs}}
+
+
+@pytest.mark.parametrize("master", MASTERS)
+@pytest.mark.parametrize("signal", INPUTS)
+def test_an_fmu_steps_from_t_with_the_input_at_t_as_fmpy_gives_it(integrator, tmp_path, master, signal):
+    """Co-Simulation, FMI 2.0: x(t_n) = sum of u(t_k) h over the steps before (the input held over
+    each step from its value where the step starts), exactly FMPy's rows; the step input of 1 from
+    0.5 s gives x(1) = 0.5 exactly, the ramp u = t gives 0.5 - h/2 (first order, as FMPy)."""
+    rows = INPUTS[signal]
+    ours = _ours(integrator, _csv(tmp_path, rows), master, "co-simulation", ("x", "y", "m"))
+    theirs = _fmpy(integrator, rows, ("u", "k"), "CoSimulation")
+    np.testing.assert_allclose(ours["time"], theirs["time"], rtol=0, atol=1e-12)
+    for name in ("x", "y", "m"):
+        np.testing.assert_allclose(ours[name], theirs[name], rtol=1e-12, atol=1e-12, err_msg=name)
+    exact = {"step": 0.5, "ramp": 0.5 - STEP / 2}[signal]
+    assert ours["x"][-1] == pytest.approx(exact, abs=1e-12)
+    before = ours["time"] <= 0.5 + 1e-9
+    if signal == "step":  # the row at 0.5 s still has the old input: the step from 0.5 takes the new one
+        assert np.all(ours["x"][before] == 0.0) and ours["x"][ours["time"] > 0.55][0] == pytest.approx(STEP)
+
+
+@pytest.mark.parametrize("master", ("gauss-seidel", "iterative"))
+def test_a_source_first_in_the_order_still_gives_its_value_at_t(integrator, tmp_path, master):
+    rows = STEP_INPUT
+    ours = _ours(integrator, _csv(tmp_path, rows), master, "co-simulation", ("x",), order_first=True)
+    theirs = _fmpy(integrator, rows, ("u", "k"), "CoSimulation")
+    np.testing.assert_allclose(ours["x"], theirs["x"], rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("master", MASTERS)
+def test_an_fmi3_fmu_sees_the_input_at_t_as_fmpy_gives_it(ball3, tmp_path, master):
+    """Co-Simulation, FMI 3.0: the ball without gravity, v' = a, driven by a step of a from 0.5 s."""
+    rows = [(0.0, 0.0, 0), (0.5, 0.0, 0), (0.5, 2.0, 0), (1.0, 2.0, 0)]
+    csv = tmp_path / "a.csv"
+    csv.write_text("time,a\n" + "".join(f"{t},{a}\n" for t, a, _ in rows))
+    builder = SystemBuilder("ball").simulation(stop_time=STOP, step=STEP, algorithm=master)
+    builder.add_fmu("model", ball3, interface="co-simulation")
+    builder.set_parameters("model", {"g": 0.0})
+    builder.add_block("input", CsvInput("input", csv)).connect("input.a", "model.a").record("model.v", replace=True)
+    ours = run(builder.build()).data["model.v"].to_numpy()
+    signals = np.array([(t, a) for t, a, _ in rows], dtype=[("time", float), ("a", float)])
+    theirs = fmpy.simulate_fmu(str(ball3), fmi_type="CoSimulation", input=signals, stop_time=STOP,
+                               output_interval=STEP, start_values={"g": 0.0})["v"]
+    np.testing.assert_allclose(ours, theirs, rtol=1e-12, atol=1e-12)
+    assert ours[-1] == pytest.approx(2.0 * 0.5, abs=1e-12)
+
+
+def test_a_step_block_under_gauss_seidel_is_seen_at_t(integrator):
+    """The built-in sources follow the same convention as the csv input: a step of u at 0.5 s."""
+    builder = SystemBuilder("step").simulation(stop_time=STOP, step=STEP, algorithm="gauss-seidel")
+    builder.add_fmu("model", integrator, interface="co-simulation")
+    builder.add_block("u", Step("u", 1.0, time=0.5)).connect("u.y", "model.u").record("model.x", replace=True)
+    x = run(builder.build()).data["model.x"].to_numpy()
+    assert x[-1] == pytest.approx(0.5, abs=1e-12) and x[5] == 0.0
