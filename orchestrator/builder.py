@@ -219,7 +219,7 @@ class SystemBuilder:
     def simulation(self, *, where: str | None = None, **settings: Any) -> SystemBuilder:
         """Set simulation settings (the others keep their values): ``stop_time``, ``step``,
         ``start_time`` [s]; ``algorithm`` (jacobi, gauss-seidel, iterative); ``order`` (instance
-        names, Gauss-Seidel order; default: FMUs, blocks with inputs, sources; the sources step last); ``tolerance``,
+        names, Gauss-Seidel order; default: sources, FMUs, other blocks; the sources step last in any order); ``tolerance``,
         ``max_iterations``, ``relaxation`` (iterative only); ``allow_algebraic_loops``;
         ``threads`` (FMUs stepped at the same time; None: the cores); ``native`` (FMUs stepped from C);
         ``relative_tolerance`` (of the integrator of Model Exchange FMUs, and told to every FMU);
@@ -589,9 +589,9 @@ class SystemBuilder:
     def _order(self) -> list[str]:
         order, where = self._settings.values["order"], self._settings.where
         blocks = list(self._blocks.values())
-        if order is None:  # the sources last: Gauss-Seidel steps them after the others whatever the order
-            return (list(self._fmus) + [b.name for b in blocks if b.block.inputs]
-                    + [b.name for b in blocks if not b.block.inputs])
+        if order is None:  # (Gauss-Seidel steps the sources after the others whatever the order)
+            return ([b.name for b in blocks if not b.block.inputs] + list(self._fmus)
+                    + [b.name for b in blocks if b.block.inputs])
         names = sorted([*self._fmus, *self._blocks])
         if not isinstance(order, (list, tuple)) or sorted(map(str, order)) != names:
             raise self.error(f"{where} order", f"{order!r}: expected every instance once: {names}")

@@ -45,7 +45,20 @@ class Execution:
             self.python = PythonExecutor(self.participants, self.outputs, self.step_seconds)
         #: Per stage (by identity): its participants stepped natively and the others, split once.
         self._splits: dict[int, tuple[list[int], list[int]]] = {}
+        self.signal_inputs = self._signal_inputs()
         algorithm.prepare(self)
+
+    def _signal_inputs(self) -> list[tuple[int, np.ndarray]]:
+        """The Model Exchange FMUs fed by a source (a block without inputs: an input signal), with
+        which of their inputs it feeds: at a communication point where the signal jumps they take
+        its new value at once (in Event Mode where a discrete input changes), so that the row there
+        shows it, as FMPy records an input event."""
+        from .algorithms import sources
+        from .model_exchange import ModelExchangeParticipant
+
+        fed = np.concatenate([self.outputs[i] for i in sources(self.participants, self.inputs)] or [np.zeros(0, int)])
+        return [(i, np.isin(self.inputs[i], fed)) for i, p in enumerate(self.participants)
+                if isinstance(p, ModelExchangeParticipant) and np.isin(self.inputs[i], fed).any()]
 
     def _steppable(self, i: int) -> bool:
         """Whether participant ``i`` can be stepped natively: an FMU whose exchanged variables are
@@ -92,6 +105,10 @@ class Execution:
     def step(self, values: np.ndarray, t: float, h: float) -> None:
         """Advance every participant from ``t`` to ``t + h``; ``values`` then holds the outputs at ``t + h``."""
         self.algorithm.step(self, values, t, h)
+        for i, fed in self.signal_inputs:  # the input signals' values at t + h, taken there
+            participant = self.participants[i]
+            if participant.take_signals(values[self.inputs[i]], fed, t + h):  # type: ignore[attr-defined]
+                values[self.outputs[i]] = participant.get_outputs(t + h)
 
     def run_stage(self, stage: Sequence[int], values: np.ndarray, t: float, h: float) -> None:
         """Step the participants of ``stage`` from the values as they are now."""

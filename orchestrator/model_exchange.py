@@ -164,6 +164,17 @@ class ModelExchangeParticipant(FmuParticipant):
         if now != end:
             self._call(f"fmi{self.version}SetTime", lambda: self.fmu.setTime(end), end)
 
+    def take_signals(self, u: np.ndarray, fed: np.ndarray, t: float) -> bool:
+        """At the end of a step (``t``): the inputs ``fed`` by input signals take their values in
+        ``u`` there (an event where a discrete one jumps); whether any changed."""
+        new = self.input_values.copy()
+        new[fed] = np.asarray(u, dtype=float)[fed]
+        if np.array_equal(new, self.input_values, equal_nan=True):
+            return False
+        self._step_start = t
+        self._take_inputs(new, t)
+        return True
+
     def _take_inputs(self, u: np.ndarray, t: float) -> None:
         """Set the inputs that changed: in Event Mode (with an event iteration) where a discrete one did."""
         moved = u != self.input_values

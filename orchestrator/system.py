@@ -9,7 +9,7 @@ from objects cannot be written: a file holds a block's type and keys).
 stop_time = 6.0            # s
 step = 1e-3                # s, communication step
 algorithm = "gauss-seidel" # or "jacobi"
-# order = ["body", "wheel1", "torque"]   # Gauss-Seidel order (default: FMUs, blocks with inputs, sources)
+# order = ["torque", "body", "wheel1"]   # Gauss-Seidel order (default: sources, FMUs, other blocks)
 # threads = 2              # FMUs stepped at the same time (default: the cores)
 # native = true            # FMUs stepped from C (orchestrator.native; default true)
 # relative_tolerance = 1e-6 # of the integrator of Model Exchange FMUs (CVode)
@@ -71,8 +71,8 @@ KEY_MEANINGS: dict[str, dict[str, str]] = {
         "step": "communication step [s]",
         "start_time": "start of the run [s]",
         "algorithm": f"the master algorithm: one of {', '.join(ALGORITHMS)}",
-        "order": "Gauss-Seidel order: a list of instance names (default: FMUs, blocks with inputs, then sources; "
-                 "sources step after the others in any order, so every participant sees their value at t)",
+        "order": "Gauss-Seidel order: a list of instance names (default: sources, FMUs, other blocks; the sources "
+                 "step after the others in any order, so every participant sees their value at t)",
         "tolerance": "iterative only: a step is repeated until every exchanged value changes by less than "
                      "tolerance x (1 + |value|) [1]",
         "max_iterations": "iterative only: the most passes per step",

@@ -120,3 +120,55 @@ def test_a_step_block_under_gauss_seidel_is_seen_at_t(integrator):
     builder.add_block("u", Step("u", 1.0, time=0.5)).connect("u.y", "model.u").record("model.x", replace=True)
     x = run(builder.build()).data["model.x"].to_numpy()
     assert x[-1] == pytest.approx(0.5, abs=1e-12) and x[5] == 0.0
+
+
+def _last_row_per_time(result: np.ndarray) -> np.ndarray:
+    """FMPy's Model Exchange rows with one row per time: the last (after an event at that time)."""
+    times = result["time"]
+    keep = np.append(np.diff(times) > 0, True)
+    return result[keep]
+
+
+@pytest.mark.parametrize("master", MASTERS)
+def test_model_exchange_takes_an_input_event_at_its_time_and_records_the_new_value(integrator, tmp_path, master):
+    """Model Exchange, FMI 2.0: the step of u and k at 0.5 s is an event there; the row at 0.5 s
+    shows the new values (y = u = 1, m = k = 1, x still 0), as FMPy's last row at that time; every
+    row equals FMPy's to CVode's tolerance."""
+    rows = STEP_INPUT
+    ours = _ours(integrator, _csv(tmp_path, rows), master, "model-exchange", ("x", "y", "m"))
+    theirs = _last_row_per_time(_fmpy(integrator, rows, ("u", "k"), "ModelExchange"))
+    np.testing.assert_allclose(ours["time"], theirs["time"], rtol=0, atol=1e-12)
+    for name in ("y", "m"):
+        np.testing.assert_array_equal(ours[name], theirs[name], err_msg=name)
+    np.testing.assert_allclose(ours["x"], theirs["x"], rtol=1e-6, atol=1e-9)
+    at = int(np.argmin(np.abs(ours["time"] - 0.5)))
+    assert (ours["x"][at], ours["y"][at], ours["m"][at]) == (0.0, 1.0, 1)
+    assert ours["x"][-1] == pytest.approx(0.5, abs=1e-9)
+
+
+@pytest.mark.parametrize("interface", ("co-simulation", "model-exchange"))
+def test_a_ramp_is_held_over_each_step_from_its_value_at_t(integrator, tmp_path, interface):
+    """u = t: x(t_n) = sum of t_k h, 0.45 at 1 s for h = 0.1 (the first-order answer of an input held
+    over the step), Co-Simulation exactly and Model Exchange to CVode's tolerance; the discrete k
+    (held from row to row) changes at 1 s, where Model Exchange records the new value. (FMPy's Model
+    Exchange gives 0.4426 here: it sets the inputs after CVode has stepped past the output point.)"""
+    ours = _ours(integrator, _csv(tmp_path, RAMP_INPUT), "gauss-seidel", interface, ("x", "m"))
+    expected = np.array([sum(0.1 * k * STEP for k in range(n)) for n in range(11)])
+    np.testing.assert_allclose(ours["x"], expected, rtol=1e-6, atol=1e-9)
+    assert ours["m"][-2] == 0 and ours["m"][-1] == (3 if interface == "model-exchange" else 0)
+
+
+def test_fmi3_model_exchange_takes_the_input_event_as_fmpy(ball3, tmp_path):
+    rows = [(0.0, 0.0), (0.5, 0.0), (0.5, 2.0), (1.0, 2.0)]
+    csv = tmp_path / "a.csv"
+    csv.write_text("time,a\n" + "".join(f"{t},{a}\n" for t, a in rows))
+    builder = SystemBuilder("ball").simulation(stop_time=STOP, step=STEP, algorithm="gauss-seidel")
+    builder.add_fmu("model", ball3, interface="model-exchange")
+    builder.set_parameters("model", {"g": 0.0})
+    builder.add_block("input", CsvInput("input", csv)).connect("input.a", "model.a").record("model.v", replace=True)
+    ours = run(builder.build()).data["model.v"].to_numpy()
+    signals = np.array(rows, dtype=[("time", float), ("a", float)])
+    theirs = _last_row_per_time(fmpy.simulate_fmu(str(ball3), fmi_type="ModelExchange", input=signals, stop_time=STOP,
+                                                  output_interval=STEP, start_values={"g": 0.0}))["v"]
+    np.testing.assert_allclose(ours, theirs, rtol=1e-6, atol=1e-9)
+    assert ours[-1] == pytest.approx(1.0, abs=1e-9)

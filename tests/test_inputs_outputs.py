@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import fmpy
 import numpy as np
 import pandas as pd
 import pytest
@@ -63,10 +64,23 @@ def test_a_csv_block_in_a_system_file_drives_typed_inputs(typed, signals):
                            {"from": "in.b", "to": "t.b"}],
             "record": {"variables": ["t.y", "t.k2", "t.notb"]}}
     result = run(system_from_dict(data, name="in.toml", base=signals.parent, path=signals.parent / "in.toml")).data
-    np.testing.assert_allclose(result["t.y"], 2.0 * result["time"], atol=1e-12)   # gain 2 * the ramp
+    # the FMU steps from t with the inputs at t (its outputs then show them at t + h), as in FMPy
+    before = np.maximum(result["time"] - 0.1, 0.0)
+    np.testing.assert_allclose(result["t.y"], 2.0 * before, atol=1e-12)          # gain 2 * the ramp
     k = result["t.k2"] - np.arange(11)                                            # k2 = k + steps
-    assert k.tolist() == [0] * 5 + [5] * 6
-    assert result["t.notb"].tolist() == [True] * 3 + [False] * 8
+    assert k.tolist() == [0] * 6 + [5] * 5
+    assert result["t.notb"].tolist() == [True] * 4 + [False] * 7
+    theirs = fmpy.simulate_fmu(str(typed), input=_fmpy_signals(signals), stop_time=1.0, output_interval=0.1,
+                               output=["y", "k2", "notb"])
+    np.testing.assert_allclose(result["t.y"], theirs["y"], atol=1e-12)
+    assert result["t.k2"].tolist() == theirs["k2"].tolist() and result["t.notb"].tolist() == theirs["notb"].tolist()
+
+
+def _fmpy_signals(signals: Path) -> np.ndarray:
+    """The CSV file as FMPy's input array (k Integer, b Boolean)."""
+    table = pd.read_csv(signals).replace({"true": True, "false": False})
+    return np.array([tuple(row) for row in table.itertuples(index=False)],
+                    dtype=[("time", float), ("u", float), ("k", np.int32), ("b", np.bool_)])
 
 
 def test_run_one_fmu_with_an_input_file_and_start_values(typed, signals, tmp_path, capsys):
@@ -74,7 +88,7 @@ def test_run_one_fmu_with_an_input_file_and_start_values(typed, signals, tmp_pat
     assert main(["run", str(typed), "--input", str(signals), "--start", "gain=3", "--start", 'label="moon"',
                  "--start", "s=sea", "-o", str(out), "--quiet"]) == 0
     data = pd.read_csv(out)
-    np.testing.assert_allclose(data["model.y"], 3.0 * data["time"], atol=1e-12)
+    np.testing.assert_allclose(data["model.y"], 3.0 * np.maximum(data["time"] - 0.1, 0.0), atol=1e-12)  # u at t
     assert set(data["model.sout"]) == {"moon:sea"}
     record = json.loads(out.with_suffix(".json").read_text())
     assert record["blocks"] == {"input": "csv"}
