@@ -219,7 +219,8 @@ class SystemBuilder:
     def simulation(self, *, where: str | None = None, **settings: Any) -> SystemBuilder:
         """Set simulation settings (the others keep their values): ``stop_time``, ``step``,
         ``start_time`` [s]; ``algorithm`` (jacobi, gauss-seidel, iterative); ``order`` (instance
-        names, Gauss-Seidel order; default: sources, FMUs, other blocks; the sources step last in any order); ``tolerance``,
+        names, Gauss-Seidel order; default: sources, FMUs, other blocks; the sources step last in
+        any order); ``tolerance``,
         ``max_iterations``, ``relaxation`` (iterative only); ``allow_algebraic_loops``;
         ``threads`` (FMUs stepped at the same time; None: the cores); ``native`` (FMUs stepped from C);
         ``relative_tolerance`` (of the integrator of Model Exchange FMUs, and told to every FMU);
