@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 import fmpy
+from fmpy.model_description import ValidationError
 
 from rover_cosim.common.units import base_units
 
@@ -40,6 +41,7 @@ from .algorithms import ALGORITHMS
 from .blocks import BLOCK_TYPES, Block
 from .loops import describe, find_loop
 from .model import (
+    VALIDATION,
     VARIABLE_TYPES,
     BlockEntry,
     Connection,
@@ -87,9 +89,18 @@ def parse_port(text: Any, where: str) -> Port:
     return Port.parse(text)
 
 
-def read_fmu(fmu_path: Path, where: str) -> Any:
+def recordable(variable: Any) -> bool:
+    """Whether an FMU's variable can be recorded: a scalar of a type that travels (not an FMI 3.0
+    array, Binary or Clock), not the independent variable (time, recorded anyway)."""
+    return (not getattr(variable, "dimensions", None) and variable.type not in ("Binary", "Clock")
+            and variable.causality != "independent")
+
+
+def read_fmu(fmu_path: Path, where: str, validation: str = "strict") -> tuple[Any, tuple[str, ...]]:
     """The model description of an FMI 2.0 or 3.0 FMU file with a Co-Simulation or Model
-    Exchange interface (``where``: the label of messages); SystemFileError for anything else."""
+    Exchange interface (``where``: the label of messages), and what FMPy's validation found wrong
+    with it where ``validation`` (``VALIDATION``) lets it run all the same; SystemFileError for
+    anything else."""
     try:
         found = fmu_path.is_file()
     except OSError as error:  # a name too long, a path through a file
@@ -97,10 +108,7 @@ def read_fmu(fmu_path: Path, where: str) -> Any:
                               f"({error.strerror})") from None
     if not found:
         raise SystemFileError(f"{where}: FMU file {fmu_path} not found (build them with `rover-cosim build-fmus`)")
-    try:
-        description = fmpy.read_model_description(str(fmu_path))
-    except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds
-        raise SystemFileError(f"{where}: {fmu_path} is not a readable FMU: {failure}") from None
+    description, problems = _description(fmu_path, where, validation)
     version = str(description.fmiVersion)
     if version.split(".")[0] not in ("2", "3"):
         raise SystemFileError(f"{where}: {fmu_path.name} is an FMI {version} FMU: expected FMI 2.0 or 3.0")
@@ -111,7 +119,27 @@ def read_fmu(fmu_path: Path, where: str) -> Any:
     if clocks:
         raise SystemFileError(f"{where}: {fmu_path.name} has clocks ({', '.join(clocks[:3])}): FMI 3.0 clocks and "
                               "clocked variables are not supported")
-    return description
+    return description, problems
+
+
+def _description(fmu_path: Path, where: str, validation: str) -> tuple[Any, tuple[str, ...]]:
+    """FMPy's reading of the model description, checked as ``validation`` says (``read_fmu``)."""
+    if validation not in VALIDATION:
+        raise SystemFileError(f"{where}: validation = {validation!r}: expected one of {', '.join(VALIDATION)}")
+    try:
+        try:
+            return fmpy.read_model_description(str(fmu_path)), ()
+        except ValidationError as invalid:
+            problems = tuple(str(p) for p in invalid.problems)
+            if validation == "strict":
+                shown = "; ".join(problems[:3]) + (f" (and {len(problems) - 3} more)" if len(problems) > 3 else "")
+                raise SystemFileError(f"{where}: {fmu_path.name}: its modelDescription.xml fails FMPy's validation: "
+                                      f"{shown}; --validate warn runs it as FMPy does with validate=False") from None
+            return fmpy.read_model_description(str(fmu_path), validate=False), problems
+    except SystemFileError:
+        raise
+    except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds
+        raise SystemFileError(f"{where}: {fmu_path} is not a readable FMU: {failure}") from None
 
 
 def interfaces_of(description: Any) -> list[str]:
@@ -128,11 +156,13 @@ def _check_binary(fmu_path: Path, identifier: str, version: int, where: str) -> 
         names = archive.namelist()
     if wanted in names:
         return
-    platforms = sorted({n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") >= 2
-                        and n.split("/")[1]})
+    libraries = {f"{identifier}{extension}" for extension in (".so", ".dll", ".dylib")}
+    platforms = sorted({n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") == 2
+                        and n.split("/")[2] in libraries})
     sources = any(n.startswith("sources/") and n.endswith(".c") for n in names)
     has = ", ".join(platforms) if platforms else "none"
-    raise SystemFileError(f"{where}: {fmu_path.name} has no binary for this platform ({wanted}); its binaries: {has}"
+    raise SystemFileError(f"{where}: {fmu_path.name} has no binary for this platform ({wanted}); the platform "
+                          f"folders holding a binary of {identifier}: {has}"
                           + ("; it ships C sources, which `fmpy compile` can build" if sources else ""))
 
 
@@ -193,8 +223,11 @@ class SystemBuilder:
     docstring). ``name`` names the system in messages; relative FMU paths start at ``base``
     (default: the working folder). Methods return the builder, so calls chain."""
 
-    def __init__(self, name: str = "system", *, base: Path | None = None, path: Path | None = None):
+    def __init__(self, name: str = "system", *, base: Path | None = None, path: Path | None = None,
+                 validation: str = "strict"):
         self.name = name
+        #: How the FMUs' model descriptions are checked (``VALIDATION``)
+        self.validation = validation
         self.base = Path(base) if base is not None else None
         self.path = path
         self._settings = _Settings(dict(SIMULATION_DEFAULTS), {})
@@ -335,13 +368,13 @@ class SystemBuilder:
         fmu_path = Path(path)
         if not fmu_path.is_absolute() and self.base is not None:
             fmu_path = self.base / fmu_path
-        description = read_fmu(fmu_path, f"{self.name}: {where}")
+        description, problems = read_fmu(fmu_path, f"{self.name}: {where}", self.validation)
         offered = interfaces_of(description)
         chosen = offered[0] if interface is None else interface
         if chosen not in offered:
             raise self.error(f"{where} interface", f"{interface!r}: expected one that {fmu_path.name} offers: "
                              f"{', '.join(offered)}")
-        entry = FmuEntry(name, fmu_path, {}, {}, description, chosen)
+        entry = FmuEntry(name, fmu_path, {}, {}, description, chosen, self.validation, problems)
         _check_binary(fmu_path, entry.capabilities.modelIdentifier, entry.fmi_version, f"{self.name}: {where}")
         self._fmus[name] = entry
         self._where[name] = where
@@ -524,15 +557,41 @@ class SystemBuilder:
 
     def record(self, *ports: str | Port, where: str | None = None, replace: bool = False) -> SystemBuilder:
         """Record these ports (in addition to those recorded before, unless ``replace``); without
-        any call to record, every output of every participant is recorded."""
+        any call to record, every output of every participant is recorded. A port may be a glob
+        pattern (``"model.*"``, ``"wheel?.F[xz]"``): every variable it matches that can be recorded
+        (of an FMU: any causality, locals too; of a block: its inputs and outputs), in the order of
+        the instances and their variables; a pattern that matches none is an error naming it."""
         where = where or "record"
         recorded = self._record if self._record is not None and not replace else []
         for text in ports:
-            port = parse_port(text, f"{self.name}: {where}")
-            self._lookup(port, f"{where} {str(text)!r}")
-            recorded.append(port)
+            matched = self._matching(text, where) if isinstance(text, str) and set("*?[") & set(text) else None
+            for port in matched if matched is not None else [parse_port(text, f"{self.name}: {where}")]:
+                self._lookup(port, f"{where} {str(text)!r}")
+                if port not in recorded:
+                    recorded.append(port)
         self._record = recorded
         return self
+
+    def _matching(self, pattern: str, where: str) -> list[Port]:
+        """The ports a glob ``pattern`` ("instance.variable", either part a pattern) matches."""
+        from fnmatch import fnmatchcase
+
+        instance, dot, variable = pattern.partition(".")
+        if not dot:
+            raise self.error(where, f"{pattern!r}: expected \"instance.variable\" (either may be a glob pattern)")
+        found: list[Port] = []
+        for name, fmu in self._fmus.items():
+            if fnmatchcase(name, instance):
+                found += [Port(name, v.name) for v in fmu.description.modelVariables
+                          if fnmatchcase(v.name, variable) and recordable(v)]
+        for name, entry in self._blocks.items():
+            if fnmatchcase(name, instance):
+                ports = (*entry.block.inputs, *entry.block.outputs)
+                found += [Port(name, v) for v in ports if fnmatchcase(v, variable)]
+        if not found:
+            raise self.error(where, f"{pattern!r} matches no variable that can be recorded (instances: "
+                             f"{', '.join([*self._fmus, *self._blocks])})")
+        return found
 
     # --- the system -----------------------------------------------------------------------------
     def _check_inputs_driven(self) -> None:
@@ -672,7 +731,8 @@ class SystemBuilder:
 
 
 def _copy_fmu(fmu: FmuEntry) -> FmuEntry:
-    return FmuEntry(fmu.name, fmu.path, dict(fmu.parameters), dict(fmu.start), fmu.description, fmu.interface)
+    return FmuEntry(fmu.name, fmu.path, dict(fmu.parameters), dict(fmu.start), fmu.description, fmu.interface,
+                    fmu.validation, fmu.problems)
 
 
 def replace_settings(system: System, *, name: str | None = None, **settings: Any) -> System:

@@ -17,6 +17,10 @@ from typing import Any
 
 from .blocks import Block
 
+#: How a model description that fails FMPy's validation is treated: refused ("strict", the
+#: default), run as FMPy runs it with validate=False after saying what is wrong ("warn"), or run
+#: without a word ("off"; the record says so).
+VALIDATION = ("strict", "warn", "off")
 #: How an FMU is run: its Co-Simulation interface (it steps itself) or its Model Exchange
 #: interface (the engine integrates it, ``model_exchange``).
 INTERFACES = ("co-simulation", "model-exchange")
@@ -146,6 +150,10 @@ class FmuEntry:
     description: Any  # fmpy ModelDescription
     #: Which of the FMU's interfaces runs it (``INTERFACES``).
     interface: str = "co-simulation"
+    #: How its model description was checked (``VALIDATION``), and what FMPy's validation found
+    #: where it was run all the same ("warn", "off").
+    validation: str = "strict"
+    problems: tuple[str, ...] = ()
 
     def variables(self) -> dict[str, Any]:
         return {v.name: v for v in self.description.modelVariables}

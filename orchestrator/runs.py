@@ -24,7 +24,9 @@ def system_record(system: System) -> dict[str, Any]:
     return {
         "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid,
                             "fmi_version": str(fmu.description.fmiVersion), "interface": fmu.interface,
-                            "parameters": dict(fmu.parameters), "start": dict(fmu.start)}
+                            "parameters": dict(fmu.parameters), "start": dict(fmu.start),
+                            **({} if fmu.validation == "strict" else {"validation": fmu.validation,
+                                                                      "validation_problems": list(fmu.problems)})}
                  for fmu in system.fmus},
         "blocks": {block.name: block.kind for block in system.blocks},
         "blocks_keys": {block.name: block.keys for block in system.blocks if block.keys is not None},

@@ -8,12 +8,12 @@ causality); an input file (a CSV, ``blocks.CsvInput``) drives the inputs its col
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from .blocks import CsvInput
-from .builder import SystemBuilder
+from .builder import SystemBuilder, recordable
 from .model import System, SystemFileError
 
 #: The instance name of the one FMU.
@@ -21,11 +21,14 @@ INSTANCE = "model"
 
 
 def single_fmu_system(path: Path, settings: Mapping[str, Any] | None = None, *, interface: str | None = None,
-                      values: Mapping[str, Any] | None = None,
-                      input_file: Path | None = None) -> tuple[System, list[str]]:
+                      values: Mapping[str, Any] | None = None, input_file: Path | None = None,
+                      record: Sequence[str] = (), validation: str = "strict") -> tuple[System, list[str]]:
     """The system of the FMU ``path`` alone, and notes for the user (input columns that name no
-    input of the FMU, left out). SystemFileError for anything that does not fit the FMU."""
-    builder = SystemBuilder(str(path))
+    input of the FMU, left out; a run that would record nothing but time). ``record``: the
+    variables to record, names or glob patterns of the FMU's variables, locals too (default: every
+    output); ``validation``: how its model description is checked (``model.VALIDATION``).
+    SystemFileError for anything that does not fit the FMU."""
+    builder = SystemBuilder(str(path), validation=validation)
     if settings:
         builder.simulation(**settings)
     builder.add_fmu(INSTANCE, Path(path).resolve(), interface=interface, where=f"FMU {Path(path).name}")
@@ -37,15 +40,43 @@ def single_fmu_system(path: Path, settings: Mapping[str, Any] | None = None, *, 
     builder.set_start(INSTANCE, {k: v for k, v in (values or {}).items() if k not in parameters}, where="--start")
     if input_file is not None:
         notes += _connect_input(builder, variables, Path(input_file))
+    if record:
+        builder.record(*[f"{INSTANCE}.{name}" for name in _matching(Path(path), variables, record)], where="--record",
+                       replace=True)
+        return builder.build(), notes
     outputs = [v for v in variables.values() if v.causality == "output"]
-    left = [f"{v.name} ({'an array' if v.dimensions else v.type})" for v in outputs
-            if v.type in ("Binary", "Clock") or v.dimensions]
+    left = [f"{v.name} ({'an array' if v.dimensions else v.type})" for v in outputs if not recordable(v)]
     if left:
         notes.append(f"outputs {', '.join(left)}: not recorded (FMI 3.0 arrays, Binary and Clock variables are "
                      "not supported)")
-    builder.record(*[f"{INSTANCE}.{v.name}" for v in outputs if v.type not in ("Binary", "Clock")
-                     and not v.dimensions], where="outputs", replace=True)
-    return builder.build(), notes
+    builder.record(*[f"{INSTANCE}.{v.name}" for v in outputs if recordable(v)], where="outputs", replace=True)
+    system = builder.build()
+    if not system.record:
+        notes.append(nothing_recorded(variables.values()))
+    return system, notes
+
+
+def _matching(path: Path, variables: Mapping[str, Any], patterns: Sequence[str]) -> list[str]:
+    """The FMU's variables that ``patterns`` (names or glob patterns) name, each once, in the order
+    of the patterns; SystemFileError for a pattern that names none."""
+    from fnmatch import fnmatchcase
+
+    found: list[str] = []
+    for pattern in patterns:
+        names = [name for name, v in variables.items() if fnmatchcase(name, pattern) and recordable(v)]
+        if not names:
+            raise SystemFileError(f"{path.name}: --record {pattern!r}: names no variable of the FMU that can be "
+                                  "recorded (scalars, not Binary or Clock; `--record '*'` records them all)")
+        found += [name for name in names if name not in found]
+    return found
+
+
+def nothing_recorded(variables: Iterable[Any]) -> str:
+    """What a run that would record nothing but time says: what it could record instead."""
+    candidates = [v.name for v in variables if recordable(v) and v.causality in ("local", "parameter", "input")]
+    shown = ", ".join(candidates[:8]) + (f" and {len(candidates) - 8} more" if len(candidates) > 8 else "")
+    return ("the FMU has no output that can be recorded: only time would be; name what to record with --record "
+            f"(names or glob patterns, e.g. --record '*'){': it has ' + shown if shown else ''}")
 
 
 def _fill_experiment(builder: SystemBuilder, description: Any, settings: dict[str, Any]) -> list[str]:

@@ -360,11 +360,12 @@ def inside(folder: Path, source: str | None, what: str) -> Path:
     return path
 
 
-def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None) -> System:
+def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None, validation: str = "strict") -> System:
     """The System of an SSP 1.0 archive, written by export_ssp or by another tool (one flat system
     of FMU components; what is not supported is named), its files unpacked into ``folder`` (which
     must outlive the run). ``settings``: simulation settings that override the archive's (as the
-    command line's --step, --stop-time); a step neither gives comes from the FMUs' DefaultExperiment."""
+    command line's --step, --stop-time); a step neither gives comes from the FMUs' DefaultExperiment.
+    ``validation``: how the FMUs' model descriptions are checked (``model.VALIDATION``)."""
     archive = Path(archive)
     _unpack(archive, folder, size_limit())
     if not (folder / "SystemStructure.ssd").is_file():
@@ -376,7 +377,7 @@ def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None
     top = ssd_root.find("ssd:System", ns)
     _refuse_unsupported(top, ns)
     annotation = _annotation(ssd_root, ns)
-    builder = SystemBuilder(str(archive), base=folder)
+    builder = SystemBuilder(str(archive), base=folder, validation=validation)
     builder.simulation(where="[simulation]", **_simulation(annotation, ssd_root, ns))
     if settings:
         builder.simulation(where="command line", **settings)

@@ -132,9 +132,10 @@ def _known_keys(builder: SystemBuilder, entry: dict[str, Any], section: str, whe
         raise builder.error(where, f"unknown key(s) {sorted(unknown)}; expected {sorted(SECTION_KEYS[section])}")
 
 
-def load_system(path: Path | str, *, fmu_dir: Path | None = None) -> System:
+def load_system(path: Path | str, *, fmu_dir: Path | None = None, validation: str = "strict") -> System:
     """Read and validate a system file. Relative FMU paths are resolved against ``fmu_dir`` if
-    given, else against the file's folder."""
+    given, else against the file's folder; ``validation``: how the FMUs' model descriptions are
+    checked (``model.VALIDATION``)."""
     path = Path(path)
     try:
         data = tomllib.loads(path.read_text())
@@ -146,12 +147,13 @@ def load_system(path: Path | str, *, fmu_dir: Path | None = None) -> System:
         raise SystemFileError(f"{path}: not valid TOML: {error}") from None
     except RecursionError:
         raise SystemFileError(f"{path}: nested too deeply to be a system file") from None
-    return system_from_dict(data, name=str(path), base=fmu_dir or path.parent, path=path)
+    return system_from_dict(data, name=str(path), base=fmu_dir or path.parent, path=path, validation=validation)
 
 
-def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path | None = None) -> System:
+def system_from_dict(data: dict[str, Any], *, name: str, base: Path, path: Path | None = None,
+                     validation: str = "strict") -> System:
     """A checked :class:`System` from the parsed TOML ``data`` (``name`` is used in messages)."""
-    builder = SystemBuilder(name, base=base, path=path)
+    builder = SystemBuilder(name, base=base, path=path, validation=validation)
     unknown = set(data) - {"simulation", "fmu", "block", "connection", "record"}
     if unknown:
         raise builder.error("top level", f"unknown table(s) {sorted(unknown)}; expected [simulation], [[fmu]], "

@@ -7,6 +7,7 @@ an FMU ends the simulation (fmi2Discard with fmi2Terminated), from Python and fr
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -183,8 +184,12 @@ def test_a_system_without_stop_time_or_step_takes_the_fmus_default_experiment(ty
 
 def test_an_fmu_without_a_binary_for_this_platform_is_named_with_the_ones_it_has(tmp_path):
     foreign = _built(tmp_path, name="Elsewhere", platform="win64")
+    with zipfile.ZipFile(foreign, "a") as archive:  # an empty folder of this platform and another model's binary
+        archive.writestr("binaries/linux64/", b"")
+        archive.writestr("binaries/darwin64/Other.dylib", b"")
     with pytest.raises(SystemFileError, match=r"Elsewhere.fmu has no binary for this platform "
-                                              r"\(binaries/linux64/Typed.so\); its binaries: win64"):
+                                              r"\(binaries/linux64/Typed.so\); the platform folders holding a binary "
+                                              r"of Typed: win64$"):
         system_from_dict(one(foreign), name="t", base=tmp_path)
 
 

@@ -40,6 +40,9 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     algorithm.choices = _Algorithms()  # after add_argument, which would read them at once
     parser.add_argument("--step", type=float, default=None, help="override the communication step [s]")
     parser.add_argument("--stop-time", type=float, default=None, help="override the stop time [s]")
+    parser.add_argument("--relative-tolerance", type=float, default=None, metavar="TOL",
+                        help="of the integrator (CVode) of Model Exchange FMUs, and told to every FMU (default: the "
+                        "system file's, else 1e-6)")
     parser.add_argument("--output-interval", type=float, default=None,
                         help="record a row every so often [s] (a whole number of steps; the last row always)")
     parser.add_argument("--threads", type=int, default=None,
@@ -54,6 +57,13 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--input", type=path, default=None, metavar="CSV",
                         help="one FMU run alone: input signals, first column time [s], one column per input "
                         "(continuous Real inputs interpolated, the others held; a repeated time is a step)")
+    parser.add_argument("--validate", choices=("strict", "warn", "off"), default="strict",
+                        help="an FMU whose modelDescription.xml fails FMPy's validation: refused (strict), run as "
+                        "FMPy runs it with validate=False after listing the problems (warn), or run silently (off; "
+                        "the record says so)")
+    parser.add_argument("--record", action="append", metavar="NAME",
+                        help="a variable to record instead of every output (repeatable; glob patterns: 'x*', '*'); "
+                        "one FMU run alone: its variable names, locals too; a system: instance.variable")
     parser.add_argument("--overwrite", action="store_true",
                         help="replace --output even if it is not a result of rover-cosim run")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -79,17 +89,32 @@ class _Algorithms:
 def _load_system(args: argparse.Namespace, unpack: Path) -> tuple[Any, Path]:
     """The system of ``rover-cosim run`` with the command line's overrides (SystemFileError if
     bad); an .ssp archive is unpacked into ``unpack``."""
-    from rover_cosim.orchestrator.builder import replace_settings
-    from rover_cosim.orchestrator.ssp import SspError, load_ssp
-    from rover_cosim.orchestrator.system import SystemFileError, load_system
+    from rover_cosim.orchestrator.builder import SystemBuilder
 
     system_file, fmu_dir = system_path(args.system, args.fmu_dir)
     overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
                                                ("stop_time", args.stop_time), ("threads", args.threads),
-                                               ("output_interval", args.output_interval))
+                                               ("output_interval", args.output_interval),
+                                               ("relative_tolerance", args.relative_tolerance))
                  if value is not None}
     if system_file.suffix.lower() == ".fmu":
         return _one_fmu(system_file, overrides, args), system_file  # the overrides are its settings
+    system, system_file = _system_of_file(system_file, fmu_dir, overrides, unpack, args)
+    if args.record:  # instead of the file's [record]
+        system = SystemBuilder.from_system(system).record(*args.record, where="--record", replace=True).build()
+    if not system.record:
+        fail("run", f"{system_file}: records nothing but time (no participant has an output that can be recorded): "
+             "name what to record with --record instance.variable (glob patterns too, e.g. --record 'model.*')")
+    return system, system_file
+
+
+def _system_of_file(system_file: Path, fmu_dir: Path | None, overrides: dict[str, Any], unpack: Path,
+                    args: argparse.Namespace) -> tuple[Any, Path]:
+    """The system of a system file or SSP archive with the command line's overrides."""
+    from rover_cosim.orchestrator.builder import replace_settings
+    from rover_cosim.orchestrator.ssp import SspError, load_ssp
+    from rover_cosim.orchestrator.system import SystemFileError, load_system
+
     given = [flag for flag, value in (("--interface", args.interface), ("--start", args.start),
                                       ("--input", args.input)) if value]
     if given:
@@ -97,10 +122,10 @@ def _load_system(args: argparse.Namespace, unpack: Path) -> tuple[Any, Path]:
                               "model.fmu); a system file gives its FMUs' interface, start values and inputs itself")
     if system_file.suffix.lower() == ".ssp":
         try:  # the overrides are settings of the archive's system, checked as its own
-            return load_ssp(system_file, unpack, overrides), system_file
+            return load_ssp(system_file, unpack, overrides, validation=args.validate), system_file
         except SspError as error:
             raise SystemFileError(f"{system_file}: {error}") from None
-    system = load_system(system_file, fmu_dir=fmu_dir)
+    system = load_system(system_file, fmu_dir=fmu_dir, validation=args.validate)
     if overrides:
         system = replace_settings(system, name=f"{system_file} (with command-line overrides)", **overrides)
     return system, system_file
@@ -113,7 +138,7 @@ def _one_fmu(fmu: Path, settings: dict[str, Any], args: argparse.Namespace) -> A
     from rover_cosim.orchestrator.single import single_fmu_system
 
     system, notes = single_fmu_system(fmu, settings, interface=args.interface, values=dict(args.start or []),
-                                      input_file=args.input)
+                                      input_file=args.input, record=args.record or (), validation=args.validate)
     for note in notes:
         fail("run", note)
     return system
@@ -141,6 +166,11 @@ def run(args: argparse.Namespace) -> int:
         if choice is not None:  # the chosen soil and wheel go to every FMU that has them
             system = with_parameters(system, fmu_parameters(choice.soil, choice.wheel))
             extra = describe(choice)
+        for fmu in system.fmus:
+            if fmu.problems and fmu.validation == "warn":
+                fail("run", f"{fmu.path.name}: its modelDescription.xml fails FMPy's validation, run all the same "
+                     f"(--validate warn): " + "; ".join(fmu.problems[:5])
+                     + (f" (and {len(fmu.problems) - 5} more)" if len(fmu.problems) > 5 else ""))
         return _run_system(args, system, system_file, extra)
 
 
