@@ -22,6 +22,7 @@ import json
 import os
 import tempfile
 import zipfile
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -360,12 +361,16 @@ def inside(folder: Path, source: str | None, what: str) -> Path:
     return path
 
 
-def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None, validation: str = "strict") -> System:
+def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None, validation: str = "strict",
+             factories: Collection[str] = ()) -> System:
     """The System of an SSP 1.0 archive, written by export_ssp or by another tool (one flat system
     of FMU components; what is not supported is named), its files unpacked into ``folder`` (which
     must outlive the run). ``settings``: simulation settings that override the archive's (as the
     command line's --step, --stop-time); a step neither gives comes from the FMUs' DefaultExperiment.
-    ``validation``: how the FMUs' model descriptions are checked (``model.VALIDATION``)."""
+    ``validation``: how the FMUs' model descriptions are checked (``model.VALIDATION``).
+    ``factories``: the Python block factories the user allows the archive to name, besides those
+    registered (``blocks.register_factory``): "module:callable", or "module" for any of its
+    callables; such a module is looked up beside the archive first."""
     archive = Path(archive)
     _unpack(archive, folder, size_limit())
     if not (folder / "SystemStructure.ssd").is_file():
@@ -386,7 +391,7 @@ def load_ssp(archive: Path, folder: Path, settings: dict[str, Any] | None = None
         builder.add_fmu(entry["name"], entry["path"], parameters=entry["parameters"], start=entry["start"],
                         interface=interfaces.get(entry["name"]), where=f"component {entry['name']!r}")
     for entry in annotation.get("blocks", []):
-        _annotation_block(builder, entry, folder)
+        _annotation_block(builder, entry, folder, set(factories), archive.parent)
     elements = [c for c in top.findall("ssd:Connections/ssd:Connection", ns)
                 if c.get("startElement") and c.get("endElement")]  # system connectors: the blocks' side
     connections = [(f"{c.get('startElement')}.{c.get('startConnector')}",
@@ -417,23 +422,28 @@ def _refuse_unsupported(top: etree._Element | None, ns: dict[str, str]) -> None:
         raise SspError("signal dictionaries are not supported: connect the components directly")
 
 
-def _annotation_block(builder: SystemBuilder, entry: dict[str, Any], folder: Path) -> None:
-    """One block of our annotation: a built-in type, or a Python factory registered with the engine."""
+def _annotation_block(builder: SystemBuilder, entry: dict[str, Any], folder: Path, allowed: set[str],
+                      beside: Path) -> None:
+    """One block of our annotation: a built-in type, or a Python factory the user allows
+    (``allowed``: "module:callable" or "module"; or registered with the engine), its module looked up
+    in ``beside`` (the archive's folder) first."""
     name, kind = entry.get("name"), entry.get("type")
     keys = {k: v for k, v in entry.items() if k not in ("name", "type")}
     where = f"annotation block {name!r}"
-    if kind == "python" and keys.get("factory") not in REGISTERED_FACTORIES:
-        raise builder.error(where, f"the archive names the Python block factory {keys.get('factory')!r}, which is "
-                            "not registered with the engine (an archive may name the built-in block types, "
-                            f"{', '.join(BLOCK_TYPES)}, and factories registered with "
-                            "rover_cosim.orchestrator.blocks.register_factory: it would run code chosen by the "
-                            "archive's author otherwise)")
+    factory = str(keys.get("factory"))
+    if kind == "python" and not (factory in REGISTERED_FACTORIES or factory in allowed
+                                 or factory.partition(":")[0] in allowed):
+        raise builder.error(where, f"the archive names the Python block factory {keys.get('factory')!r}, which you "
+                            "have not allowed (an archive may name the built-in block types, "
+                            f"{', '.join(BLOCK_TYPES)}, and the factories you allow: `rover-cosim run --allow-factory "
+                            f"{factory.partition(':')[0]}`, or rover_cosim.orchestrator.blocks.register_factory; "
+                            "it would run code chosen by the archive's author otherwise)")
     if kind != "python" and kind not in BLOCK_TYPES:
         raise builder.error(where, f"type {kind!r}: expected one of {', '.join(BLOCK_TYPES)}")
     if kind == "csv":
         keys["file"] = str(inside(folder, keys.get("file"), where))
     try:
-        block = make_block(str(name), str(kind), keys, None)
+        block = make_block(str(name), str(kind), keys, beside if kind == "python" else None)
     except ValueError as failure:
         raise builder.error(where, str(failure)) from None
     builder.add_block(str(name), block, kind=str(kind), keys=keys, where=where)

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pytest
+import tomli_w
 
 from rover_cosim.cli import EXAMPLES, main
 from rover_cosim.orchestrator.blocks import register_factory
@@ -135,7 +136,7 @@ def test_a_python_block_travels_as_connectors_and_an_annotation(fmu_dir, fmus, t
     data["fmu"][0]["start"] = {"omega": 5.0}
     system = system_from_dict(data, name="brake.toml", base=fmu_dir)
     exported = export_ssp(system, tmp_path / "brake.ssp")
-    with pytest.raises(SystemFileError, match="Python block factory 'test_orchestrator:Gain', which is not registered"):
+    with pytest.raises(SystemFileError, match="factory 'test_orchestrator:Gain', which you have not allowed"):
         load_ssp(exported.path, tmp_path / "refused")
     register_factory("test_orchestrator:Gain")
     with zipfile.ZipFile(exported.path) as archive:
@@ -143,6 +144,36 @@ def test_a_python_block_travels_as_connectors_and_an_annotation(fmu_dir, fmus, t
     assert 'name="brake_y" kind="input"' in ssd and 'name="brake_u" kind="output"' in ssd
     again = load_ssp(exported.path, tmp_path / "unpacked")
     pd.testing.assert_frame_equal(run(system).data, run(again).data, check_exact=True)
+
+
+def test_an_archive_with_a_python_block_runs_from_the_command_line_where_the_user_allows_its_module(
+        fmu_dir, fmus, tmp_path, capsys):
+    """The block's module beside the archive; refused (exit 2, naming --allow-factory) until the user
+    allows that module, then the same rows as the system file it was exported from."""
+    (tmp_path / "my_brake.py").write_text(
+        "import numpy as np\n"
+        "class Brake:\n"
+        "    inputs, outputs, units = ('u',), ('y',), {'u': 'rad/s', 'y': 'N.m'}\n"
+        "    def __init__(self, name, k):\n"
+        "        self.name, self.k = name, k\n"
+        "    def start(self, t0, u0, h):\n"
+        "        return -self.k * u0\n"
+        "    def step(self, t, h, u):\n"
+        "        return -self.k * u\n")
+    data = tomllib.loads(EXAMPLES["single_wheel_step"].read_text())
+    data["simulation"]["stop_time"] = 0.2
+    data["block"] = [{"name": "brake", "type": "python", "factory": "my_brake:Brake", "k": 100.0}]
+    data["connection"] = [{"from": "testbed.omega", "to": "brake.u"}, {"from": "brake.y", "to": "testbed.tau"}]
+    data["fmu"][0]["start"] = {"omega": 5.0}
+    data["fmu"][0]["path"] = str(fmu_dir / "SingleWheel.fmu")
+    (tmp_path / "brake.toml").write_text(tomli_w.dumps(data))
+    assert main(["export-ssp", str(tmp_path / "brake.toml"), "-o", str(tmp_path / "brake.ssp")]) == 0
+    out = tmp_path / "ssp.csv"
+    assert main(["run", str(tmp_path / "brake.ssp"), "-o", str(out), "--quiet"]) == 2
+    assert "`rover-cosim run --allow-factory my_brake`" in capsys.readouterr().err and not out.exists()
+    assert main(["run", str(tmp_path / "brake.ssp"), "--allow-factory", "my_brake", "-o", str(out), "--quiet"]) == 0
+    assert main(["run", str(tmp_path / "brake.toml"), "-o", str(tmp_path / "toml.csv"), "--quiet"]) == 0
+    pd.testing.assert_frame_equal(pd.read_csv(out), pd.read_csv(tmp_path / "toml.csv"))
 
 
 def test_a_broken_archive_is_a_clear_error(tmp_path):

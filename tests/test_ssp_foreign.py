@@ -131,7 +131,7 @@ def test_an_unregistered_python_factory_is_refused_before_anything_runs(typed, t
     with zipfile.ZipFile(tmp_path / "evil.ssp", "w") as zf:
         for name, data in files.items():
             zf.writestr(name, data)
-    with pytest.raises(SystemFileError, match="'os:makedirs', which is not registered with the engine"):
+    with pytest.raises(SystemFileError, match="'os:makedirs', which you have not allowed"):
         load_ssp(tmp_path / "evil.ssp", tmp_path / "unpacked")
     assert not victim.exists()
 

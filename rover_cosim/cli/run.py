@@ -61,6 +61,10 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="an FMU whose modelDescription.xml fails FMPy's validation: refused (strict), run as "
                         "FMPy runs it with validate=False after listing the problems (warn), or run silently (off; "
                         "the record says so)")
+    parser.add_argument("--allow-factory", action="append", metavar="MODULE", default=[],
+                        help="an SSP archive may name Python blocks of this module (module or module:callable; "
+                        "repeatable): the archive's code runs only where you allow it; the module is looked up "
+                        "beside the archive first")
     parser.add_argument("--record", action="append", metavar="NAME",
                         help="a variable to record instead of every output (repeatable; glob patterns: 'x*', '*'); "
                         "one FMU run alone: its variable names, locals too; a system: instance.variable")
@@ -122,7 +126,8 @@ def _system_of_file(system_file: Path, fmu_dir: Path | None, overrides: dict[str
                               "model.fmu); a system file gives its FMUs' interface, start values and inputs itself")
     if system_file.suffix.lower() == ".ssp":
         try:  # the overrides are settings of the archive's system, checked as its own
-            return load_ssp(system_file, unpack, overrides, validation=args.validate), system_file
+            return load_ssp(system_file, unpack, overrides, validation=args.validate,
+                            factories=args.allow_factory), system_file
         except SspError as error:
             raise SystemFileError(f"{system_file}: {error}") from None
     system = load_system(system_file, fmu_dir=fmu_dir, validation=args.validate)
