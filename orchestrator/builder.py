@@ -38,7 +38,7 @@ from fmpy.model_description import ValidationError
 from rover_cosim.common.units import base_units
 
 from .algorithms import ALGORITHMS
-from .blocks import BLOCK_TYPES, Block
+from .blocks import BLOCK_TYPES, Block, make_block
 from .loops import describe, find_loop
 from .model import (
     VALIDATION,
@@ -471,11 +471,20 @@ class SystemBuilder:
     def fmu_names(self) -> list[str]:
         return list(self._fmus)
 
-    def add_block(self, name: str, block: Block, *, kind: str | None = None, keys: dict[str, Any] | None = None,
+    def add_block(self, name: str, block: Block | str, *, kind: str | None = None, keys: dict[str, Any] | None = None,
                   where: str | None = None) -> SystemBuilder:
-        """A Python block ``name`` (any object with the block interface, ``blocks``). ``kind`` and
-        ``keys``: the block type and keys it was made from, when it came from a system file."""
+        """A Python block ``name``: any object with the block interface (``blocks``), or a factory
+        ``"module:callable"`` called with ``name`` and the ``keys`` (the module looked up in the
+        builder's base folder first, else the current folder), as a system file's ``type = "python"``
+        block; the system then keeps the factory, so that a system file or SSP archive of it names it. ``kind`` and
+        ``keys`` of an object: the block type and keys it was made from, when it came from a file."""
         where = where or f"add_block({name!r})"
+        if isinstance(block, str):
+            keys, kind = {"factory": block, **(keys or {})}, "python"
+            try:
+                block = make_block(name, kind, keys, self.base if self.base is not None else Path.cwd())
+            except ValueError as failure:
+                raise self.error(where, str(failure)) from None
         self._claim_for(name, where)
         for attribute in ("inputs", "outputs", "start", "step"):
             if not hasattr(block, attribute):
