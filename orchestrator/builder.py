@@ -52,6 +52,7 @@ from .model import (
     SystemFileError,
     Value,
     compatible_types,
+    elements_of,
     typed_value,
 )
 
@@ -416,6 +417,10 @@ class SystemBuilder:
     def _scalar(self, fmu: FmuEntry, variable: Any, where: str) -> None:
         """SystemFileError for an array variable (FMI 3.0 dimensions) or a type that cannot travel."""
         if getattr(variable, "dimensions", None):
+            elements = elements_of(variable)
+            if elements:
+                raise self.error(where, f"{fmu.name}.{variable.name} is an array (FMI 3.0 dimensions): name its "
+                                 f"elements, {elements[0].name} ... {elements[-1].name}")
             raise self.error(where, f"{fmu.name}.{variable.name} is an array (FMI 3.0 dimensions): array variables "
                              "are not supported (scalar variables are)")
         if variable.type in ("Binary", "Clock"):
@@ -573,13 +578,24 @@ class SystemBuilder:
         where = where or "record"
         recorded = self._record if self._record is not None and not replace else []
         for text in ports:
-            matched = self._matching(text, where) if isinstance(text, str) and set("*?[") & set(text) else None
+            matched = self._matching(text, where) if isinstance(text, str) and self._pattern(text) else None
             for port in matched if matched is not None else [parse_port(text, f"{self.name}: {where}")]:
                 self._lookup(port, f"{where} {str(text)!r}")
                 if port not in recorded:
                     recorded.append(port)
         self._record = recorded
         return self
+
+    def _pattern(self, text: str | Port) -> bool:
+        """Whether ``text`` is a glob pattern rather than a port (an array element's name,
+        ``y[1]``, is a port)."""
+        if not isinstance(text, str) or not set("*?[") & set(text) or "." not in text:
+            return False
+        port = Port.parse(text)
+        if port.instance in self._fmus:
+            return port.variable not in self._fmus[port.instance].variables()
+        return not (port.instance in self._blocks and port.variable in (*self._blocks[port.instance].block.inputs,
+                                                                         *self._blocks[port.instance].block.outputs))
 
     def _matching(self, pattern: str, where: str) -> list[Port]:
         """The ports a glob ``pattern`` ("instance.variable", either part a pattern) matches."""
@@ -591,7 +607,7 @@ class SystemBuilder:
         found: list[Port] = []
         for name, fmu in self._fmus.items():
             if fnmatchcase(name, instance):
-                found += [Port(name, v.name) for v in fmu.description.modelVariables
+                found += [Port(name, v.name) for v in fmu.variables().values()
                           if fnmatchcase(v.name, variable) and recordable(v)]
         for name, entry in self._blocks.items():
             if fnmatchcase(name, instance):
@@ -667,11 +683,11 @@ class SystemBuilder:
         return [str(name) for name in order]
 
     def _outputs(self, instance: str) -> list[Port]:
-        """What is recorded by default: every scalar output (FMI 3.0 arrays, Binary and Clock
-        variables are left out)."""
+        """What is recorded by default: every output, an FMI 3.0 array as its elements (Binary and
+        Clock variables are left out)."""
         if instance in self._fmus:
-            return [Port(instance, v.name) for v in self._fmus[instance].description.modelVariables
-                    if v.causality == "output" and v.type not in ("Binary", "Clock") and not v.dimensions]
+            return [Port(instance, v.name) for v in self._fmus[instance].variables().values()
+                    if v.causality == "output" and recordable(v)]
         return [Port(instance, o) for o in self._blocks[instance].block.outputs]
 
     def _loop(self) -> list[Port] | None:

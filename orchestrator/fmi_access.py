@@ -48,14 +48,16 @@ def c_type(version: int, kind: str) -> Any:
     return table[kind]
 
 
-def raw_call(fmu: Any, version: int, action: str, kind: str) -> Callable[[Any, int, Any], Any]:
-    """``call(references, n, buffer)`` of fmi2<action><kind> or fmi3<action><kind> (``action``:
-    Set or Get) on the instance of the FMPy object ``fmu``."""
+def raw_call(fmu: Any, version: int, action: str, kind: str) -> Callable[..., Any]:
+    """``call(references, n, buffer[, n_values])`` of fmi2<action><kind> or fmi3<action><kind>
+    (``action``: Set or Get) on the instance of the FMPy object ``fmu``; ``n_values`` (FMI 3.0):
+    the values in ``buffer``, more than ``n`` where arrays are among the references."""
     function = getattr(fmu, f"fmi{version}{action}{kind}")
     component = fmu.component
     if version == 2:
-        return lambda references, n, buffer: function(component, references, n, buffer)
-    return lambda references, n, buffer: function(component, references, n, buffer, n)
+        return lambda references, n, buffer, n_values=None: function(component, references, n, buffer)
+    return lambda references, n, buffer, n_values=None: function(component, references, n, buffer,
+                                                                 n if n_values is None else n_values)
 
 
 class StringTable:
@@ -80,59 +82,112 @@ class StringTable:
         return self.texts[k] if 0 <= k < len(self.texts) else ""
 
 
+class _Group:
+    """The variables of one function family: the value references (each array once), where each
+    name's value sits in the buffer (an array's elements follow each other), and the buffer."""
+
+    def __init__(self, version: int, kind: str, names: list[str], positions: list[int], refs: dict[str, int],
+                 elements: dict[str, tuple[int, int]]):
+        starts: dict[int, int] = {}  # value reference -> where its values begin in the buffer
+        sizes: list[int] = []
+        offsets = []
+        for k in positions:
+            reference = refs[names[k]]
+            index, size = elements.get(names[k], (0, 1))
+            if reference not in starts:
+                starts[reference] = sum(sizes)
+                sizes.append(size)
+            offsets.append(starts[reference] + index)
+        self.references = (ctypes.c_uint * len(starts))(*starts)
+        self.positions = np.array(positions, dtype=int)
+        self.offsets = np.array(offsets, dtype=int)
+        self.n_values = sum(sizes)
+        self.buffer = (c_type(version, kind) * self.n_values)()
+        #: whether every value of the buffer is one of ``names`` (else a set must keep the others)
+        self.whole = len(set(offsets)) == self.n_values
+        self.primed = self.whole
+        #: the names' values are the buffer in order (no arrays, or whole arrays in order): copied at once
+        self.in_order = offsets == list(range(self.n_values))
+
+
 class Exchange:
     """The variables ``names`` of an FMU (of FMI ``version``) grouped by the function that sets
     or gets them; :meth:`set` and :meth:`get` move them between the FMU and a float array in the
-    order of ``names``. ``real_only``: a single FMI 2.0 fmi2Set/GetReal group (the native stepper's
-    and the fast path's case)."""
+    order of ``names``. ``elements``: the names that are elements of FMI 3.0 arrays, with their
+    (index, size): an array is set and got whole, its other elements kept as the FMU has them.
+    ``real_only``: a single FMI 2.0 fmi2Set/GetReal group (the native stepper's and the fast path's
+    case)."""
 
     def __init__(self, version: int, names: list[str], types: dict[str, str], refs: dict[str, int],
-                 strings: StringTable):
+                 strings: StringTable, elements: dict[str, tuple[int, int]] | None = None):
         self.version, self.strings = version, strings
-        #: kind -> (value references, positions in ``names``, a buffer of the kind's C type), made once
-        self.groups: dict[str, tuple[Any, np.ndarray, Any]] = {}
+        #: kind -> its group of variables, made once
+        self.groups: dict[str, _Group] = {}
         for name in names:
             c_type(version, call_kind(version, types[name]))  # refuse a type that cannot travel, by name
         kinds = dict.fromkeys(call_kind(version, types[n]) for n in names)
         for kind in kinds:
             positions = [k for k, n in enumerate(names) if call_kind(version, types[n]) == kind]
-            references = (ctypes.c_uint * len(positions))(*[refs[names[k]] for k in positions])
-            buffer = (c_type(version, kind) * len(positions))()
-            self.groups[kind] = (references, np.array(positions, dtype=int), buffer)
+            self.groups[kind] = _Group(version, kind, names, positions, refs, elements or {})
         self.real_only = version == 2 and set(self.groups) <= {"Real"}
+
+    def _call(self, fmu: Any, action: str, kind: str, group: _Group,
+              call: Callable[[str, Callable[[], Any]], Any]) -> None:
+        call(f"fmi{self.version}{action}{kind}", partial(raw_call(fmu, self.version, action, kind), group.references,
+                                                         len(group.references), group.buffer, group.n_values))
 
     def set(self, fmu: Any, values: np.ndarray, call: Callable[[str, Callable[[], Any]], Any]) -> None:
         """Set every variable from ``values``; ``call(what, action)`` makes each FMI call (and
         turns its failure into the participant's error)."""
-        for kind, (references, positions, buffer) in self.groups.items():
-            chosen = values[positions].tolist()
-            buffer[:] = c_values(self.version, kind, [self.strings.text(v) for v in chosen] if kind == "String"
+        for kind, group in self.groups.items():
+            if not group.primed:  # an array set in part: its other elements as the FMU has them
+                self._call(fmu, "Get", kind, group, call)
+                group.primed = True
+            chosen = values[group.positions].tolist()
+            converted = c_values(self.version, kind, [self.strings.text(v) for v in chosen] if kind == "String"
                                  else chosen)
-            call(f"fmi{self.version}Set{kind}", partial(raw_call(fmu, self.version, "Set", kind), references,
-                                                         len(references), buffer))
+            if group.in_order:
+                group.buffer[:] = converted
+            else:
+                for offset, value in zip(group.offsets.tolist(), converted):
+                    group.buffer[offset] = value
+            self._call(fmu, "Set", kind, group, call)
 
     def get(self, fmu: Any, out: np.ndarray, call: Callable[[str, Callable[[], Any]], Any]) -> None:
         """Read every variable into ``out`` (in the order of ``names``)."""
-        for kind, (references, positions, buffer) in self.groups.items():
-            call(f"fmi{self.version}Get{kind}", partial(raw_call(fmu, self.version, "Get", kind), references,
-                                                         len(references), buffer))
+        for kind, group in self.groups.items():
+            self._call(fmu, "Get", kind, group, call)
+            values = group.buffer[:]
+            if not group.in_order:
+                values = [values[k] for k in group.offsets.tolist()]
             if kind == "String":
-                out[positions] = [self.strings.number((b or b"").decode(errors="replace")) for b in buffer]
+                out[group.positions] = [self.strings.number((b or b"").decode(errors="replace")) for b in values]
             else:
-                out[positions] = [float(v) for v in buffer]
+                out[group.positions] = [float(v) for v in values]
 
 
 def set_by_name(fmu: Any, version: int, values: dict[str, Any], types: dict[str, str], refs: dict[str, int],
-                call: Callable[[str, Callable[[], Any]], Any]) -> None:
+                call: Callable[[str, Callable[[], Any]], Any],
+                arrays: dict[str, tuple[int, list[Any]]] | None = None) -> None:
     """Set typed values (parameters, start values) by variable name: one call per function
-    family, each value converted to its C type directly (64-bit integers stay exact)."""
-    groups: dict[str, list[tuple[int, Any]]] = {}
+    family, each value converted to its C type directly (64-bit integers stay exact). ``arrays``:
+    the names that are elements of FMI 3.0 arrays, with their index and the array's start values
+    (an array is set whole: its other elements keep their start)."""
+    arrays = arrays or {}
+    groups: dict[str, dict[int, list[Any]]] = {}  # kind -> value reference -> its values
     for name, value in values.items():
-        groups.setdefault(call_kind(version, types[name]), []).append((refs[name], value))
-    for kind, pairs in groups.items():
-        references = (ctypes.c_uint * len(pairs))(*[r for r, _ in pairs])
-        buffer = (c_type(version, kind) * len(pairs))(*c_values(version, kind, [v for _, v in pairs]))
-        call(f"fmi{version}Set{kind}", partial(raw_call(fmu, version, "Set", kind), references, len(pairs), buffer))
+        family = groups.setdefault(call_kind(version, types[name]), {})
+        if name in arrays:
+            index, starts = arrays[name]
+            family.setdefault(refs[name], list(starts))[index] = value
+        else:
+            family[refs[name]] = [value]
+    for kind, family in groups.items():
+        flat = [v for values_of in family.values() for v in values_of]
+        references = (ctypes.c_uint * len(family))(*family)
+        buffer = (c_type(version, kind) * len(flat))(*c_values(version, kind, flat))
+        call(f"fmi{version}Set{kind}", partial(raw_call(fmu, version, "Set", kind), references, len(family), buffer,
+                                               len(flat)))
 
 
 def c_values(version: int, kind: str, values: list[Any]) -> list[Any]:

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .blocks import Block
 
 #: How a model description that fails FMPy's validation is treated: refused ("strict", the
@@ -138,6 +140,50 @@ class Iteration:
     relaxation: float = 1.0
 
 
+class Element:
+    """One element of an FMI 3.0 array variable, seen as a scalar named ``name[i]`` or
+    ``name[i,j]`` (1-based, row-major, as the array's values follow each other): its type,
+    causality, unit and value reference are the array's; ``index`` is its place among the array's
+    ``size`` values, ``start`` its part of the array's start."""
+
+    dimensions = None
+
+    def __init__(self, array: Any, index: int, name: str, size: int):
+        self.array, self.index, self.name, self.size = array, index, name, size
+        starts = str(array.start).split() if array.start is not None else []
+        self.start = starts[index] if len(starts) == size else (starts[0] if len(starts) == 1 else None)
+
+    def starts(self) -> list[Any]:
+        """The array's start values, typed (0 where it declares none)."""
+        text = str(self.array.start).split() if self.array.start is not None else []
+        if len(text) == 1:
+            text *= self.size
+        if len(text) != self.size:
+            text = ["0"] * self.size
+        if self.array.type == "Boolean":
+            return [t in ("true", "1") for t in text]
+        if self.array.type in ("Float64", "Float32"):
+            return [float(t) for t in text]
+        return [int(t) for t in text]
+
+    def __getattr__(self, attribute: str) -> Any:  # the array's type, causality, unit, valueReference ...
+        return getattr(self.array, attribute)
+
+    def __repr__(self) -> str:
+        return f"Element({self.name!r} of {self.array.name!r})"
+
+
+def elements_of(variable: Any) -> list[Element]:
+    """The elements of an array ``variable`` of known shape (none for a scalar, or an array whose
+    size is not known before the run)."""
+    shape = tuple(getattr(variable, "shape", None) or ())
+    if not getattr(variable, "dimensions", None) or not shape or not all(isinstance(n, int) and n > 0 for n in shape):
+        return []
+    size = int(np.prod(shape))
+    return [Element(variable, k, f"{variable.name}[{','.join(str(i + 1) for i in np.unravel_index(k, shape))}]", size)
+            for k in range(size)]
+
+
 @dataclass
 class FmuEntry:
     """An FMU component: its instance name, file, parameter and start values (by variable name,
@@ -156,7 +202,16 @@ class FmuEntry:
     problems: tuple[str, ...] = ()
 
     def variables(self) -> dict[str, Any]:
-        return {v.name: v for v in self.description.modelVariables}
+        """Every variable by name (made once), and every element of an FMI 3.0 array as a scalar
+        ``name[i]`` (``Element``)."""
+        cached = self.__dict__.get("_variables")
+        if cached is None or cached[0] is not self.description:
+            found: dict[str, Any] = {}
+            for v in self.description.modelVariables:
+                found[v.name] = v
+                found.update((e.name, e) for e in elements_of(v))
+            cached = self.__dict__["_variables"] = (self.description, found)
+        return cached[1]
 
     @property
     def fmi_version(self) -> int:

@@ -94,7 +94,7 @@ class ModelExchangeParticipant(FmuParticipant):
         # the continuous inputs alone: what may be set in Continuous-Time Mode
         self._continuous_positions = np.flatnonzero(~self._discrete)
         self._continuous = Exchange(self.version, [self.inputs[k] for k in self._continuous_positions], self.types,
-                                    self.refs, self.strings)
+                                    self.refs, self.strings, self.elements)
 
     # --- FMI calls that differ between the versions ----------------------------------------------
     def _mode(self, what: str, t: float) -> None:

@@ -36,7 +36,7 @@ from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 from .blocks import Block, takes_step
 from .fmi_access import Exchange, StringTable, set_by_name
-from .model import FmuEntry, Value
+from .model import Element, FmuEntry, Value
 from .native import NativeBlock, NativeCalls, function_address
 
 T = TypeVar("T")
@@ -218,9 +218,14 @@ class FmuParticipant:
         self.strings = strings if strings is not None else StringTable()
         self.messages: list[str] = []
         md = entry.description
-        self.refs = {v.name: v.valueReference for v in md.modelVariables}
-        self.types = {v.name: str(v.type) for v in md.modelVariables}
-        self.variability = {v.name: str(v.variability) for v in md.modelVariables}
+        variables = entry.variables()  # the elements of FMI 3.0 arrays too, as name[i]
+        self.refs = {name: v.valueReference for name, v in variables.items()}
+        self.types = {name: str(v.type) for name, v in variables.items()}
+        self.variability = {name: str(v.variability) for name, v in variables.items()}
+        #: the elements of arrays among them: name -> (its index in the array, the array's size)
+        self.elements = {name: (v.index, v.size) for name, v in variables.items() if isinstance(v, Element)}
+        #: the same with the array's start values, for setting parameters and start values by element
+        self.array_starts = {name: (v.index, v.starts()) for name, v in variables.items() if isinstance(v, Element)}
         self.fmu = self._instantiate(md, folder)
         self.inputs: list[str] = []
         self.outputs: list[str] = []
@@ -319,8 +324,8 @@ class FmuParticipant:
         """Fix the inputs set and the variables read at every step (preallocated arrays)."""
         self.inputs, self.outputs = list(inputs), list(reads)
         try:
-            self._inputs = Exchange(self.version, self.inputs, self.types, self.refs, self.strings)
-            self._reads = Exchange(self.version, self.outputs, self.types, self.refs, self.strings)
+            self._inputs = Exchange(self.version, self.inputs, self.types, self.refs, self.strings, self.elements)
+            self._reads = Exchange(self.version, self.outputs, self.types, self.refs, self.strings, self.elements)
         except ValueError as problem:
             raise RunError(f"{self.name} ({self.entry.path.name}): {problem}") from None
         self._in_refs = (ctypes.c_uint * max(1, len(inputs)))(*[self.refs[n] for n in inputs])
@@ -354,7 +359,7 @@ class FmuParticipant:
         """Set variables by name, one call per FMI type (fmi2SetReal, fmi2SetInteger, ...)."""
         if names:
             set_by_name(self.fmu, self.version, names, self.types, self.refs,
-                        lambda what, act: self._call(what, act, t))
+                        lambda what, act: self._call(what, act, t), self.array_starts)
 
     def enter_initialization(self, t0: float, stop_time: float) -> None:
         """The parameters and start values and Initialization Mode (FMI 2.0: after

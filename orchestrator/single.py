@@ -14,7 +14,7 @@ from typing import Any
 
 from .blocks import CsvInput
 from .builder import SystemBuilder, recordable
-from .model import System, SystemFileError
+from .model import System, SystemFileError, elements_of
 
 #: The instance name of the one FMU.
 INSTANCE = "model"
@@ -45,10 +45,12 @@ def single_fmu_system(path: Path, settings: Mapping[str, Any] | None = None, *, 
                        replace=True)
         return builder.build(), notes
     outputs = [v for v in variables.values() if v.causality == "output"]
-    left = [f"{v.name} ({'an array' if v.dimensions else v.type})" for v in outputs if not recordable(v)]
+    left = [f"{v.name} ({'an array of a size known only at run time' if v.dimensions else v.type})"
+            for v in outputs if not recordable(v) and not elements_of(v)]
     if left:
-        notes.append(f"outputs {', '.join(left)}: not recorded (FMI 3.0 arrays, Binary and Clock variables are "
-                     "not supported)")
+        raise SystemFileError(f"{path}: outputs {', '.join(left)} cannot be recorded (Binary and Clock variables, and "
+                              "arrays whose size depends on structural parameters, are not supported): name what to "
+                              "record with --record (names or glob patterns) to leave them out")
     builder.record(*[f"{INSTANCE}.{v.name}" for v in outputs if recordable(v)], where="outputs", replace=True)
     system = builder.build()
     if not system.record:
@@ -63,7 +65,8 @@ def _matching(path: Path, variables: Mapping[str, Any], patterns: Sequence[str])
 
     found: list[str] = []
     for pattern in patterns:
-        names = [name for name, v in variables.items() if fnmatchcase(name, pattern) and recordable(v)]
+        names = [pattern] if pattern in variables and recordable(variables[pattern]) else [
+            name for name, v in variables.items() if fnmatchcase(name, pattern) and recordable(v)]
         if not names:
             raise SystemFileError(f"{path.name}: --record {pattern!r}: names no variable of the FMU that can be "
                                   "recorded (scalars, not Binary or Clock; `--record '*'` records them all)")
