@@ -33,12 +33,18 @@ def system_record(system: System) -> dict[str, Any]:
     }
 
 
+#: The convention by which participants see input signals (sources), said in every run's record.
+INPUT_TIMING = ("every participant stepping from t to t + h sees each input signal (a source block: csv, step, ramp, "
+                "...) at t, held over the step (FMPy's convention; at a repeated time, the later row); a Model Exchange "
+                "FMU takes a signal's jump at a communication point there, in Event Mode for discrete inputs")
+
+
 def sidecar(system: System, result: RunResult, command: str,
             extra: dict[str, Any] | None = None) -> dict[str, object]:
     record = run_record(command, {"algorithm": system.algorithm, "step_s": system.step,
                                   "start_time_s": system.start_time, "stop_time_s": system.stop_time,
                                   "order": system.order, "relative_tolerance": system.relative_tolerance,
-                                  "output_interval_s": system.output_interval})
+                                  "output_interval_s": system.output_interval, "input_timing": INPUT_TIMING})
     return {
         **record,
         "system_file": str(system.path) if system.path else None,
