@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from .model import INTEGER_RANGES
+
 #: FMI 3.0 types -> their C type (an Enumeration is an Int64).
 FMI3_C_TYPES = {"Float64": ctypes.c_double, "Float32": ctypes.c_float, "Int8": ctypes.c_int8,
                 "UInt8": ctypes.c_uint8, "Int16": ctypes.c_int16, "UInt16": ctypes.c_uint16,
@@ -200,4 +202,9 @@ def c_values(version: int, kind: str, values: list[Any]) -> list[Any]:
         return [float(v) for v in values]
     if kind == "Boolean":
         return [bool(v) if version == 3 else int(bool(v)) for v in values]
-    return [v if isinstance(v, int) else int(round(v)) for v in values]
+    whole = [v if isinstance(v, int) else int(round(v)) for v in values]
+    if kind not in INTEGER_RANGES:
+        return whole
+    # a value-vector float rounded up from the type's largest value (2^63 - 1 is 2^63 as a float) saturates
+    low, high = INTEGER_RANGES[kind]
+    return [min(max(v, low), high - 1) for v in whole]

@@ -87,8 +87,14 @@ class Recorder:
 
 def typed(values: np.ndarray, kind: str, strings: StringTable | None = None) -> np.ndarray:
     """A recorded column (float64 slots of the value vector) as its FMI type ``kind``."""
-    if kind in INTEGER_RANGES:
-        return values.astype("uint64" if kind == "UInt64" else "int64")
+    if kind in INTEGER_RANGES:  # a value beyond the type's range (a float rounded up from its largest) saturates
+        low, high = INTEGER_RANGES[kind]
+        column = np.empty(len(values), dtype="uint64" if kind == "UInt64" else "int64")
+        above, below = values >= float(high), values < float(low)
+        inside = ~(above | below)
+        column[inside] = values[inside].astype(column.dtype)
+        column[above], column[below] = high - 1, low
+        return column
     if kind == "Boolean":
         return values != 0.0
     if kind == "String":

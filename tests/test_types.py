@@ -216,3 +216,17 @@ def test_results_have_short_reprs(typed):
     result = run(SystemBuilder("r").simulation(stop_time=1.0, step=0.1).add_fmu("a", typed).build())
     text = repr(result)
     assert text.startswith("RunResult(11 rows x ") and "10 steps" in text and len(text) < 200
+
+
+def test_the_largest_64_bit_integers_saturate_instead_of_wrapping():
+    """The value vector holds floats: 2^63 - 1 and 2^64 - 1 become 2^63 and 2^64 there. Set into an
+    Int64/UInt64 input or recorded, they are the type's largest value again (the Reference-FMUs'
+    Feedthrough with its input file: before, -2^63 and 0 where FMPy gives 2^63 - 1 and 2^64 - 1)."""
+    from rover_cosim.orchestrator.fmi_access import c_values
+    from rover_cosim.orchestrator.recorder import typed
+
+    assert c_values(3, "Int64", [float(2**63 - 1), -float(2**63), 7.0]) == [2**63 - 1, -2**63, 7]
+    assert c_values(3, "UInt64", [float(2**64 - 1), -1.0]) == [2**64 - 1, 0]
+    assert c_values(2, "Integer", [float(2**31), 3.0]) == [2**31 - 1, 3]
+    assert typed(np.array([float(2**63 - 1), -float(2**63), 5.0]), "Int64").tolist() == [2**63 - 1, -2**63, 5]
+    assert typed(np.array([float(2**64 - 1), 1.0]), "UInt64").tolist() == [2**64 - 1, 1]
