@@ -135,8 +135,9 @@ def test_the_closed_loop_with_the_c_twin_is_the_python_closed_loop(fmu_dir, mode
 
 
 def test_a_failing_c_twin_is_named_with_its_message(fmu_dir, model):
-    """Limb 1's load falls to 0 N within the first step (a step source in place of the rover's Fz[1]):
-    the controller's C twin refuses it, and the run names the block, the call, the time and why."""
+    """Limb 1's load falls to 0 N at 0.5 ms (a step source in place of the rover's Fz[1]; the
+    controller sees it from the next communication point, 1 ms, on): the controller's C twin
+    refuses it, and the run names the block, the call, the time and why."""
     from rover_cosim.orchestrator.blocks import Step
     from rover_cosim.orchestrator.builder import SystemBuilder
 
@@ -149,9 +150,10 @@ def test_a_failing_c_twin_is_named_with_its_message(fmu_dir, model):
         if i > 1:
             builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]")
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
-    with pytest.raises(RunError, match=r"ctrl \(block\): step at t = 0 s failed: loads = 0 N: expected > 0") as info:
+    with pytest.raises(RunError, match=r"ctrl \(block\): step at t = 0.001 s failed: loads = 0 N: expected > 0") \
+            as info:
         run(builder.build())
-    assert len(info.value.partial) == 1  # the start only
+    assert len(info.value.partial) == 2  # the start and the first step
 
 
 def test_without_a_compiler_the_controller_steps_in_python(fmu_dir, model, tmp_path, monkeypatch):
