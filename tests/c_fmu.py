@@ -35,3 +35,12 @@ def compile_fmu(source: str, identifier: str, folder: Path, name: str, descripti
         archive.writestr("modelDescription.xml", description)
         archive.write(library, f"binaries/{platform}/{identifier}.so")
     return fmu
+
+
+def built_or_skip(built: Path | str) -> Path:
+    """The FMU a build function made, or the test skipped with the reason it could not be built."""
+    import pytest
+
+    if isinstance(built, str):
+        pytest.skip(f"the test FMU cannot be built here: {built}")
+    return built

@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from arrays_fmu import build_arrays
+from c_fmu import built_or_skip
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, run
@@ -22,10 +23,7 @@ from rover_cosim.orchestrator.model import SystemFileError
 
 @pytest.fixture(scope="module")
 def arrays(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    built = build_arrays(tmp_path_factory.mktemp("arrays"))
-    if isinstance(built, str):
-        pytest.skip(f"the test FMU cannot be built here: {built}")
-    return built
+    return built_or_skip(build_arrays(tmp_path_factory.mktemp("arrays")))
 
 
 def test_every_element_is_a_column_and_the_rows_are_fmpys(arrays, tmp_path):

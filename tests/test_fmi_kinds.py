@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 from ball_fmus import E, G, build_ball2, build_ball3, exact_height
+from c_fmu import built_or_skip
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, run
@@ -22,20 +23,14 @@ from rover_cosim.orchestrator.model import SystemFileError
 from rover_cosim.orchestrator.system import load_system, system_from_dict, system_to_toml
 
 
-def _built(built: Path | str) -> Path:
-    if isinstance(built, str):
-        pytest.skip(f"the test FMU cannot be built here: {built}")
-    return built
-
-
 @pytest.fixture(scope="module")
 def ball2(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return _built(build_ball2(tmp_path_factory.mktemp("ball2")))
+    return built_or_skip(build_ball2(tmp_path_factory.mktemp("ball2")))
 
 
 @pytest.fixture(scope="module")
 def ball3(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return _built(build_ball3(tmp_path_factory.mktemp("ball3")))
+    return built_or_skip(build_ball3(tmp_path_factory.mktemp("ball3")))
 
 
 def _exact(times: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -12,6 +12,7 @@ import fmpy
 import numpy as np
 import pytest
 from ball_fmus import build_ball3
+from c_fmu import built_or_skip
 from integrator_fmu import build_integrator
 
 from rover_cosim.orchestrator import SystemBuilder, run
@@ -26,20 +27,14 @@ INPUTS = {"step": STEP_INPUT, "ramp": RAMP_INPUT}
 MASTERS = ("gauss-seidel", "jacobi", "iterative")
 
 
-def _built(built: Path | str) -> Path:
-    if isinstance(built, str):
-        pytest.skip(f"the test FMU cannot be built here: {built}")
-    return built
-
-
 @pytest.fixture(scope="module")
 def integrator(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return _built(build_integrator(tmp_path_factory.mktemp("integrator")))
+    return built_or_skip(build_integrator(tmp_path_factory.mktemp("integrator")))
 
 
 @pytest.fixture(scope="module")
 def ball3(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return _built(build_ball3(tmp_path_factory.mktemp("ball3")))
+    return built_or_skip(build_ball3(tmp_path_factory.mktemp("ball3")))
 
 
 def _csv(folder: Path, rows: list[tuple[float, float, int]], names: tuple[str, str] = ("u", "k")) -> Path:

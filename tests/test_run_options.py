@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from c_fmu import built_or_skip
 from integrator_fmu import build_integrator
 
 from rover_cosim.cli import main
@@ -18,10 +19,7 @@ from rover_cosim.cli import main
 
 @pytest.fixture(scope="module")
 def integrator(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    built = build_integrator(tmp_path_factory.mktemp("integrator"))
-    if isinstance(built, str):
-        pytest.skip(f"the test FMU cannot be built here: {built}")
-    return built
+    return built_or_skip(build_integrator(tmp_path_factory.mktemp("integrator")))
 
 
 def _variant(fmu: Path, folder: Path, name: str, change: tuple[str, str], *more: tuple[str, str]) -> Path:
