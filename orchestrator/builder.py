@@ -577,11 +577,13 @@ class SystemBuilder:
         the instances and their variables; a pattern that matches none is an error naming it."""
         where = where or "record"
         recorded = self._record if self._record is not None and not replace else []
+        seen = set(recorded)
         for text in ports:
             matched = self._matching(text, where) if isinstance(text, str) and self._pattern(text) else None
             for port in matched if matched is not None else [parse_port(text, f"{self.name}: {where}")]:
                 self._lookup(port, f"{where} {str(text)!r}")
-                if port not in recorded:
+                if port not in seen:
+                    seen.add(port)
                     recorded.append(port)
         self._record = recorded
         return self

@@ -65,6 +65,7 @@ class _Builder:
         self.entries = system.participants()
         self.slots = _Slots()
         self.reads: dict[str, list[str]] = {name: [] for name in self.entries}
+        self._read: dict[str, set[str]] = {name: set() for name in self.entries}  # the same, to look up
         self.constants: dict[int, Value] = {}
 
     def slot_of(self, port: Port) -> int:
@@ -79,7 +80,8 @@ class _Builder:
                 start = entry.start.get(port.variable, declared_start(variable))
                 self.constants[slot] = start if start is not None else 0.0
                 return slot
-            if port.variable not in self.reads[port.instance]:
+            if port.variable not in self._read[port.instance]:
+                self._read[port.instance].add(port.variable)
                 self.reads[port.instance].append(port.variable)
         return self.slots(port)
 
