@@ -203,6 +203,22 @@ class BlockParticipant:
             self.native.close()
 
 
+#: How many of an FMU's error messages a participant keeps, and how long one may be (characters).
+MESSAGES_KEPT, MESSAGE_LENGTH = 20, 500
+
+
+def clean_message(raw: bytes | str | None) -> str:
+    """An FMU's log message as it may reach a terminal: control characters (escape sequences, CR,
+    LF) shown as spaces or ``\\xNN``, at most MESSAGE_LENGTH characters (the rest counted), a NULL
+    message said as such."""
+    if raw is None:
+        return "(the FMU logged a NULL message)"
+    text = raw.decode(errors="replace") if isinstance(raw, bytes) else str(raw)
+    shown = "".join(c if c.isprintable() else (" " if c in "\r\n\t" else f"\\x{ord(c):02x}")
+                    for c in text[:MESSAGE_LENGTH])
+    return shown + (f"... ({len(text)} characters)" if len(text) > MESSAGE_LENGTH else "")
+
+
 class FmuParticipant:
     """An FMU instance run through its Co-Simulation interface (FMI 2.0 or 3.0); ``inputs`` are
     its connected inputs, ``outputs`` the variables read from it (connected or recorded), both
@@ -259,8 +275,9 @@ class FmuParticipant:
         return fmu
 
     def _log(self, env, instance, status, category, message) -> None:
-        if status >= 2:  # discard, error, fatal
-            self.messages.append(message.decode(errors="replace"))
+        if status >= 2:  # discard, error, fatal: kept (the last MESSAGES_KEPT) to name in an error
+            self.messages.append(clean_message(message))
+            del self.messages[:-MESSAGES_KEPT]
 
     def _log3(self, env, status, category, message) -> None:
         self._log(env, None, status, category, message)

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import base64
 import html
 import json
 import re
@@ -153,3 +154,26 @@ def test_the_probe_sees_overflow_broken_figures_and_errors(tmp_path):
            "</body></html>")
     check = _rendered(bad, tmp_path)
     assert check["scroll"] > 1024 and check["broken"] == 1 and len(check["errors"]) == 1, check
+
+
+def test_study_values_are_escaped_and_a_linked_figure_is_not_embedded(tmp_path):
+    """A summary.json whose values carry markup (runs, seed, stop time, not only the title) and a
+    figure that is a link to another file of the machine: the markup is text, the link is named and
+    not read."""
+    results = tmp_path / "results"
+    write_fig3(results)
+    secret = tmp_path / "secret.txt"
+    secret.write_text("not for the page")
+    figure = next(results.glob("fig3_fx_vs_slip*.png"))
+    figure.unlink()
+    figure.symlink_to(secret)
+    (results / "montecarlo").mkdir()
+    (results / "montecarlo" / "summary.json").write_text(json.dumps({
+        "parameters": {"title": "<b>t</b>", "runs": "<script>1</script>", "seed": "<img src=x>", "soil": "s",
+                       "stop_time_s": "<iframe src=y>"}, "scenarios": {}}))
+    page = build_report(results)
+    for text in ("<script", "<img src=x", "<iframe", "<b>t</b>"):
+        assert text not in page, text
+    assert "&lt;script&gt;1&lt;/script&gt;" in page and "&lt;iframe src=y&gt;" in page
+    assert "is not a regular file (a link or a folder): not embedded" in page
+    assert base64.b64encode(b"not for the page").decode() not in page

@@ -254,3 +254,15 @@ def test_a_process_unpacks_an_fmu_file_once_and_again_when_it_changes(fmu_dir, f
     os.utime(copy, ns=(copy.stat().st_atime_ns, copy.stat().st_mtime_ns + 10**9))  # the file changed
     changed = system().fmus[0]
     assert unpack(changed) != folder and run(system()).data.equals(first.data)
+
+
+def test_an_fmus_log_message_reaches_the_terminal_tamed():
+    """Escape sequences, CR/LF and a huge message from an FMU's logger: shown without control
+    characters and cut to its first 500 characters (the rest counted); a NULL message is said."""
+    from rover_cosim.orchestrator.participants import MESSAGE_LENGTH, clean_message
+
+    assert clean_message(b"bad \x1b[2J\x1b[31mred\r\nsecond line\x07") == "bad \\x1b[2J\\x1b[31mred  second line\\x07"
+    huge = clean_message(b"x" * 20_000_000)
+    assert len(huge) < MESSAGE_LENGTH + 40 and huge.endswith("... (20000000 characters)")
+    assert clean_message(None) == "(the FMU logged a NULL message)"
+    assert clean_message("\u00e9t\u00e9 ok") == "\u00e9t\u00e9 ok"

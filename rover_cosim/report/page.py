@@ -26,6 +26,11 @@ def missing(path: Path) -> str:
 
 
 def image(path: Path, caption: str) -> str:
+    """The figure ``path`` embedded with its caption; only a regular file is read (a link, which
+    could point at any file of the machine, is named and left out)."""
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        return (f"<p class='missing'>{html.escape(caption)}: {html.escape(str(path))} is not a regular file "
+                "(a link or a folder): not embedded.</p>")
     if not path.exists():
         return f"<p class='missing'>{html.escape(caption)}: {html.escape(str(path))} not produced.</p>"
     data = base64.b64encode(path.read_bytes()).decode()

@@ -129,7 +129,8 @@ def identification_section(identification: Path, paper_soil: bool = True) -> lis
         coefficients = identified.model().fx_coefficients.tolist()
         rows = [{"term": f"slip^{k}", "p0 [N]": c[0], "p1 [-]": c[1], "p2 [1/N]": c[2]}
                 for k, c in enumerate(coefficients)]
-        sections += [f"<p>The recommended ({recommended}) model, Fx = Σ c<sub>k</sub>(W) slip<sup>k</sup> with "
+        sections += [f"<p>The recommended ({html.escape(str(recommended))}) model, Fx = Σ c<sub>k</sub>(W) "
+                     "slip<sup>k</sup> with "
                      "c<sub>k</sub>(W) = p0 + p1 W + p2 W<sup>2</sup> (W in N):</p>",
                      table(pd.DataFrame(rows), default="{:.5g}")]
     for name, caption in (("fig5_fx_vs_slip.png", "Fig. 5: settled Fx against slip over the fitted range, with "
@@ -362,9 +363,10 @@ def montecarlo_section(montecarlo: Path) -> list[str]:
     summary = json.loads(summary_path.read_text())
     study = summary.get("parameters", {})
     sections = ["<h2>Monte Carlo over soil uncertainty</h2>",
-                f"<p>Study <b>{html.escape(str(study.get('title') or study.get('file')))}</b>: {study.get('runs')} "
-                f"samples (seed {study.get('seed')}); sample 0 is the nominal soil the model was identified on "
-                f"({html.escape(str(study.get('soil')))}); the paper's closed loop, {study.get('stop_time_s')} s, "
+                f"<p>Study <b>{html.escape(str(study.get('title') or study.get('file')))}</b>: "
+                f"{html.escape(str(study.get('runs')))} samples (seed {html.escape(str(study.get('seed')))}); sample 0 "
+                f"is the nominal soil the model was identified on ({html.escape(str(study.get('soil')))}); the "
+                f"paper's closed loop, {html.escape(str(study.get('stop_time_s')))} s, "
                 "with the controller and the identified model unchanged.</p>"]
     rows = []
     for scenario, numbers in summary.get("scenarios", {}).items():
