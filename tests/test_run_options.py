@@ -91,3 +91,31 @@ def test_validate_strict_refuses_warn_runs_and_says_off_runs_and_records(integra
     assert main(["run", str(odd), "--validate", "off", "-o", str(out), "--quiet", "--overwrite"]) == 0
     assert "validation" not in capsys.readouterr().err
     assert json.loads(out.with_suffix(".json").read_text())["fmus"]["model"]["validation"] == "off"
+
+
+def test_run_does_not_replace_a_users_files_beside_its_output(integrator, tmp_path, capsys):
+    """The record (x.json) and the partial rows (x.partial.csv) a run may write beside x.csv: a
+    user's file of that name is named and kept unless --overwrite; the run's own are replaced."""
+    out = tmp_path / "x.csv"
+    mine = tmp_path / "x.json"
+    mine.write_text('{"my": "notes"}')
+    assert main(["run", str(integrator), "--start", "u=1", "-o", str(out), "--quiet"]) == 2
+    assert f"{mine} exists and is not a result of rover-cosim run" in capsys.readouterr().err
+    assert mine.read_text() == '{"my": "notes"}' and not out.exists()
+    mine.unlink()
+    (tmp_path / "x.partial.csv").write_text("time,a\n0,1\n")
+    assert main(["run", str(integrator), "--start", "u=1", "-o", str(out), "--quiet"]) == 2
+    assert "x.partial.csv exists and is not a result of rover-cosim run" in capsys.readouterr().err
+    (tmp_path / "x.partial.csv").unlink()
+    assert main(["run", str(integrator), "--start", "u=1", "-o", str(out), "--quiet"]) == 0
+    assert main(["run", str(integrator), "--start", "u=2", "-o", str(out), "--quiet"]) == 0  # its own: replaced
+    assert pd.read_csv(out)["model.x"].iloc[-1] == pytest.approx(2.0)
+    (tmp_path / "y.json").write_text("{}")
+    assert main(["run", str(integrator), "-o", str(tmp_path / "y.csv"), "--quiet", "--overwrite"]) == 0
+
+
+def test_testbed_data_does_not_replace_a_users_record(tmp_path, capsys):
+    (tmp_path / "w.json").write_text('{"mine": 1}')
+    assert main(["testbed-data", "--out", str(tmp_path / "w.csv")]) == 2
+    assert "w.json exists and is not a result of rover-cosim testbed-data" in capsys.readouterr().err
+    assert (tmp_path / "w.json").read_text() == '{"mine": 1}' and not (tmp_path / "w.csv").exists()

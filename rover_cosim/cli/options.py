@@ -261,3 +261,26 @@ def option_ok(command: str, option: str, check: Callable[[], object]) -> bool:
         fail(command, f"{option}: {error}")
         return False
     return True
+
+
+def foreign_companion(paths: Iterable[Path], command: str) -> str | None:
+    """Why one of ``paths`` (the files a command writes beside its output: a JSON record, a partial
+    table and its record) may not be replaced without --overwrite: it exists and no record of
+    ``rover-cosim command`` says it made it. None: none such."""
+    owned = recorded_by(command)
+    for companion in paths:
+        if not companion.exists() or companion.is_dir():
+            continue
+        try:
+            if companion.suffix == ".json":
+                import json
+
+                if json.loads(companion.read_text()).get("command") == f"rover-cosim {command}":
+                    continue
+            elif owned(companion):
+                continue
+        except (OSError, ValueError, AttributeError):
+            pass
+        return (f"{companion} exists and is not a result of rover-cosim {command} (it would be replaced beside the "
+                "output): pass --overwrite to replace it")
+    return None

@@ -9,7 +9,18 @@ from pathlib import Path
 from typing import Any
 
 from .command import Command
-from .options import add_soil_options, choice_of, fail, foreign, path, path_text, print_written, recorded_by, unwritable
+from .options import (
+    add_soil_options,
+    choice_of,
+    fail,
+    foreign,
+    foreign_companion,
+    path,
+    path_text,
+    print_written,
+    recorded_by,
+    unwritable,
+)
 from .systems import EXAMPLES, system_path
 
 
@@ -182,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
 def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra: dict[str, Any] | None) -> int:
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.master import run as run_system
-    from rover_cosim.orchestrator.runs import PartialWriter, sidecar_path, write_run
+    from rover_cosim.orchestrator.runs import PartialWriter, partial_path, sidecar_path, write_run
     from rover_cosim.progress import ProgressBar
 
     output = args.output or Path("results") / f"{system_file.stem}.csv"
@@ -191,7 +202,9 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
     except ValueError as error:
         fail("run", str(error))
         return 2
-    problem = unwritable(output, _run_bytes(system)) or (None if args.overwrite else foreign(output, "run", OWNS))
+    companions = (sidecar_path(output), partial_path(output), sidecar_path(partial_path(output)))
+    problem = unwritable(output, _run_bytes(system)) or (None if args.overwrite else (
+        foreign(output, "run", OWNS) or foreign_companion(companions, "run")))
     if problem:  # said before the run, not after it
         fail("run", f"output {output}: {problem}")
         return 2

@@ -9,6 +9,7 @@ from .options import (
     add_soil_options,
     choice_of,
     fail,
+    foreign_companion,
     numbers,
     output_file,
     path,
@@ -65,6 +66,10 @@ def run(args: argparse.Namespace) -> int:
         fail("testbed-data", f"--out {args.out}: expected a .csv file name (its record goes beside it as .json)")
         return 2
     if not output_file(args.out, "testbed-data", COMMAND.needs_bytes, OWNS, args.overwrite, "--out"):
+        return 2
+    companion = None if args.overwrite else foreign_companion([args.out.with_suffix(".json")], "testbed-data")
+    if companion:
+        fail("testbed-data", f"--out {args.out}: {companion}")
         return 2
     choice = choice_of(args, "testbed-data")
     if choice is None:
