@@ -153,19 +153,6 @@ class Element:
         starts = str(array.start).split() if array.start is not None else []
         self.start = starts[index] if len(starts) == size else (starts[0] if len(starts) == 1 else None)
 
-    def starts(self) -> list[Any]:
-        """The array's start values, typed (0 where it declares none)."""
-        text = str(self.array.start).split() if self.array.start is not None else []
-        if len(text) == 1:
-            text *= self.size
-        if len(text) != self.size:
-            text = ["0"] * self.size
-        if self.array.type == "Boolean":
-            return [t in ("true", "1") for t in text]
-        if self.array.type in ("Float64", "Float32"):
-            return [float(t) for t in text]
-        return [int(t) for t in text]
-
     def __getattr__(self, attribute: str) -> Any:  # the array's type, causality, unit, valueReference ...
         return getattr(self.array, attribute)
 

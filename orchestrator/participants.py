@@ -36,7 +36,7 @@ from fmpy.fmi3 import FMU3Model, FMU3Slave
 
 from .blocks import Block, takes_step
 from .fmi_access import Exchange, StringTable, set_by_name
-from .model import Element, FmuEntry, Value
+from .model import Element, FmuEntry, Value, declared_start
 from .native import NativeBlock, NativeCalls, function_address
 
 T = TypeVar("T")
@@ -241,7 +241,13 @@ class FmuParticipant:
         #: the elements of arrays among them: name -> (its index in the array, the array's size)
         self.elements = {name: (v.index, v.size) for name, v in variables.items() if isinstance(v, Element)}
         #: the same with the array's start values, for setting parameters and start values by element
-        self.array_starts = {name: (v.index, v.starts()) for name, v in variables.items() if isinstance(v, Element)}
+        starts: dict[str, list[Any]] = {}  # per array: its elements' declared starts, in order
+        for v in variables.values():
+            if isinstance(v, Element):
+                declared = declared_start(v)
+                starts.setdefault(v.array.name, []).append(declared if declared is not None else 0)
+        self.array_starts = {name: (v.index, starts[v.array.name]) for name, v in variables.items()
+                             if isinstance(v, Element)}
         self.fmu = self._instantiate(md, folder)
         self.inputs: list[str] = []
         self.outputs: list[str] = []
