@@ -23,6 +23,7 @@ run.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -41,6 +42,7 @@ from .algorithms import ALGORITHMS
 from .blocks import BLOCK_TYPES, Block, make_block
 from .loops import describe, find_loop
 from .model import (
+    ISOLATION,
     VALIDATION,
     VARIABLE_TYPES,
     BlockEntry,
@@ -61,7 +63,7 @@ IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 #: The simulation settings and their defaults (stop_time and step have none).
 SIMULATION_DEFAULTS: dict[str, Any] = {"start_time": 0.0, "algorithm": "gauss-seidel", "order": None,
                                        "allow_algebraic_loops": False, "threads": None, "native": True,
-                                       "relative_tolerance": 1e-6, "output_interval": None}
+                                       "relative_tolerance": 1e-6, "output_interval": None, "fmu_timeout": None}
 ITERATION_KEYS = ("tolerance", "max_iterations", "relaxation")
 #: Limits a run is checked against before anything is allocated: the communication steps of a
 #: run, the bytes of its recorded rows, the threads stepping FMUs, the largest time [s].
@@ -321,6 +323,10 @@ class SystemBuilder:
                              "(of the integrator of Model Exchange FMUs)")
         if not isinstance(values["native"], bool):
             raise self.error(f"{where} native", f"{values['native']!r}: expected true or false (FMUs stepped from C)")
+        timeout = values["fmu_timeout"]
+        if timeout is not None and not 0 < self._number(timeout, f"{where} fmu_timeout") <= MAX_TIME:
+            raise self.error(f"{where} fmu_timeout", f"{timeout!r}: expected a time limit > 0 s (and at most "
+                             f"{MAX_TIME:g} s) for one call of an FMU run in a child process")
 
     def _iteration(self) -> Iteration:
         given, algorithm, where = self._settings.iteration, self._settings.values["algorithm"], self._settings.where
@@ -357,12 +363,15 @@ class SystemBuilder:
 
     def add_fmu(self, name: str, path: str | Path, *, parameters: Mapping[str, Any] | None = None,
                 start: Mapping[str, Any] | None = None, interface: str | None = None,
-                where: str | None = None) -> SystemBuilder:
+                isolation: str = "auto", where: str | None = None) -> SystemBuilder:
         """An FMU instance ``name`` of the FMU file ``path`` (relative: to the builder's base), with
         parameter values and start values (inputs, and states with an exact start) by variable name.
         ``interface``: "co-simulation" or "model-exchange" (the engine integrates it); default
-        Co-Simulation where the FMU offers it, else Model Exchange."""
+        Co-Simulation where the FMU offers it, else Model Exchange. ``isolation``: where it runs
+        (``ISOLATION``: "auto", "process": a child process of its own, "none": this process)."""
         where = where or f"add_fmu({name!r})"
+        if isolation not in ISOLATION:
+            raise self.error(f"{where} isolation", f"{isolation!r}: expected one of {', '.join(ISOLATION)}")
         self._claim_for(name, where)
         if not isinstance(path, (str, Path)):
             raise self.error(where, f"path = {path!r}: expected a file name")
@@ -375,7 +384,7 @@ class SystemBuilder:
         if chosen not in offered:
             raise self.error(f"{where} interface", f"{interface!r}: expected one that {fmu_path.name} offers: "
                              f"{', '.join(offered)}")
-        entry = FmuEntry(name, fmu_path, {}, {}, description, chosen, self.validation, problems)
+        entry = FmuEntry(name, fmu_path, {}, {}, description, chosen, self.validation, problems, isolation)
         _check_binary(fmu_path, entry.capabilities.modelIdentifier, entry.fmi_version, f"{self.name}: {where}")
         self._fmus[name] = entry
         self._where[name] = where
@@ -729,7 +738,8 @@ class SystemBuilder:
                       float(values["start_time"]), values["algorithm"], order, list(record), iteration, loop,
                       values["threads"], values["native"], values["allow_algebraic_loops"], self.name,
                       dict(self._settings_from), float(values["relative_tolerance"]),
-                      None if values["output_interval"] is None else float(values["output_interval"]))
+                      None if values["output_interval"] is None else float(values["output_interval"]),
+                      None if values["fmu_timeout"] is None else float(values["fmu_timeout"]))
 
     @classmethod
     def from_system(cls, system: System, name: str | None = None) -> SystemBuilder:
@@ -740,7 +750,7 @@ class SystemBuilder:
                     "algorithm": system.algorithm, "order": list(system.order),
                     "allow_algebraic_loops": system.allow_algebraic_loops, "threads": system.threads_setting,
                     "native": system.native, "relative_tolerance": system.relative_tolerance,
-                    "output_interval": system.output_interval}
+                    "output_interval": system.output_interval, "fmu_timeout": system.fmu_timeout}
         if system.algorithm == "iterative":
             settings.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,
                             relaxation=system.iteration.relaxation)
@@ -759,13 +769,22 @@ class SystemBuilder:
 
 def _copy_fmu(fmu: FmuEntry) -> FmuEntry:
     return FmuEntry(fmu.name, fmu.path, dict(fmu.parameters), dict(fmu.start), fmu.description, fmu.interface,
-                    fmu.validation, fmu.problems)
+                    fmu.validation, fmu.problems, fmu.isolation)
 
 
 def replace_settings(system: System, *, name: str | None = None, **settings: Any) -> System:
     """``system`` with other simulation settings (checked as when it was built: the step against
     the run, an algebraic loop against the algorithm)."""
     return SystemBuilder.from_system(system, name).simulation(**settings).build()
+
+
+def with_isolation(system: System, isolation: str) -> System:
+    """``system`` with every FMU run as ``isolation`` says (``ISOLATION``); ValueError for another word."""
+    if isolation not in ISOLATION:
+        raise ValueError(f"isolation {isolation!r}: expected one of {', '.join(ISOLATION)}")
+    changed = replace_settings(system)
+    changed.fmus = [dataclasses.replace(fmu, isolation=isolation) for fmu in changed.fmus]
+    return changed
 
 
 def with_parameters(system: System, values: Mapping[str, float], *, only_known: bool = True,

@@ -54,11 +54,10 @@ class Execution:
         its new value at once (in Event Mode where a discrete input changes), so that the row there
         shows it, as FMPy records an input event."""
         from .algorithms import sources
-        from .model_exchange import ModelExchangeParticipant
 
         fed = np.concatenate([self.outputs[i] for i in sources(self.participants, self.inputs)] or [np.zeros(0, int)])
         return [(i, np.isin(self.inputs[i], fed)) for i, p in enumerate(self.participants)
-                if isinstance(p, ModelExchangeParticipant) and np.isin(self.inputs[i], fed).any()]
+                if getattr(p, "takes_signals", False) and np.isin(self.inputs[i], fed).any()]
 
     def _steppable(self, i: int) -> bool:
         """Whether participant ``i`` can be stepped natively: an FMU whose exchanged variables are

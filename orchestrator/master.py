@@ -18,6 +18,7 @@ import numpy as np
 from .builder import block_port_type
 from .execution import Execution, make_execution
 from .fmi_access import StringTable
+from .isolation import IsolatedFmu, isolated
 from .model import FmuEntry, Port, System
 from .model_exchange import make_fmu_participant
 from .native import unavailable_reason
@@ -32,7 +33,7 @@ from .observers import (
     check_finite,
     watches_every_step,
 )
-from .participants import BlockParticipant, Participant, RunError, Terminated
+from .participants import BlockParticipant, FmuParticipant, Participant, RunError, Terminated
 from .recorder import Recorder, RunResult, communication_points
 from .unpacking import UNZIP_PREFIX, once_per_process, remove_stale_folders, run_folder, unpack
 from .wiring import Wiring, wire
@@ -83,7 +84,12 @@ def participants_of(system: System, wiring: Wiring,
         unzip_root = stack.enter_context(run_folder()) if own else None
         by_name: dict[str, Participant] = {}
         for entry in system.fmus:
-            fmu = make_fmu_participant(entry, unpack(entry, unzip_root), strings, system.relative_tolerance)
+            fmu: FmuParticipant | IsolatedFmu
+            if isolated(entry, system.fmu_timeout):
+                fmu = IsolatedFmu(entry, unpack(entry, unzip_root), strings, system.relative_tolerance,
+                                  system.fmu_timeout)
+            else:
+                fmu = make_fmu_participant(entry, unpack(entry, unzip_root), strings, system.relative_tolerance)
             stack.callback(fmu.close)
             ports = wiring.participants[entry.name]
             fmu.configure(ports.inputs, ports.outputs)
@@ -137,7 +143,9 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
     times = communication_points(system.start_time, system.stop_time, system.step)
     n_steps = len(times) - 1
     strings = StringTable()
+    closed: list[Participant] = []
     with participants_of(system, wiring, strings) as participants, ExitStack() as stack:
+        closed = participants
         values = wiring.initial_values(strings)
         initialize(participants, wiring, values, system.start_time, system.stop_time)
         execution = make_execution(system, participants, wiring)
@@ -174,6 +182,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
             raise
         execution.close()
         result = RunResult(recorder.table(), time.perf_counter() - started, steps, execution.step_seconds, stopped)
+    result.notes.extend(problem for p in closed for problem in getattr(p, "problems", ()))
     for observer in observers:
         observer.finish(result)
     return result

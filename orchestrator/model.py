@@ -23,6 +23,10 @@ from .blocks import Block
 #: default), run as FMPy runs it with validate=False after saying what is wrong ("warn"), or run
 #: without a word ("off"; the record says so).
 VALIDATION = ("strict", "warn", "off")
+#: Where an FMU runs: "process" (in a child process of its own: a crash, exit() or hang of the FMU
+#: ends its run with a message, not the tool), "none" (in the tool's process: the fastest, the
+#: native stepper can step it) or "auto" ("none" for an FMU this project generated, else "process").
+ISOLATION = ("auto", "process", "none")
 #: How an FMU is run: its Co-Simulation interface (it steps itself) or its Model Exchange
 #: interface (the engine integrates it, ``model_exchange``).
 INTERFACES = ("co-simulation", "model-exchange")
@@ -187,6 +191,9 @@ class FmuEntry:
     #: where it was run all the same ("warn", "off").
     validation: str = "strict"
     problems: tuple[str, ...] = ()
+    #: Where it runs (``isolation.ISOLATION``): "auto" (in a child process unless this project
+    #: generated it), "process" or "none" (in the tool's process).
+    isolation: str = "auto"
 
     def variables(self) -> dict[str, Any]:
         """Every variable by name (made once), and every element of an FMI 3.0 array as a scalar
@@ -264,6 +271,8 @@ class System:
     relative_tolerance: float = 1e-6
     #: s, rows recorded every so often (a whole number of steps; the last row always); None: every step.
     output_interval: float | None = None
+    #: s, the longest one call of an FMU run in a child process may take (None: no limit).
+    fmu_timeout: float | None = None
 
     @property
     def record_every(self) -> int:

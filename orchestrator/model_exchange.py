@@ -72,6 +72,9 @@ class _Solver(CVodeSolver):
 class ModelExchangeParticipant(FmuParticipant):
     """An FMU run through its Model Exchange interface, integrated by CVode over each step."""
 
+    #: Takes an input signal's jump at a communication point (``take_signals``; ``execution``).
+    takes_signals = True
+
     def __init__(self, entry: FmuEntry, folder: Path, strings: StringTable | None = None,
                  relative_tolerance: float = 1e-6):
         super().__init__(entry, folder, strings)

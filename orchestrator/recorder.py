@@ -113,6 +113,9 @@ class RunResult:
     step_seconds: dict[str, float] = field(default_factory=dict)  # time inside each participant's step
     #: Why an observer ended the run before its stop time (None: it ran to the end).
     stopped: str | None = None
+    #: What went wrong after the last step, the rows being complete (e.g. an FMU that crashed or
+    #: hung in fmi2Terminate or fmi2FreeInstance, in its child process).
+    notes: list[str] = field(default_factory=list)
 
     @cached_property
     def data(self) -> Any:

@@ -12,6 +12,7 @@ import numpy as np
 
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, write_all
 
+from .isolation import isolated
 from .model import System
 from .observers import Observer
 from .participants import RunError
@@ -25,6 +26,7 @@ def system_record(system: System) -> dict[str, Any]:
         "fmus": {fmu.name: {"path": str(fmu.path), "sha256": file_sha256(fmu.path), "guid": fmu.description.guid,
                             "fmi_version": str(fmu.description.fmiVersion), "interface": fmu.interface,
                             "parameters": dict(fmu.parameters), "start": dict(fmu.start),
+                            "isolation": "process" if isolated(fmu, system.fmu_timeout) else "none",
                             **({} if fmu.validation == "strict" else {"validation": fmu.validation,
                                                                       "validation_problems": list(fmu.problems)})}
                  for fmu in system.fmus},
@@ -44,13 +46,15 @@ def sidecar(system: System, result: RunResult, command: str,
     record = run_record(command, {"algorithm": system.algorithm, "step_s": system.step,
                                   "start_time_s": system.start_time, "stop_time_s": system.stop_time,
                                   "order": system.order, "relative_tolerance": system.relative_tolerance,
-                                  "output_interval_s": system.output_interval, "input_timing": INPUT_TIMING})
+                                  "output_interval_s": system.output_interval, "input_timing": INPUT_TIMING,
+                                  "fmu_timeout_s": system.fmu_timeout})
     return {
         **record,
         "system_file": str(system.path) if system.path else None,
         "system_sha256": file_sha256(system.path) if system.path else None,
         "settings_from": system.settings_from,
         "stopped": result.stopped,
+        **({"notes": list(result.notes)} if result.notes else {}),
         **system_record(system),
         "steps": result.steps,
         "wall_seconds": result.wall_seconds,

@@ -54,6 +54,7 @@ from .blocks import make_block
 from .builder import SIMULATION_DEFAULTS, SystemBuilder, dependency_graph, optional_inputs
 from .model import (
     INTERFACES,
+    ISOLATION,
     BlockEntry,
     Connection,
     FmuEntry,
@@ -83,6 +84,8 @@ KEY_MEANINGS: dict[str, dict[str, str]] = {
         "native": "step the FMUs from C (the native stepper) where the system allows it",
         "relative_tolerance": "of the integrator (CVode) of Model Exchange FMUs, and told to every FMU [1]",
         "output_interval": "rows recorded every so often [s] (a whole number of steps; default every step)",
+        "fmu_timeout": "the longest one call of an FMU run in a child process may take [s] (default: no limit); "
+                       "an FMU that takes longer is ended and the run fails with the rows so far kept",
     },
     "fmu": {
         "name": "instance name (letters, digits, _; it names a folder)",
@@ -91,6 +94,9 @@ KEY_MEANINGS: dict[str, dict[str, str]] = {
         "start": "a table of start values of inputs (and of states with an exact start)",
         "interface": f"which interface runs it: one of {', '.join(INTERFACES)} (default: co-simulation where "
                      "offered)",
+        "isolation": "where it runs: \"process\" (a child process of its own: a crash, exit() or hang of the FMU "
+                     "ends the run with a message, not the tool), \"none\" (this process: the fastest) or \"auto\" "
+                     "(the default: none for an FMU this project generated, else process)",
     },
     "block": {
         "name": "instance name",
@@ -193,7 +199,10 @@ def _read_fmu_entry(builder: SystemBuilder, entry: dict[str, Any], number: int) 
     interface = entry.get("interface")
     if interface is not None and interface not in INTERFACES:
         raise builder.error(f"{where} interface", f"{interface!r}: expected one of {', '.join(INTERFACES)}")
-    builder.add_fmu(instance, entry["path"], where=where, interface=interface, **values)
+    isolation = entry.get("isolation", "auto")
+    if isolation not in ISOLATION:
+        raise builder.error(f"{where} isolation", f"{isolation!r}: expected one of {', '.join(ISOLATION)}")
+    builder.add_fmu(instance, entry["path"], where=where, interface=interface, isolation=isolation, **values)
 
 
 def _read_block_entry(builder: SystemBuilder, entry: dict[str, Any], number: int, folder: Path | None) -> None:
@@ -219,7 +228,7 @@ def system_to_dict(system: System, folder: Path | None = None) -> dict[str, Any]
     settings = {"start_time": system.start_time, "algorithm": system.algorithm, "order": list(system.order),
                 "allow_algebraic_loops": system.allow_algebraic_loops, "threads": system.threads_setting,
                 "native": system.native, "relative_tolerance": system.relative_tolerance,
-                "output_interval": system.output_interval}
+                "output_interval": system.output_interval, "fmu_timeout": system.fmu_timeout}
     simulation.update({k: v for k, v in settings.items() if v is not None and v != SIMULATION_DEFAULTS.get(k)})
     if system.algorithm == "iterative":
         simulation.update(tolerance=system.iteration.tolerance, max_iterations=system.iteration.max_iterations,
@@ -230,6 +239,8 @@ def system_to_dict(system: System, folder: Path | None = None) -> dict[str, Any]
         entry: dict[str, Any] = {"name": f.name, "path": _relative(f.path, folder)}
         if f.interface != "co-simulation":
             entry["interface"] = f.interface
+        if f.isolation != "auto":
+            entry["isolation"] = f.isolation
         entry.update({key: dict(values) for key, values in (("parameters", f.parameters), ("start", f.start))
                       if values})
         data["fmu"].append(entry)

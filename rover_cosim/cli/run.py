@@ -76,6 +76,14 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="an SSP archive may name Python blocks of this module (module or module:callable; "
                         "repeatable): the archive's code runs only where you allow it; the module is looked up "
                         "beside the archive first")
+    parser.add_argument("--isolation", choices=("auto", "process", "none"), default=None,
+                        help="where the FMUs run: each in a child process of its own (process: a crash, exit() or "
+                        "hang of an FMU ends the run with a message, the rows so far kept), in this process (none: "
+                        "the fastest) or auto (the default: none for FMUs this project generated, else process; a "
+                        "system file may say per FMU)")
+    parser.add_argument("--fmu-timeout", type=float, default=None, metavar="SECONDS",
+                        help="the longest one call of an FMU run in a child process may take (default: no limit); a "
+                        "hanging FMU is ended and the run fails with the rows computed so far kept")
     parser.add_argument("--record", action="append", metavar="NAME",
                         help="a variable to record instead of every output (repeatable; glob patterns: 'x*', '*'); "
                         "one FMU run alone: its variable names, locals too; a system: instance.variable")
@@ -104,19 +112,23 @@ class _Algorithms:
 def _load_system(args: argparse.Namespace, unpack: Path) -> tuple[Any, Path]:
     """The system of ``rover-cosim run`` with the command line's overrides (SystemFileError if
     bad); an .ssp archive is unpacked into ``unpack``."""
-    from rover_cosim.orchestrator.builder import SystemBuilder
+    from rover_cosim.orchestrator.builder import SystemBuilder, with_isolation
 
     system_file, fmu_dir = system_path(args.system, args.fmu_dir)
     overrides = {key: value for key, value in (("algorithm", args.algorithm), ("step", args.step),
                                                ("stop_time", args.stop_time), ("threads", args.threads),
                                                ("output_interval", args.output_interval),
-                                               ("relative_tolerance", args.relative_tolerance))
+                                               ("relative_tolerance", args.relative_tolerance),
+                                               ("fmu_timeout", args.fmu_timeout))
                  if value is not None}
     if system_file.suffix.lower() == ".fmu":
-        return _one_fmu(system_file, overrides, args), system_file  # the overrides are its settings
+        system = _one_fmu(system_file, overrides, args)  # the overrides are its settings
+        return (with_isolation(system, args.isolation) if args.isolation else system), system_file
     system, system_file = _system_of_file(system_file, fmu_dir, overrides, unpack, args)
     if args.record:  # instead of the file's [record]
         system = SystemBuilder.from_system(system).record(*args.record, where="--record", replace=True).build()
+    if args.isolation:
+        system = with_isolation(system, args.isolation)
     if not system.record:
         fail("run", f"{system_file}: records nothing but time (no participant has an output that can be recorded): "
              "name what to record with --record instance.variable (glob patterns too, e.g. --record 'model.*')")
@@ -221,6 +233,8 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
         return 1
     bar.close()
     print_written(write_run(system, result, output, extra=extra))
+    for note in result.notes:
+        fail("run", f"warning: {note} (after the last step; {output} is complete)")
     if result.stopped:
         print(f"stopped: {result.stopped}")
     print(f"{result.steps} steps of {system.step:g} s ({system.algorithm}) in {result.wall_seconds:.2f} s")
