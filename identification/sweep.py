@@ -174,10 +174,17 @@ Arguments = tuple[str | None, Case, float, float, float, float, str, Soil | None
 Result = tuple[Case, str | None, float]
 
 
-def _results(arguments: list[Arguments], workers: int | None, scheduler: str | None) -> Iterator[Result]:
-    """compute_run for every argument tuple, on a Dask cluster, local processes or serially;
-    results in the order they complete (common.parallel)."""
-    return parallel_map(compute_run, arguments, workers, scheduler)
+def _results(arguments: list[Arguments], workers: int | None, scheduler: str | None,
+             timeout: float | None = None) -> Iterator[Result]:
+    """compute_run for every argument tuple, on a Dask cluster or local processes; results in the
+    order they complete (common.parallel); a run whose worker crashed or overran ``timeout`` [s]
+    is a failed run saying so."""
+    return parallel_map(compute_run, arguments, workers, scheduler, lost=_lost, timeout=timeout)
+
+
+def _lost(arguments: Arguments, reason: str) -> Result:
+    """The failure of a run whose worker process was lost (``reason``)."""
+    return Case(*arguments[1]), f"lost: {reason}", 0.0
 
 
 def _cached(folder: Path, plan: SweepPlan) -> tuple[dict[Case, pd.DataFrame], dict[Path, str]]:
@@ -211,7 +218,8 @@ def _read_computed(folder: Path, plan: SweepPlan, cases: list[Case], runs: dict[
 
 
 def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, workers: int | None = None,
-              scheduler: str | None = None, progress: Callable[[float], None] | None = None) -> SweepOutcome:
+              scheduler: str | None = None, progress: Callable[[float], None] | None = None,
+              run_timeout: float | None = None) -> SweepOutcome:
     """Run (or take from the cache) every case of ``plan`` on the FMU, or on the numpy reference
     test bed when ``fmu_path`` is None."""
     started = time.perf_counter()
@@ -234,7 +242,7 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
         progress(done / len(cases))
     arguments = [(str(fmu_path) if fmu_path else None, c, plan.stop_time, plan.sample_time, plan.tolerance,
                   plan.start_speed, str(run_file(folder, *c)), plan.soil, plan.wheel) for c in missing]
-    for case, error, seconds in _results(arguments, workers, scheduler):
+    for case, error, seconds in _results(arguments, workers, scheduler, run_timeout):
         case = Case(*case)
         run_seconds[case] = seconds
         if error is not None:

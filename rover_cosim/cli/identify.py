@@ -11,7 +11,6 @@ from .options import (
     add_quiet,
     add_soil_options,
     add_workers,
-    at_least,
     choice_of,
     fail,
     option_ok,
@@ -19,6 +18,7 @@ from .options import (
     path,
     print_written,
     with_progress,
+    workers_ok,
 )
 
 
@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     if not output_folder(args.out, "identify", COMMAND.needs_bytes) or (
             args.cache and not output_folder(args.cache, "identify", 0, "--cache")):
         return 2
-    if not at_least("identify", ("--workers", args.workers, 1)) or not option_ok(
+    if not workers_ok("identify", args) or not option_ok(
             "identify", "--record-interval", lambda: check_record_interval(args.record_interval)):
         return 2
     if not args.fmu.is_file():
@@ -65,7 +65,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     outcome = with_progress("identify", "sweep", args.quiet, lambda bar: run_identification(
         args.fmu, args.out, workers=args.workers, scheduler=args.scheduler, cache_dir=args.cache, progress=bar,
-        choice=choice, record_interval=args.record_interval), (OSError, RuntimeError, ValueError))
+        choice=choice, record_interval=args.record_interval, run_timeout=args.run_timeout),
+        (OSError, RuntimeError, ValueError))
     if outcome is None:
         return 1
     for name, sweep in (("sweep", outcome.sweep), ("lateral sweep", outcome.lateral_sweep)):

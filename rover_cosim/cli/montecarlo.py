@@ -19,6 +19,7 @@ from .options import (
     path_text,
     print_written,
     with_progress,
+    workers_ok,
 )
 
 #: Bytes of the study's files besides its runs, and of each run's.
@@ -48,7 +49,8 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
 
-    if not at_least("montecarlo", ("--workers", args.workers, 1), ("--runs", args.runs, 1), ("--seed", args.seed, 0)):
+    if not workers_ok("montecarlo", args) or not at_least("montecarlo", ("--runs", args.runs, 1),
+                                                            ("--seed", args.seed, 0)):
         return 2
     try:
         study = load_study(args.study, runs=args.runs, seed=args.seed)
@@ -64,7 +66,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     outcome = with_progress("montecarlo", "montecarlo", args.quiet, lambda bar: run_montecarlo(
         study, args.fmu_dir, args.model, args.out, workers=args.workers, scheduler=args.scheduler,
-        cache_dir=args.cache, progress=bar, allow_model_mismatch=args.allow_model_mismatch),
+        cache_dir=args.cache, progress=bar, allow_model_mismatch=args.allow_model_mismatch,
+        run_timeout=args.run_timeout),
         (OSError, RuntimeError, ValueError))
     if outcome is None:
         return 1

@@ -121,7 +121,12 @@ def add_model(parser: argparse.ArgumentParser, help: str) -> None:  # noqa: A002
 
 def add_workers(parser: argparse.ArgumentParser) -> None:
     """--workers, --scheduler and --cache: where a sweep or study runs and what it reuses."""
-    parser.add_argument("--workers", type=int, default=None, help="local processes (default: all cores; 1: serial)")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="local processes (default and at most: the cores); a run whose process crashes or "
+                        "overruns --run-timeout is recorded as failed and its process replaced")
+    parser.add_argument("--run-timeout", type=float, default=None, metavar="SECONDS",
+                        help="the longest one run may take (default: 20 x the slowest run so far once three "
+                        "completed, at least 120 s)")
     parser.add_argument("--scheduler", type=scheduler, default=None,
                         help="run on a Dask cluster, e.g. tcp://host:8786")
     parser.add_argument("--cache", type=path, default=None, help="run cache (default: <out>/cache)")
@@ -218,6 +223,23 @@ def fmu_dir_exists(fmu_dir: Path, command: str) -> bool:
     if not fmu_dir.is_dir():
         fail(command, f"--fmu-dir {fmu_dir}: no such folder (build the FMUs with `rover-cosim build-fmus`)")
         return False
+    return True
+
+
+def workers_ok(command: str, args: argparse.Namespace) -> bool:
+    """--workers >= 1 (more than the cores: said, the cores used) and --run-timeout > 0 (finite)."""
+    import math
+
+    from rover_cosim.common.parallel import cores
+
+    if not at_least(command, ("--workers", args.workers, 1)):
+        return False
+    timeout = args.run_timeout
+    if timeout is not None and not (math.isfinite(timeout) and timeout > 0):
+        fail(command, f"--run-timeout {timeout!r}: expected a time limit > 0 s")
+        return False
+    if args.workers is not None and args.scheduler is None and args.workers > cores():
+        fail(command, f"note: --workers {args.workers}: more than the {cores()} cores of this machine; {cores()} used")
     return True
 
 

@@ -82,8 +82,9 @@ class IdentificationResult:
 
 
 def _sweep(fmu_path: Path, plan: SweepPlan, cache_dir: Path, workers: int | None, scheduler: str | None,
-           progress: Callable[[float], None] | None) -> SweepOutcome:
-    sweep = run_sweep(fmu_path, plan, cache_dir, workers=workers, scheduler=scheduler, progress=progress)
+           progress: Callable[[float], None] | None, run_timeout: float | None = None) -> SweepOutcome:
+    sweep = run_sweep(fmu_path, plan, cache_dir, workers=workers, scheduler=scheduler, progress=progress,
+                      run_timeout=run_timeout)
     if not sweep.runs:
         raise RuntimeError(f"every run of the sweep failed; first error: {next(iter(sweep.failures.values()))}")
     return sweep
@@ -139,7 +140,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
                        scheduler: str | None = None, cache_dir: Path | None = None,
                        progress: Callable[[float], None] | None = None,
                        choice: Choice | Soil | Wheel | None = None,
-                       record_interval: float = RECORD_INTERVAL) -> IdentificationResult:
+                       record_interval: float = RECORD_INTERVAL,
+                       run_timeout: float | None = None) -> IdentificationResult:
     """Sweep, fit, validate and write every file of ``results/identification/`` (all or none):
     the paper's longitudinal model (``plan``) and the lateral model (``lateral_plan``), on the
     soil and wheel of ``choice`` (default: the paper's). runs.csv keeps a row every
@@ -157,8 +159,8 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
             return None
         return lambda fraction: progress((offset + fraction * count) / (first + second))
 
-    sweep = _sweep(fmu_path, plan, cache_dir, workers, scheduler, share(0, first))
-    lateral_sweep = _sweep(fmu_path, lateral_plan, cache_dir, workers, scheduler, share(first, second))
+    sweep = _sweep(fmu_path, plan, cache_dir, workers, scheduler, share(0, first), run_timeout)
+    lateral_sweep = _sweep(fmu_path, lateral_plan, cache_dir, workers, scheduler, share(first, second), run_timeout)
     table = step_table(sweep.at_slip_angle(0.0))
     models = {label: identify(table, degree) for label, degree in MODELS.items()}
     per_load = fx_per_load(table, 1)

@@ -91,15 +91,23 @@ def _cached(specs: list[RunSpec]) -> tuple[dict[tuple[int, str], dict[str, Any]]
     return found, rejected
 
 
+def _lost(arguments: tuple[RunSpec], reason: str) -> tuple[int, str, str | None, float]:
+    """The failure of a run whose worker process was lost (``reason``: a crash, exit(), the time limit)."""
+    spec = arguments[0]
+    return spec.sample, spec.scenario, f"lost: {reason}", 0.0
+
+
 def _compute(specs: list[RunSpec], workers: int | None, scheduler: str | None,
-             progress: Callable[[float], None] | None, done: int,
-             total: int) -> tuple[dict[tuple[int, str], dict[str, Any]], dict[tuple[int, str], str]]:
+             progress: Callable[[float], None] | None, done: int, total: int,
+             run_timeout: float | None = None) -> tuple[dict[tuple[int, str], dict[str, Any]],
+                                                        dict[tuple[int, str], str]]:
     """Run ``specs``: the metrics of those that completed, the errors of those that failed."""
     results: dict[tuple[int, str], dict[str, Any]] = {}
     errors: dict[tuple[int, str], str] = {}
     if progress:
         progress(done / max(total, 1))
-    for sample, scenario, error, _seconds in parallel_map(compute_run, [(s,) for s in specs], workers, scheduler):
+    for sample, scenario, error, _seconds in parallel_map(compute_run, [(s,) for s in specs], workers, scheduler,
+                                                          lost=_lost, timeout=run_timeout):
         if error is not None:
             errors[sample, scenario] = error
         done += 1
@@ -232,7 +240,8 @@ def identified_on(models: ModelSet, nominal: Choice) -> dict[str, Any]:
 def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, workers: int | None = None,
                    scheduler: str | None = None, cache_dir: Path | None = None,
                    progress: Callable[[float], None] | None = None, samples: pd.DataFrame | None = None,
-                   simulation: Path | None = None, allow_model_mismatch: bool = False) -> MonteCarloResult:
+                   simulation: Path | None = None, allow_model_mismatch: bool = False,
+                   run_timeout: float | None = None) -> MonteCarloResult:
     """Run (or take from the cache) every sample of ``study`` and write every file (all or none).
     ``samples`` replaces the study's drawn samples (a table like sampling.sample_table's);
     ``simulation``: make simulate's folder, for the nominal check (default: beside ``out_dir``)."""
@@ -263,7 +272,8 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     results, rejected = _cached(specs)
     missing = [s for s in specs if (s.sample, s.scenario) not in results]
     compute_started = time.perf_counter()
-    computed, errors = _compute(missing, workers, scheduler, progress, len(specs) - len(missing), len(specs))
+    computed, errors = _compute(missing, workers, scheduler, progress, len(specs) - len(missing), len(specs),
+                                run_timeout)
     compute_seconds = time.perf_counter() - compute_started
     results.update(computed)
     runs, failures = _tables(study, samples, results, errors)

@@ -1,0 +1,93 @@
+"""The local worker pool of identify and montecarlo (common.parallel) survives a bad call (issue
+45): a worker that crashes (SIGSEGV, as an FMU does), calls exit(), hangs past the time limit or
+raises is replaced, its call reported through ``lost`` with the reason, every other call
+completes, and no worker outlives the pool. One worker too: the caller survives its crash."""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+from pathlib import Path
+
+import pytest
+
+from rover_cosim.common.parallel import cores, parallel_map
+from rover_cosim.identification.sweep import Case
+from rover_cosim.identification.sweep import _lost as sweep_lost
+from rover_cosim.jobs.montecarlo.job import _lost as study_lost
+
+
+def _call(k: int) -> int:
+    """k squared, except: 2 segfaults, 3 calls exit(0), 4 hangs, 5 raises."""
+    if k == 2:
+        os.kill(os.getpid(), signal.SIGSEGV)
+    if k == 3:
+        os._exit(0)
+    if k == 4:
+        time.sleep(600)
+    if k == 5:
+        raise ValueError("five")
+    return k * k
+
+
+def _lost(arguments: tuple[int], reason: str) -> tuple[int, str]:
+    return arguments[0], reason
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_crash_an_exit_a_hang_and_an_exception_each_lose_one_call_only(workers):
+    started = time.monotonic()
+    results = list(parallel_map(_call, [(k,) for k in range(8)], workers=workers, lost=_lost, timeout=1.0))
+    assert time.monotonic() - started < 30
+    done = sorted(r for r in results if isinstance(r, int))
+    lost: dict[int, str] = dict(r for r in results if isinstance(r, tuple))
+    assert done == [0, 1, 36, 49] and sorted(lost) == [2, 3, 4, 5]
+    assert "SIGSEGV" in lost[2] and "exit status 0" in lost[3]
+    assert "longer than 1 s" in lost[4] and lost[5] == "it raised ValueError: five"
+    time.sleep(0.2)
+    assert not _children(), "no worker outlives the pool"
+
+
+def test_without_lost_one_worker_runs_here_and_a_lost_call_is_an_error():
+    assert list(parallel_map(_call, [(0,), (1,)], workers=1)) == [0, 1]  # serially, in this process
+    with pytest.raises(RuntimeError, match="a worker process was lost: .*SIGSEGV"):
+        list(parallel_map(_call, [(1,), (2,)], workers=2))
+
+
+def test_the_jobs_record_a_lost_run_as_a_failed_one():
+    case = Case(100.0, 10.0, 0.0)
+    assert sweep_lost((None, case, 1.0, 0.01, 1e-6, 0.0, "x", None, None), "why") == (case, "lost: why", 0.0)
+
+    class Spec:
+        sample, scenario = 7, "straight"
+
+    said = study_lost((Spec(),), "its worker process ended with SIGSEGV")  # type: ignore[arg-type]  # a RunSpec's keys
+    assert said == (
+        7, "straight", "lost: its worker process ended with SIGSEGV", 0.0)
+
+
+def test_more_workers_than_cores_are_said_and_capped(capsys, tmp_path):
+    from rover_cosim.cli import main
+
+    code = main(["montecarlo", "--workers", str(cores() + 98), "--runs", "1", "--out", str(tmp_path / "mc"),
+                 "--model", str(tmp_path / "missing.json"), "-q"])
+    assert code == 2  # the missing model: nothing run
+    assert f"--workers {cores() + 98}: more than the {cores()} cores of this machine; {cores()} used" in \
+        capsys.readouterr().err
+    assert main(["identify", "--run-timeout", "nan", "--out", str(tmp_path / "id")]) == 2
+    assert "--run-timeout nan: expected a time limit > 0 s" in capsys.readouterr().err
+
+
+def _children() -> list[int]:
+    """This process's living children."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == os.getpid() and fields[0] != "Z":
+                found.append(int(entry.name))
+    return found
