@@ -13,6 +13,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -282,10 +283,14 @@ def test_lock_files_are_removed_and_still_exclude(tmp_path, monkeypatch, capsys)
     from rover_cosim.common import locks
 
     (tmp_path / "tmp").mkdir()
+    (tmp_path / "run").mkdir(mode=0o700)
     monkeypatch.setenv("TMPDIR", str(tmp_path / "tmp"))
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
     monkeypatch.setattr(tempfile, "tempdir", None)
+    assert locks.lock_folder() == tmp_path / "run" / "rover-cosim-locks"
     assert cli.main([*FIG3, "--out", str(tmp_path / "out")]) == 0
     assert not [p.name for p in (tmp_path / "tmp").iterdir()]
+    assert not [p.name for p in (tmp_path / "run" / "rover-cosim-locks").iterdir()]
     counter = tmp_path / "counter"
     counter.write_text("0")
 
@@ -303,3 +308,56 @@ def test_lock_files_are_removed_and_still_exclude(tmp_path, monkeypatch, capsys)
         thread.join()
     assert counter.read_text() == "80"
     assert not [p.name for p in (tmp_path / "tmp").iterdir()]
+    assert not [p.name for p in (tmp_path / "run" / "rover-cosim-locks").iterdir()]
+
+
+def _private_runtime(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    (tmp_path / "run").mkdir(mode=0o700)
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path / "run"))
+    return tmp_path / "run" / "rover-cosim-locks"
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX file modes and links")
+def test_lock_files_live_in_a_private_folder_and_follow_no_link(tmp_path, monkeypatch):
+    """Before: lock files had predictable names in the shared temporary folder and were opened
+    following links, so a planted link made a run write "PID n (rover-cosim run)" into another
+    file. Now the folder is the user's alone (0700, a real folder) and a link there is not followed."""
+    from rover_cosim.common import locks
+
+    folder = _private_runtime(tmp_path, monkeypatch)
+    assert locks.lock_folder() == folder and folder.stat().st_mode & 0o777 == 0o700
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    target = tmp_path / "out.csv"
+    lock = locks.lock_file(target, "busy")
+    assert lock is not None and lock.parent == folder
+    lock.symlink_to(victim)
+    with locks.writing(target, "rover-cosim run"):
+        pass
+    assert victim.read_text() == "precious"
+    lock.unlink()
+    shared = tmp_path / "shared-run"   # a folder others may enter is not taken: the next candidate is
+    shared.mkdir(mode=0o777)
+    shared.chmod(0o777)
+    (shared / "rover-cosim-locks").mkdir(mode=0o777)
+    (shared / "rover-cosim-locks").chmod(0o777)
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(shared))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    assert locks.lock_folder() == tmp_path / "cache" / "rover-cosim" / "locks"
+    odd = Path(os.fsdecode(b"\xff\xfe-not-utf8.csv"))  # a path that is not UTF-8 has a lock file too
+    assert locks.lock_file(tmp_path / odd, "busy") is not None
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="flock")
+def test_stale_lock_files_are_removed_and_held_ones_kept(tmp_path, monkeypatch):
+    from rover_cosim.common import locks
+
+    folder = _private_runtime(tmp_path, monkeypatch)
+    folder.mkdir(mode=0o700)
+    stale, held = folder / "rover-cosim-busy-0123", folder / "rover-cosim-busy-4567"
+    for path in (stale, held):
+        path.write_text("PID 1 (rover-cosim run)")
+        os.utime(path, (time.time() - 2 * locks.STALE_SECONDS,) * 2)
+    with locks._held(held, wait=False):
+        assert locks.remove_stale_locks() == [stale]
+    assert not stale.exists()
