@@ -12,9 +12,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
+from pathlib import Path
 
 import numpy as np
 
+from .archives import UnpackError
 from .builder import block_port_type
 from .execution import Execution, make_execution
 from .fmi_access import StringTable
@@ -84,12 +86,15 @@ def participants_of(system: System, wiring: Wiring,
         unzip_root = stack.enter_context(run_folder()) if own else None
         by_name: dict[str, Participant] = {}
         for entry in system.fmus:
+            try:
+                folder = unpack(entry, unzip_root)
+            except UnpackError as error:
+                raise RunError(f"{entry.name} ({Path(entry.path).name}): {error}") from None
             fmu: FmuParticipant | IsolatedFmu
             if isolated(entry, system.fmu_timeout):
-                fmu = IsolatedFmu(entry, unpack(entry, unzip_root), strings, system.relative_tolerance,
-                                  system.fmu_timeout)
+                fmu = IsolatedFmu(entry, folder, strings, system.relative_tolerance, system.fmu_timeout)
             else:
-                fmu = make_fmu_participant(entry, unpack(entry, unzip_root), strings, system.relative_tolerance)
+                fmu = make_fmu_participant(entry, folder, strings, system.relative_tolerance)
             stack.callback(fmu.close)
             ports = wiring.participants[entry.name]
             fmu.configure(ports.inputs, ports.outputs)

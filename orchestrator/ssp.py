@@ -32,6 +32,7 @@ from lxml import etree
 from rover_cosim.common.outputs import result_mode
 from rover_cosim.common.units import base_units
 
+from .archives import LIMIT_VARIABLE, UnpackError, unpack_archive
 from .blocks import BLOCK_TYPES, REGISTERED_FACTORIES, make_block
 from .builder import SystemBuilder
 from .model import BlockEntry, Connection, System, Value
@@ -312,37 +313,13 @@ def size_limit() -> int:
 
 
 def _unpack(archive: Path, folder: Path, limit: int) -> None:
-    """Every entry of ``archive`` into ``folder``: none may lie outside it, none be a link, and
-    together they may not exceed ``limit`` bytes (read as they are unpacked, not as declared)."""
+    """Every entry of ``archive`` into ``folder`` (``archives.unpack_archive``: none outside it,
+    no links, the bytes counted with every other archive this process unpacks, the FMUs inside
+    included); SspError otherwise."""
     try:
-        with zipfile.ZipFile(archive) as zf:
-            entries = zf.infolist()
-            declared = sum(e.file_size for e in entries)
-            if declared > limit:
-                raise SspError(f"{archive}: {declared} bytes unpacked: above the limit of {limit} bytes "
-                               "(ROVER_COSIM_SSP_MAX_BYTES sets another)")
-            folder.mkdir(parents=True, exist_ok=True)
-            root = folder.resolve()
-            total = 0
-            for entry in entries:
-                target = (root / entry.filename).resolve()
-                if not target.is_relative_to(root) or entry.filename.startswith("/"):
-                    raise SspError(f"{archive}: entry {entry.filename!r} lies outside the archive's folder")
-                if (entry.external_attr >> 16) & 0o170000 == 0o120000:
-                    raise SspError(f"{archive}: entry {entry.filename!r} is a symbolic link (not allowed)")
-                if entry.is_dir():
-                    target.mkdir(parents=True, exist_ok=True)
-                    continue
-                target.parent.mkdir(parents=True, exist_ok=True)
-                with zf.open(entry) as source, open(target, "wb") as sink:
-                    while chunk := source.read(1 << 20):
-                        total += len(chunk)
-                        if total > limit:
-                            raise SspError(f"{archive}: more than {limit} bytes unpacked: above the limit "
-                                           "(ROVER_COSIM_SSP_MAX_BYTES sets another)")
-                        sink.write(chunk)
-    except (OSError, zipfile.BadZipFile) as error:
-        raise SspError(f"{archive}: not a readable SSP archive ({error})") from None
+        unpack_archive(archive, folder, limit)
+    except UnpackError as error:
+        raise SspError(str(error).replace(LIMIT_VARIABLE, "ROVER_COSIM_SSP_MAX_BYTES")) from None
 
 
 def inside(folder: Path, source: str | None, what: str) -> Path:

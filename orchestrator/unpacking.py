@@ -21,10 +21,9 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-import fmpy
-
 from rover_cosim.common.scratch import PREFIX, remove_stale_folders, scratch_prefix
 
+from .archives import release, unpack_archive
 from .model import FmuEntry
 
 #: The temporary folder of a process's unpacked FMUs: ``<tmp>/rover-cosim-run-<pid>-<random>``.
@@ -47,7 +46,7 @@ class _ProcessCopies:
             if found is not None and (found / "modelDescription.xml").is_file():
                 return found
             target = Path(tempfile.mkdtemp(prefix="fmu-", dir=self._root()))
-            fmpy.extract(str(path), str(target))
+            unpack_archive(path, target)
             self.folders[key] = target
             return target
 
@@ -61,6 +60,8 @@ class _ProcessCopies:
 
 
 _COPIES = _ProcessCopies()
+#: The bytes unpacked into each run folder (given back to the unpacking budget when it is removed).
+_RUN_BYTES: dict[Path, int] = {}
 
 
 @contextmanager
@@ -69,7 +70,10 @@ def run_folder() -> Iterator[Path]:
     removed on leaving."""
     remove_stale_folders()
     with tempfile.TemporaryDirectory(prefix=scratch_prefix("run")) as folder:
-        yield Path(folder)
+        try:
+            yield Path(folder)
+        finally:
+            release(_RUN_BYTES.pop(Path(folder), 0))
 
 
 def once_per_process(entry: FmuEntry) -> bool:
@@ -80,13 +84,14 @@ def once_per_process(entry: FmuEntry) -> bool:
 def unpack(entry: FmuEntry, root: Path | None = None) -> Path:
     """The folder holding ``entry``'s FMU unpacked: the process's copy of its file, or, for an FMU
     that can be instantiated only once per process, a copy of its own under ``root`` (a
-    ``run_folder``)."""
+    ``run_folder``). ``archives.UnpackError`` for an archive that may not be unpacked (an entry
+    outside its folder, a link, more than the process's unpacking limit, a full disk)."""
     if once_per_process(entry):
         if root is None:
             raise ValueError(f"{entry.name}: {Path(entry.path).name} can be instantiated only once per process: "
                              "expected a run folder for its own copy")
         folder = root / entry.name
-        fmpy.extract(str(entry.path), str(folder))
+        _RUN_BYTES[root] = _RUN_BYTES.get(root, 0) + unpack_archive(Path(entry.path), folder)
         return folder
     return _COPIES.folder(Path(entry.path))
 

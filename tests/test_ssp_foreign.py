@@ -160,7 +160,7 @@ def test_sources_must_stay_inside_the_archive(typed, tmp_path):
 def test_an_archive_above_the_size_limit_is_refused(typed, tmp_path, monkeypatch):
     archive = _foreign(typed, tmp_path, extra_entries={"resources/padding.bin": b"\0" * 200_000})
     monkeypatch.setenv("ROVER_COSIM_SSP_MAX_BYTES", "100000")
-    with pytest.raises(SspError, match="above the limit of 100000 bytes"):
+    with pytest.raises(SspError, match="more than the limit of 100000 bytes"):
         load_ssp(archive, tmp_path / "unpacked")
     monkeypatch.setenv("ROVER_COSIM_SSP_MAX_BYTES", "lots")
     with pytest.raises(SspError, match="expected a whole number of bytes"):
