@@ -65,20 +65,21 @@ def size_limit(variable: str = LIMIT_VARIABLE, default: int = SIZE_LIMIT) -> int
 
 
 def unpack_archive(archive: Path, folder: Path, limit: int | None = None) -> int:
-    """Every entry of ``archive`` into ``folder`` (none outside it, no links), counted against
-    this process's budget (``limit``: its size, default :func:`size_limit`): the bytes written
-    (:func:`release` them when the folder is removed). UnpackError naming the archive otherwise,
-    or when it is not a readable zip file or the disk is full."""
+    """Every entry of ``archive`` into ``folder`` (none outside it, no links): at most ``limit``
+    bytes of this archive (None: no limit of its own), and all this process unpacks, this
+    included, within :func:`size_limit`. Returns the bytes written (:func:`release` them when the
+    folder is removed). UnpackError naming the archive otherwise, or when it is not a readable zip
+    file or the disk is full."""
     archive = Path(archive)
-    limit = size_limit() if limit is None else limit
+    total = size_limit()
+    own = total if limit is None else min(limit, total)
     try:
         with zipfile.ZipFile(archive) as zf:
             entries = zf.infolist()
-            _BUDGET.take(0, limit, archive)
             declared = sum(e.file_size for e in entries)
-            if declared > limit:
+            if declared > own:
                 raise UnpackError(f"{archive}: unpacking it would take {declared} bytes: more than the limit of "
-                                  f"{limit} bytes ({LIMIT_VARIABLE} sets another)")
+                                  f"{own} bytes ({LIMIT_VARIABLE} sets another)")
             folder.mkdir(parents=True, exist_ok=True)
             root = folder.resolve()
             written = 0
@@ -94,8 +95,11 @@ def unpack_archive(archive: Path, folder: Path, limit: int | None = None) -> int
                 target.parent.mkdir(parents=True, exist_ok=True)
                 with zf.open(entry) as source, open(target, "wb") as sink:
                     while chunk := source.read(1 << 20):
-                        _BUDGET.take(len(chunk), limit, archive)
                         written += len(chunk)
+                        if written > own:
+                            raise UnpackError(f"{archive}: more than {own} bytes unpacked: above the limit "
+                                              f"({LIMIT_VARIABLE} sets another)")
+                        _BUDGET.take(len(chunk), total, archive)
                         sink.write(chunk)
             return written
     except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, NotImplementedError) as error:

@@ -45,15 +45,18 @@ def test_an_fmu_that_unpacks_beyond_the_limit_is_refused_with_a_message(misbehav
 
 def test_the_limit_counts_every_archive_the_process_unpacks(tmp_path, monkeypatch):
     monkeypatch.setattr(archives, "_BUDGET", archives._Budget())
+    monkeypatch.setenv(archives.LIMIT_VARIABLE, str(5 << 20))
     one = tmp_path / "one.zip"
     with zipfile.ZipFile(one, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.writestr("a.bin", bytes(3 << 20))
-    written = unpack_archive(one, tmp_path / "first", limit=5 << 20)
+    written = unpack_archive(one, tmp_path / "first")
     assert written == 3 << 20
     with pytest.raises(UnpackError, match="more than 5242880 bytes in all"):
-        unpack_archive(one, tmp_path / "second", limit=5 << 20)  # 6 MB together
+        unpack_archive(one, tmp_path / "second")  # 6 MB together: an FMU inside an archive counts with it
     archives.release(written)  # the first folder removed: room again
-    assert unpack_archive(one, tmp_path / "third", limit=5 << 20) == 3 << 20
+    assert unpack_archive(one, tmp_path / "third") == 3 << 20
+    with pytest.raises(UnpackError, match="more than the limit of 1048576 bytes"):
+        unpack_archive(one, tmp_path / "fourth", limit=1 << 20)  # an archive's own limit (SSP)
 
 
 @pytest.mark.parametrize(("name", "said"), [("../escape.txt", "lies outside the archive's folder"),
