@@ -10,7 +10,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 RESULTS ?= results
 
-.PHONY: run test test-fast docs lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
+.PHONY: run test test-fast fuzz docs lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
@@ -109,6 +109,14 @@ test: $(STAMP)
 ## pages, fuzz): seconds, for the edit-test loop; make test runs them all
 test-fast: $(STAMP)
 	$(PY) -P -m pytest -m "not fmu and not slow" -q
+
+## fuzz: a seeded fuzz of hostile inputs through the command line (system files, studies, soils,
+## options, model descriptions, report inputs): every case must end in a message and exit 0/1/2,
+## change nothing outside its output and leave nothing half-written; minutes, not part of make test
+SEED ?= 20261206
+CASES ?= 600
+fuzz: $(STAMP)
+	$(PY) -P tests/fuzz_harness.py --seed $(SEED) --cases $(CASES)
 
 ## docs: the documentation site -> site/ (MkDocs; reference pages generated from the code)
 docs: fmus

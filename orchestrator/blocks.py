@@ -139,6 +139,14 @@ class Table(Source):
         return float(np.interp(t, self.times, self.data))
 
 
+def _header(path: Path) -> list[str]:
+    """The column names of a CSV file's first line (as written: pandas renames a repeated one)."""
+    import csv
+
+    with open(path, newline="", errors="replace") as stream:
+        return [c.strip() for c in next(csv.reader(stream), [])]
+
+
 class CsvInput:
     """Signals read from a CSV file, FMPy's convention: the first column is time [s], increasing
     (a repeated time is a step: from that time on the later row holds), every other column an
@@ -158,6 +166,11 @@ class CsvInput:
             table = pd.read_csv(self.file, skipinitialspace=True)
         except (OSError, ValueError) as error:
             raise ValueError(f"block {name!r}: file {self.file}: cannot be read as CSV ({error})") from None
+        header = _header(self.file)
+        twice = sorted({c for c in header if header.count(c) > 1})
+        if twice:
+            raise ValueError(f"block {name!r}: file {self.file}: column {twice[0]!r} appears more than once; "
+                             "expected one column per signal")
         if table.shape[1] < 2 or len(table) < 1:
             raise ValueError(f"block {name!r}: file {self.file}: expected a time column and at least one signal "
                              f"column with at least one row (got {table.shape[1]} columns, {len(table)} rows)")

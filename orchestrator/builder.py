@@ -295,14 +295,21 @@ class SystemBuilder:
             raise self.error(f"{where} step", f"{step!r} s makes {steps:.3g} communication steps of a "
                              f"{stop_time - start_time!r} s run: more than the {MAX_STEPS:,} a run may take "
                              "(a larger step, or a shorter run)")
-        interval = values.get("output_interval")
-        if interval is not None:
-            interval = self._number(interval, f"{where} output_interval")
-            multiple = interval / step
-            if not 0 < interval < math.inf or abs(multiple - round(multiple)) > 1e-9 * max(1.0, multiple) \
-                    or round(multiple) < 1:
-                raise self.error(f"{where} output_interval", f"{interval!r}: expected a whole number of communication "
-                                 f"steps ({step!r} s) > 0")
+        self._check_interval(values.get("output_interval"), stop_time - start_time, step)
+
+    def _check_interval(self, interval: Any, length: float, step: float) -> None:
+        """output_interval: a whole number of steps [s] within the run's ``length`` [s]."""
+        where = self._settings.where
+        if interval is None:
+            return
+        interval = self._number(interval, f"{where} output_interval")
+        if not 0 < interval <= length:
+            raise self.error(f"{where} output_interval", f"{interval!r}: expected an interval > 0 s and at most "
+                             f"the run's length ({length!r} s)")
+        multiple = interval / step
+        if abs(multiple - round(multiple)) > 1e-9 * max(1.0, multiple) or round(multiple) < 1:
+            raise self.error(f"{where} output_interval", f"{interval!r}: expected a whole number of communication "
+                             f"steps ({step!r} s) > 0")
 
     def _check_switches(self) -> None:
         values, where = self._settings.values, self._settings.where

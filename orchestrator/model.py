@@ -10,6 +10,7 @@ Units: times and steps in seconds; parameter and start values in the unit of the
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -69,6 +70,8 @@ def typed_value(value: object, variable_type: str) -> Value:
         return float(value)
     if not isinstance(value, kind) or (kind is float and isinstance(value, bool)):
         raise ValueError(f"{value!r}: expected {text} ({variable_type})")
+    if kind is float and not math.isfinite(value):  # type: ignore[arg-type]
+        raise ValueError(f"{value!r}: expected a finite number ({variable_type})")
     return value  # type: ignore[return-value]
 
 

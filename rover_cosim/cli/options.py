@@ -52,19 +52,29 @@ def scheduler(text: str) -> str:
 
     if not re.fullmatch(r"([a-z][a-z0-9+.-]*://)?(\[[0-9A-Fa-f:.]+\]|[^\s/:\[\]]+):\d{1,5}", text):
         raise argparse.ArgumentTypeError(f"{text!r}: expected a Dask scheduler's address, e.g. tcp://host:8786")
+    from rover_cosim.common.parallel import scheduler_timeout
+
+    try:
+        scheduler_timeout()  # the time it may take to answer: said now, before any work
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
     return text
 
 
+#: N, the least wheel load a command takes (a thousandth of a newton: below, no sinkage is found).
+LEAST_LOAD = 1e-3
+
+
 def positive_loads(text: str) -> tuple[float, ...]:
-    """Comma-separated wheel loads [N], each finite and > 0."""
+    """Comma-separated wheel loads [N], each finite and >= LEAST_LOAD."""
     try:
         loads = tuple(float(part) for part in text.split(","))
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"loads={text!r}: expected comma-separated numbers in N, e.g. 100,200") from None
-    bad = [w for w in loads if not (0 < w < float("inf"))]
+    bad = [w for w in loads if not (LEAST_LOAD <= w < float("inf"))]
     if bad:
-        raise argparse.ArgumentTypeError(f"load={bad[0]!r} N: expected a finite load > 0 N")
+        raise argparse.ArgumentTypeError(f"load={bad[0]!r} N: expected a finite load >= {LEAST_LOAD:g} N")
     return loads
 
 

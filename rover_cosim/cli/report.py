@@ -38,7 +38,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     try:
         page = build_report(args.results)
-    except (KeyError, ValueError, OSError) as error:  # a results file not as its job writes it
+    except (KeyError, ValueError, OSError, AttributeError, TypeError, RecursionError) as error:  # a results file
+        # not as its job writes it: a value of another shape where a table or record was expected
         fail("report", f"{args.results}: a results file is not as its command writes it ({type(error).__name__}: "
              f"{error}); nothing written")
         return 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from .command import Command, no_result_set
 from .options import fail, path_text
@@ -37,15 +38,20 @@ def _one(name: str) -> int:
     from rover_cosim.terramechanics.parameters import UNITS
 
     found = []
+    problems = []
     for kind in ("soil", "wheel"):
         try:
             entry_name, table = library.entry(kind, name)
             found.append((kind, entry_name, table, library.build(kind, entry_name, table)))
-        except ValueError:
+        except ValueError as error:
+            problems.append(f"as a {kind}: {error}")
             continue
     if not found:
-        fail("soils", f"{name!r}: no shipped soil or wheel of that name, and no such TOML file (soils: "
-             f"{', '.join(library.names('soil'))}; wheels: {', '.join(library.names('wheel'))})")
+        shipped = (f"soils: {', '.join(library.names('soil'))}; wheels: {', '.join(library.names('wheel'))}")
+        if Path(name.rsplit(":", 1)[0]).is_file() or Path(name).is_file():  # a file of the user's: why not
+            fail("soils", f"{name!r}: neither a soil nor a wheel: " + "; ".join(problems))
+        else:
+            fail("soils", f"{name!r}: no shipped soil or wheel of that name, and no such TOML file ({shipped})")
         return 2
     for kind, entry_name, table, built in found:
         print(f"{kind} {entry_name}: {table.get('title', '')}")

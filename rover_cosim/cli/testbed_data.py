@@ -85,6 +85,10 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as error:
         fail("testbed-data", f"{error} (nothing written)")
         return 2
+    except RuntimeError as error:  # the reference wheel finds no sinkage for a load and slip given
+        fail("testbed-data", f"{error}: the wheel on this soil has no steady state there; expected loads and "
+             "slips it can carry (nothing written)")
+        return 2
     print(f"{outcome.data.rows} rows ({', '.join(outcome.data.channels)}) on soil {choice.soil_name}, wheel "
           f"{choice.wheel_name}, noise {args.noise:g} of each channel's range (seed {args.seed})")
     print_written(outcome.files)

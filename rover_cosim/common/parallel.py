@@ -14,6 +14,7 @@ so a caller killed in any way (kill -9 included) leaves no workers behind.
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import time
@@ -41,7 +42,7 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
         from dask.distributed import Client
         from dask.distributed import as_completed as dask_completed
 
-        timeout = float(os.environ.get("ROVER_COSIM_SCHEDULER_TIMEOUT", SCHEDULER_TIMEOUT))
+        timeout = scheduler_timeout()
         try:
             client = Client(scheduler, timeout=timeout)
         except Exception as error:  # noqa: BLE001 - no answer, a refusal, or something else answering there
@@ -67,6 +68,22 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     finally:  # done, or Ctrl-C, SIGTERM (raised as KeyboardInterrupt by the CLI), the consumer closing
         pool.stop()
         remove_stale_folders()  # the workers' temporary folders (they exit without clean-ups)
+
+
+def scheduler_timeout() -> float:
+    """s, how long a Dask scheduler may take to answer: ROVER_COSIM_SCHEDULER_TIMEOUT, else
+    SCHEDULER_TIMEOUT; ValueError naming the variable for a value that is not a number of
+    seconds in (0, 3600]."""
+    text = os.environ.get("ROVER_COSIM_SCHEDULER_TIMEOUT")
+    if text is None:
+        return SCHEDULER_TIMEOUT
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 < value <= 3600:
+        raise ValueError(f"ROVER_COSIM_SCHEDULER_TIMEOUT = {text!r}: expected a number of seconds > 0 and at most 3600")
+    return value
 
 
 def cores() -> int:

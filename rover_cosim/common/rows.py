@@ -17,6 +17,9 @@ def steps_between_rows(interval: float, step: float) -> int:
     """Steps of ``step`` [s] between two kept rows; ValueError unless ``interval`` [s] is a whole
     number (>= 1) of them."""
     count = interval / step if isinstance(interval, (int, float)) and 0 < interval < math.inf else 0.0
+    if not count < 2**53:  # beyond any run, and beyond what a whole number of steps can be told apart
+        raise ValueError(f"record interval {interval!r} s: expected a whole number of steps of {step} s "
+                         "within a run's length")
     if round(count) < 1 or abs(count - round(count)) > 1e-9 * max(1.0, count):
         raise ValueError(f"record interval {interval!r} s: expected a whole number of steps of {step} s")
     return round(count)

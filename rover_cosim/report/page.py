@@ -8,6 +8,7 @@ import html
 import json
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -60,10 +61,22 @@ def _cell(value: object, pattern: str) -> str:
     return str(value)
 
 
+def read_record(path: Path) -> dict[str, Any]:
+    """A JSON record of a job (a JSON object); ValueError naming the file for anything else (not
+    JSON, not UTF-8, nested too deeply, an array or a number at the top)."""
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except RecursionError:
+        raise ValueError(f"{path}: nested too deeply to be a record of this tool") from None
+    if not isinstance(record, dict):
+        raise ValueError(f"{path}: a JSON {type(record).__name__}: expected an object (a record of this tool)")
+    return record
+
+
 def provenance(path: Path) -> str:
     if not path.exists():
         return missing(path)
-    record = json.loads(path.read_text())
+    record = read_record(path)
     keep = {k: record[k] for k in ("command", "created_utc", "git_commit", "versions", "parameters", "fmu_sha256",
                                    "fmus", "model_sha256", "soil", "wheel", "set", "wall_seconds", "run_wall_seconds",
                                    "sweep_wall_seconds", "runs_computed", "runs_cached", "runs_failed") if k in record}

@@ -6,7 +6,6 @@ over soil uncertainty, behaviour outside the paper's scope, provenance."""
 from __future__ import annotations
 
 import html
-import json
 import math
 from dataclasses import asdict
 from pathlib import Path
@@ -19,7 +18,7 @@ from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.jobs.simulate import CHECKS
 from rover_cosim.terramechanics import Soil, Wheel
 
-from .page import image, missing, provenance, table
+from .page import image, missing, provenance, read_record, table
 
 #: Units and names of the soil and wheel parameters (Table 2).
 PARAMETERS = {"c": ("cohesion c", "Pa"), "phi": ("friction angle φ", "deg"), "kc": ("k_c", "N/m^(n+1)"),
@@ -36,7 +35,7 @@ def _record(*paths: Path) -> dict[str, Any]:
     """The first of the records that exists (soil and wheel are in every job's record)."""
     for path in paths:
         if path.exists():
-            record = json.loads(path.read_text())
+            record = read_record(path)
             if "soil" in record:
                 return record
             choice = record.get("parameters", {}).get("choice")
@@ -57,7 +56,7 @@ def fig3_file(results: Path, suffix: str) -> Path:
     record = soil_record(results)
     soil, wheel = record.get("soil", {}).get("name"), record.get("wheel", {}).get("name")
     for path in sorted(results.glob("fig3_fx_vs_slip*.json")):
-        choice = json.loads(path.read_text()).get("parameters", {}).get("choice", {})
+        choice = read_record(path).get("parameters", {}).get("choice", {})
         if choice.get("soil", {}).get("name") == soil and choice.get("wheel", {}).get("name") == wheel:
             return path.with_suffix(f".{suffix}")
     return results / f"fig3_fx_vs_slip.{suffix}"
@@ -199,11 +198,11 @@ def closed_loop_section(simulation: Path, paper_soil: bool = True) -> list[str]:
         sections += ["<p>Ablation: the same controller with one model at a fixed 424 N instead of the per-load "
                      "look-up tables:</p>", table(shown, default="{:.2f}")]
     record_path = simulation / "simulation.json"
-    if record_path.exists() and json.loads(record_path.read_text()).get("model_mismatch"):
-        why = html.escape(str(json.loads(record_path.read_text())["model_mismatch"]))
+    if record_path.exists() and read_record(record_path).get("model_mismatch"):
+        why = html.escape(str(read_record(record_path)["model_mismatch"]))
         sections.insert(1, f"<p class='note'>Run with --allow-model-mismatch: {why}</p>")
     if record_path.exists():
-        checks = json.loads(record_path.read_text()).get("checks", {})
+        checks = read_record(record_path).get("checks", {})
         rows = [{"plant": {"monolithic": "Rover.fmu", "cosim": "RoverBody + 6 Wheel"}.get(p, p),
                  **{CHECKS[k][0]: v for k, v in values.items() if k in CHECKS}} for p, values in checks.items()]
         formats = {label: fmt for label, fmt in CHECKS.values()}
@@ -360,7 +359,7 @@ def montecarlo_section(montecarlo: Path) -> list[str]:
     summary_path = montecarlo / "summary.json"
     if not summary_path.exists():
         return []
-    summary = json.loads(summary_path.read_text())
+    summary = read_record(summary_path)
     study = summary.get("parameters", {})
     sections = ["<h2>Monte Carlo over soil uncertainty</h2>",
                 f"<p>Study <b>{html.escape(str(study.get('title') or study.get('file')))}</b>: "

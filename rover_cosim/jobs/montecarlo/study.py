@@ -160,7 +160,7 @@ def _distribution(where: str, name: str, table: Any) -> Distribution:
         raise StudyError(f"{where}: expected a table with distribution = uniform, normal or lognormal")
     _check_name(where, name)
     kind = table.get("distribution")
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise StudyError(f"{where}: distribution = {kind!r}: expected one of {', '.join(KINDS)}")
     known = {"distribution", "lower", "upper", "unit", "note", *KINDS[kind]}
     unknown = sorted(set(table) - known)
@@ -193,14 +193,15 @@ def _correlation(where: str, table: Any, names: list[str]) -> np.ndarray:
     if not isinstance(table, dict) or set(table) != {"parameters", "matrix"}:
         raise StudyError(f"{where}: expected a table with parameters = [names] and matrix = [[...], ...]")
     chosen = table["parameters"]
-    if not isinstance(chosen, list) or len(set(chosen)) != len(chosen) or not chosen:
+    if not isinstance(chosen, list) or not all(isinstance(n, str) for n in chosen) \
+            or len(set(chosen)) != len(chosen) or not chosen:
         raise StudyError(f"{where}: parameters = {chosen!r}: expected a list of distinct parameter names")
     unknown = [n for n in chosen if n not in names]
     if unknown:
         raise StudyError(f"{where}: {unknown[0]!r} is not a parameter of the study (has {', '.join(names)})")
     try:
         given = np.array(table["matrix"], dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise StudyError(f"{where}: matrix = {table['matrix']!r}: expected a square table of numbers") from None
     k = len(chosen)
     if given.shape != (k, k) or not np.all(np.isfinite(given)):

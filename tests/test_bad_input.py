@@ -1,0 +1,92 @@
+"""Bad input found by the fuzz of issue 45 that ended in a traceback or a misleading message:
+each now gets one line naming the value and what was expected, and exit 2, before any work."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from c_fmu import built_or_skip
+from misbehave_fmu import build_misbehave
+
+from rover_cosim.cli import main
+
+STUDY = Path(__file__).parents[1] / "rover_cosim" / "jobs" / "montecarlo" / "studies" / "lunar_regolith.toml"
+
+
+@pytest.fixture(scope="module")
+def misbehave(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return built_or_skip(build_misbehave(tmp_path_factory.mktemp("misbehave")))
+
+
+def _refused(argv: list[str], said: str, capsys: pytest.CaptureFixture[str]) -> None:
+    code: object
+    try:
+        code = main(argv)
+    except SystemExit as exit_:  # argparse's own refusals
+        code = exit_.code
+    err = capsys.readouterr().err
+    assert code == 2, (argv, err)
+    assert said in err and "Traceback" not in err, err
+
+
+@pytest.mark.parametrize(("option", "said"), [
+    (["--output-interval", "1e308"], "output_interval: 1e+308: expected an interval > 0 s and at most"),
+    (["--output-interval", "1e23"], "expected an interval > 0 s and at most the run's length (1.0 s)"),
+    (["--start", "at=nan"], "at: nan: expected a finite number (Real)"),
+    (["--start", "at=-inf"], "at: -inf: expected a finite number (Real)"),
+])
+def test_run_refuses_absurd_numbers(misbehave, tmp_path, capsys, option, said):
+    _refused(["run", str(misbehave), "-q", "-o", str(tmp_path / "x.csv"), *option], said, capsys)
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_an_input_file_with_a_column_twice_is_refused(misbehave, tmp_path, capsys):
+    signals = tmp_path / "in.csv"
+    signals.write_text("time,u,u\n0,1,2\n")
+    _refused(["run", str(misbehave), "-q", "-o", str(tmp_path / "x.csv"), "--input", str(signals)],
+             "column 'u' appears more than once", capsys)
+
+
+def test_identify_and_testbed_data_refuse_absurd_numbers(tmp_path, capsys, monkeypatch):
+    _refused(["identify", "--record-interval", "1e308", "--out", str(tmp_path / "id")],
+             "record interval 1e+308 s: expected a whole number of steps", capsys)
+    _refused(["testbed-data", "--loads", "1e-308", "--out", str(tmp_path / "t.csv")],
+             "load=1e-308 N: expected a finite load >= 0.001 N", capsys)
+    monkeypatch.setenv("ROVER_COSIM_SCHEDULER_TIMEOUT", "abc")
+    _refused(["identify", "--scheduler", "tcp://127.0.0.1:1", "--out", str(tmp_path / "id2")],
+             "ROVER_COSIM_SCHEDULER_TIMEOUT = 'abc': expected a number of seconds > 0", capsys)
+    assert not (tmp_path / "id").exists() and not (tmp_path / "id2").exists()
+
+
+@pytest.mark.parametrize(("pattern", "replacement", "said"), [
+    (r'distribution = "lognormal"', 'distribution = ["uniform"]', "distribution = ['uniform']: expected one of"),
+    (r"(\[correlation\]\nparameters = ).*", r'\1[["soil.c"]]', "expected a list of distinct parameter names"),
+    (r"(\nmatrix = ).*", r"\1[[1e400, 0], [0, 1]]", "expected 2 x 2 finite numbers"),
+    (r"(\nmatrix = ).*", r'\1"x"', "expected a square table of numbers"),
+])
+def test_a_study_of_odd_shapes_is_refused(tmp_path, capsys, pattern, replacement, said):
+    study = tmp_path / "study.toml"
+    study.write_text(re.sub(pattern, replacement, STUDY.read_text(), count=1))
+    _refused(["montecarlo", "--study", str(study), "--out", str(tmp_path / "mc"), "-q"], said, capsys)
+
+
+def test_soils_says_why_a_file_of_the_users_is_neither_a_soil_nor_a_wheel(tmp_path, capsys):
+    mixed = tmp_path / "mixed.toml"
+    mixed.write_text("c = 800.0\nr = 0.3\n")
+    _refused(["soils", str(mixed)], "neither a soil nor a wheel: as a soil: soil 'mixed': unknown key(s) ['r']",
+             capsys)
+
+
+@pytest.mark.parametrize("text", ["[1, 2]", "[" * 100_000 + "]" * 100_000, "3.5", '{"parameters": [1]}'])
+def test_a_report_input_of_another_shape_is_a_message(tmp_path, capsys, text):
+    results = tmp_path / "results"
+    assert main(["fig3", "--out", str(results), "--loads", "300", "--slip-step", "0.1"]) == 0
+    (results / "montecarlo").mkdir()
+    (results / "montecarlo" / "summary.json").write_text(text)
+    capsys.readouterr()
+    assert main(["report", "--results", str(results), "--out", str(tmp_path / "r.html")]) == 1
+    err = capsys.readouterr().err
+    assert "a results file is not as its command writes it" in err and "Traceback" not in err
+    assert not (tmp_path / "r.html").exists()
