@@ -16,6 +16,7 @@ import math
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import fmpy
 import numpy as np
@@ -28,6 +29,17 @@ from rover_cosim.orchestrator.unpacking import unpack
 
 #: What every run records besides time and torque (SingleWheel outputs, SI units).
 RECORDED = ("slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v", "Fy", "beta")
+
+
+#: The variables a single-wheel test bed FMU has (SingleWheel.fmu's interface).
+TEST_BED_VARIABLES = ("W", "tau", "slipAngle", "trackAngle", *RECORDED)
+
+
+def not_a_test_bed(description: Any) -> str | None:
+    """Why an FMU (its FMPy model description) is not a single-wheel test bed, or None."""
+    names = {v.name for v in description.modelVariables}
+    missing = [n for n in TEST_BED_VARIABLES if n not in names]
+    return f"not a SingleWheel FMU (no variables {missing})" if missing else None
 
 
 @dataclass(frozen=True)
@@ -62,12 +74,11 @@ class WheelTestBed:
         self.path = Path(fmu_path)
         self._folder = tempfile.TemporaryDirectory(prefix=scratch_prefix("testbed"))
         self.description = fmpy.read_model_description(str(self.path))
-        names = {v.name for v in self.description.modelVariables}
         self.radius = float(next((v.start for v in self.description.modelVariables if v.name == "wheel.r"), 0.355))
-        missing = [n for n in ("W", "tau", "slipAngle", "trackAngle", *RECORDED) if n not in names]
-        if missing:
-            raise ValueError(f"{self.path}: not a SingleWheel FMU (no variables {missing})")
-        self.names = names
+        problem = not_a_test_bed(self.description)
+        if problem:
+            raise ValueError(f"{self.path}: {problem}")
+        self.names = {v.name for v in self.description.modelVariables}
         entry = FmuEntry("testbed", self.path, {}, {}, self.description)
         self.fmu = FmuParticipant(entry, unpack(entry, Path(self._folder.name)))
         self.fmu.configure([], list(RECORDED))  # inputs are set by name when they change; RECORDED read each step

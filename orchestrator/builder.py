@@ -129,6 +129,9 @@ def _description(fmu_path: Path, where: str, validation: str) -> tuple[Any, tupl
     """FMPy's reading of the model description, checked as ``validation`` says (``read_fmu``)."""
     if validation not in VALIDATION:
         raise SystemFileError(f"{where}: validation = {validation!r}: expected one of {', '.join(VALIDATION)}")
+    problem = _structure_problem(fmu_path)
+    if problem:  # FMPy reads index 0 as the last variable, and fails on one past the end with "list index ..."
+        raise SystemFileError(f"{where}: {fmu_path.name}: its modelDescription.xml: {problem}")
     try:
         try:
             return fmpy.read_model_description(str(fmu_path)), ()
@@ -143,6 +146,33 @@ def _description(fmu_path: Path, where: str, validation: str) -> tuple[Any, tupl
         raise
     except Exception as failure:  # noqa: BLE001 - fmpy raises many kinds
         raise SystemFileError(f"{where}: {fmu_path} is not a readable FMU: {failure}") from None
+
+
+def _structure_problem(fmu_path: Path) -> str | None:
+    """What is wrong with the variable indices of an FMI 2.0 ModelStructure (each Unknown's index
+    and dependencies are 1-based places among the ScalarVariables), or None (also for FMI 3.0,
+    which names value references, and for an archive FMPy will say is unreadable)."""
+    from lxml import etree
+
+    try:
+        with zipfile.ZipFile(fmu_path) as archive:
+            root = etree.fromstring(archive.read("modelDescription.xml"), etree.XMLParser(resolve_entities=False,
+                                                                                          huge_tree=False))
+    except Exception:  # noqa: BLE001 - unreadable: FMPy's reading says how
+        return None
+    if not str(root.get("fmiVersion", "")).startswith("2"):
+        return None
+    count = len(root.findall("ModelVariables/ScalarVariable"))
+    for unknown in root.iterfind("ModelStructure/*/Unknown"):
+        section = unknown.getparent().tag
+        for attribute in ("index", "dependencies"):
+            given = unknown.get(attribute, "") if attribute == "dependencies" else unknown.get("index")
+            for text in str(given).split():
+                if not text.isdigit() or not 1 <= int(text) <= count:
+                    return (f"<Unknown {attribute}=\"{unknown.get(attribute)}\"> in {section}: expected "
+                            f"{'indices' if attribute == 'dependencies' else 'an index'} from 1 to {count} (1-based "
+                            "places among its ScalarVariables)")
+    return None
 
 
 def interfaces_of(description: Any) -> list[str]:

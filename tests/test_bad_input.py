@@ -90,3 +90,41 @@ def test_a_report_input_of_another_shape_is_a_message(tmp_path, capsys, text):
     err = capsys.readouterr().err
     assert "a results file is not as its command writes it" in err and "Traceback" not in err
     assert not (tmp_path / "r.html").exists()
+
+
+def test_fig3_and_estimate_soil_refuse_to_replace_a_users_file(tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "fig3_fx_vs_slip.png").write_text("my own figure")
+    fig3 = ["fig3", "--out", str(out), "--loads", "300", "--slip-step", "0.1"]
+    _refused(fig3, "fig3_fx_vs_slip.png exists and is not a result of rover-cosim fig3", capsys)
+    assert (out / "fig3_fx_vs_slip.png").read_text() == "my own figure"
+    assert main([*fig3, "--overwrite"]) == 0 and main(fig3) == 0  # then it is the command's own: replaced
+    (out / "soil.toml").write_text("# my soil")
+    _refused(["estimate-soil", str(tmp_path / "data.csv"), "--out", str(out)],
+             "soil.toml exists and is not a result of rover-cosim estimate-soil", capsys)
+    assert (out / "soil.toml").read_text() == "# my soil"
+
+
+@pytest.mark.parametrize(("index", "said"), [("0", '<Unknown index="0"> in Outputs: expected an index from 1 to 3'),
+                                             ("9", '<Unknown index="9"> in Outputs: expected an index from 1 to 3')])
+def test_a_model_structure_index_outside_the_variables_is_refused(misbehave, tmp_path, capsys, index, said):
+    """FMPy reads index 0 as the last variable (silently wrong) and fails on one past the end
+    with "list index out of range"."""
+    import zipfile
+
+    edited = tmp_path / "Edited.fmu"
+    with zipfile.ZipFile(misbehave) as source, zipfile.ZipFile(edited, "w") as target:
+        for item in source.infolist():
+            data = source.read(item)
+            if item.filename == "modelDescription.xml":
+                data = data.replace(b'<Unknown index="1"/>', f'<Unknown index="{index}"/>'.encode())
+            target.writestr(item, data)
+    for validate in ("strict", "off"):
+        _refused(["run", str(edited), "-q", "-o", str(tmp_path / "x.csv"), "--validate", validate], said, capsys)
+
+
+def test_identify_refuses_an_fmu_that_is_not_a_test_bed_before_any_run(misbehave, tmp_path, capsys):
+    _refused(["identify", "--fmu", str(misbehave), "--out", str(tmp_path / "id")],
+             "not a SingleWheel FMU (no variables ['W', 'tau'", capsys)
+    assert not (tmp_path / "id").exists()

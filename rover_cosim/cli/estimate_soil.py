@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from .command import Command
-from .options import add_out, fail, output_folder, path, path_text, print_written
+from .options import add_out, add_overwrite, fail, foreign_results, output_folder, path, path_text, print_written
 
 
 def _names(text: str) -> tuple[str, ...]:
@@ -44,6 +44,7 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("data", type=path, help="CSV file: columns load_N, slip, any of Fx_N, Tx_Nm, sinkage_m, Fy_N "
                         "and optionally slip_angle_deg; one row per steady-state measurement")
     add_out(parser, "results/soil_estimate")
+    add_overwrite(parser, "the files in --out")
     parser.add_argument("--wheel", type=path_text, default=None,
                         help="the test bed's wheel: a name of the shipped library, a TOML file, or FILE:NAME (default: "
                         "paper)")
@@ -61,10 +62,15 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.estimate_soil import run_estimate_soil
+    from rover_cosim.jobs.estimate_soil import FILES, run_estimate_soil
     from rover_cosim.terramechanics.library import choose
 
     if not output_folder(args.out, "estimate-soil", COMMAND.needs_bytes):
+        return 2
+    mine = None if args.overwrite else foreign_results([args.out / name for name in FILES], args.out / "estimate.json",
+                                                       "estimate-soil")
+    if mine:
+        fail("estimate-soil", f"--out {args.out}: {mine}")
         return 2
     try:
         choice = choose(args.prior, args.wheel, args.assignments)

@@ -3,9 +3,19 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from .command import Command
-from .options import add_out, add_soil_options, choice_of, fail, output_folder, print_written
+from .options import (
+    add_out,
+    add_overwrite,
+    add_soil_options,
+    choice_of,
+    fail,
+    foreign_results,
+    output_folder,
+    print_written,
+)
 
 
 def _slip_step(text: str) -> float:
@@ -39,13 +49,22 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--slip-range", type=_slip_range, default=(0.0, 0.9), metavar="FIRST,LAST",
                         help="slip ratios from FIRST to LAST in [-1, 1] (negative: braking; default: 0,0.9)")
     add_soil_options(parser)
+    add_overwrite(parser, "the figure's files in --out")
 
 
 def run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.fig3 import PAPER_LOADS, slip_grid, write_fig3
+    from rover_cosim.common.figures import SETTINGS
+    from rover_cosim.jobs.fig3 import PAPER_LOADS, file_names, slip_grid, write_fig3
 
     choice = choice_of(args, "fig3")
     if choice is None or not output_folder(args.out, "fig3", COMMAND.needs_bytes):
+        return 2
+    names = file_names(choice)
+    extra = [args.out / f"{Path(names['png']).stem}.{kind}" for kind in SETTINGS.formats if kind != "png"]
+    mine = None if args.overwrite else foreign_results(
+        [args.out / name for name in names.values()] + extra, args.out / names["json"], "fig3")
+    if mine:
+        fail("fig3", f"--out {args.out}: {mine}")
         return 2
     try:
         first, last = args.slip_range

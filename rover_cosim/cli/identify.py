@@ -44,6 +44,18 @@ def is_fmu(fmu: Path) -> bool:
         return False
 
 
+def _not_a_test_bed(fmu: Path) -> str | None:
+    """Why ``fmu`` cannot be the identification's test bed (its model description read), or None."""
+    import fmpy
+
+    from rover_cosim.identification.testbed import not_a_test_bed
+
+    try:
+        return not_a_test_bed(fmpy.read_model_description(str(fmu), validate=False))
+    except Exception as error:  # noqa: BLE001 - FMPy raises many kinds
+        return f"its modelDescription.xml cannot be read ({error})"
+
+
 def run(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.identify import check_record_interval, run_identification
 
@@ -59,6 +71,10 @@ def run(args: argparse.Namespace) -> int:
     if not is_fmu(args.fmu):
         fail("identify", f"--fmu {args.fmu}: not an FMU (expected a zip archive holding a modelDescription.xml, "
              "e.g. fmus/SingleWheel.fmu)")
+        return 2
+    problem = _not_a_test_bed(args.fmu)
+    if problem:
+        fail("identify", f"--fmu {args.fmu}: {problem}; expected the single-wheel test bed, e.g. fmus/SingleWheel.fmu")
         return 2
     choice = choice_of(args, "identify")
     if choice is None:

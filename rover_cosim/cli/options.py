@@ -119,6 +119,12 @@ def add_out(parser: argparse.ArgumentParser, default: str, help: str = "output f
     parser.add_argument("--out", type=path, default=Path(default), help=help)
 
 
+def add_overwrite(parser: argparse.ArgumentParser, what: str) -> None:
+    """--overwrite: replace same-named files that are not the command's own results."""
+    parser.add_argument("--overwrite", action="store_true",
+                        help=f"replace {what} even where a file of that name is not a result of this command")
+
+
 def add_fmu_dir(parser: argparse.ArgumentParser, help: str = "where the FMUs are") -> None:  # noqa: A002
     """--fmu-dir: the folder of the built FMUs."""
     parser.add_argument("--fmu-dir", type=path, default=Path("fmus"), help=help)
@@ -293,6 +299,24 @@ def option_ok(command: str, option: str, check: Callable[[], object]) -> bool:
         fail(command, f"{option}: {error}")
         return False
     return True
+
+
+def foreign_results(files: Iterable[Path], record: Path, command: str) -> str | None:
+    """Why ``files`` (what a command writes into a folder, ``record`` its JSON record among them)
+    may not be replaced without --overwrite: one exists and ``record`` does not say that
+    ``rover-cosim command`` made them. None: none exists, or they are the command's."""
+    import json
+
+    present = [f for f in files if f.exists() and not f.is_dir()]
+    if not present:
+        return None
+    try:
+        if json.loads(record.read_text()).get("command") == f"rover-cosim {command}":
+            return None
+    except (OSError, ValueError, AttributeError):
+        pass
+    return (f"{present[0]} exists and is not a result of rover-cosim {command} (no record of it in {record.name}): "
+            "pass --overwrite to replace it, or write elsewhere")
 
 
 def foreign_companion(paths: Iterable[Path], command: str) -> str | None:
