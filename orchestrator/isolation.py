@@ -60,7 +60,10 @@ START_SECONDS = 120.0
 def isolated(entry: FmuEntry, timeout: float | None = None) -> bool:
     """Whether ``entry`` runs in a child process: its ``isolation`` (``ISOLATION``) says so, or
     says "auto" and the FMU is not one this project generated or a time limit is set (only an FMU
-    in a child process can be ended)."""
+    in a child process can be ended); never in a daemonic process (multiprocessing's pool workers),
+    which may not start processes."""
+    if multiprocessing.current_process().daemon:  # a daemonic process may not start one: in-process there
+        return False
     if entry.isolation == "auto":
         return timeout is not None or not generated_here(entry)
     return entry.isolation == "process"

@@ -205,7 +205,8 @@ def test_a_signal_during_the_exchange_waits_for_it(tmp_path):
             "    return real(*a)\n"
             "folders.exchange = patched\n")
     (tmp_path / "out").mkdir()
-    (tmp_path / "out" / "fig3_fx_vs_slip.csv").write_text("old")
+    (tmp_path / "out" / "fig3_fx_vs_slip.csv").write_text("old")  # an earlier result of fig3 (its record says so)
+    (tmp_path / "out" / "fig3_fx_vs_slip.json").write_text('{"command": "rover-cosim fig3"}')
     done = _fig3_process(tmp_path / "out", hook)
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "out" / "fig3_fx_vs_slip.csv").read_text() != "old"

@@ -110,7 +110,9 @@ class _Worker:
 
     def __init__(self, context: Any, function: Callable[..., Any]):
         self.conn, child = context.Pipe()
-        self.process = context.Process(target=_work, args=(child, function, os.getpid()), daemon=True)
+        # not a daemon: a run in it may start processes of its own (an isolated FMU, a nested sweep); it
+        # ends with the pool (stop) or its parent (PR_SET_PDEATHSIG)
+        self.process = context.Process(target=_work, args=(child, function, os.getpid()), daemon=False)
         self.process.start()
         child.close()
         self.task: int | None = None
