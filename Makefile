@@ -137,6 +137,7 @@ bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_reference.py --out $(RESULTS)/bench/reference.json
 	$(PY) -P benchmarks/bench_fmus.py --out $(RESULTS)/bench/fmus.json
 	$(PY) -P benchmarks/bench_orchestrator.py --out $(RESULTS)/bench/orchestrator.json
+	$(PY) -P benchmarks/bench_isolation.py --out $(RESULTS)/bench/isolation.json
 	$(PY) -P benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
 	$(PY) -P benchmarks/bench_controller.py --out $(RESULTS)/bench/controller.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_soil_estimation.py --out $(RESULTS)/bench/soil_estimation.json --markdown $(RESULTS)/bench/soil_estimation.md
