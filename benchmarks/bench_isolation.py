@@ -58,7 +58,8 @@ def main() -> None:
             results["trivial"] = {"skipped": built}
         wheel = args.fmu_dir / "SingleWheel.fmu"
         if wheel.is_file():
-            cases["single_wheel_2000_steps"] = (wheel, ["--stop-time", "2", "--step", "1e-3", "--start", "tau=40"], 2000)
+            options = ["--stop-time", "2", "--step", "1e-3", "--start", "tau=40"]
+            cases["single_wheel_2000_steps"] = (wheel, options, 2000)
         else:
             results["single_wheel"] = {"skipped": f"{wheel} not built (make fmus)"}
         for name, (fmu, extra, steps) in cases.items():
