@@ -36,7 +36,7 @@ from .observers import (
     watches_every_step,
 )
 from .participants import BlockParticipant, FmuParticipant, Participant, RunError, Terminated
-from .recorder import Recorder, RunResult, communication_points
+from .recorder import Recorder, RunResult, Table, communication_points
 from .unpacking import UNZIP_PREFIX, once_per_process, remove_stale_folders, run_folder, unpack
 from .wiring import Wiring, wire
 
@@ -138,10 +138,12 @@ def _types(system: System, ports: Sequence[Port]) -> list[str]:
 
 
 def run(system: System, *, progress: Callable[[float], None] | None = None,
-        observers: Sequence[Observer] = ()) -> RunResult:
+        observers: Sequence[Observer] = (), sink: Callable[[Table], None] | None = None) -> RunResult:
     """Run ``system``; raises :class:`RunError` naming the participant, call and time on failure,
     with the rows recorded up to the failure in its ``partial``. ``progress(fraction)`` is told
-    how far the run is; ``observers`` watch it (and may end it early: ``observers``)."""
+    how far the run is; ``observers`` watch it (and may end it early: ``observers``). ``sink``:
+    the recorded rows are handed to it in chunks as the run goes (``recorder``), the result's and
+    a failure's tables holding only what was not handed over; without it they hold every row."""
     started = time.perf_counter()
     watched = _observed_ports(system, observers)
     wiring = wire(system, watched)
@@ -156,7 +158,7 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
         execution = make_execution(system, participants, wiring)
         stack.callback(execution.close)
         recorder = Recorder(system.record, wiring.record_slots, times, _types(system, system.record), strings,
-                            system.record_every)
+                            system.record_every, sink)
         watchers: list[Watcher] = [FiniteCheck(execution, execution.checked_in_python), Recording(recorder)]
         offset = 0
         for observer in observers:
@@ -181,16 +183,23 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
             _last_row(participants, execution, values, times, recorder, end)
             steps, stopped = recorder.filled - 1, str(end)
         except RunError as error:
-            error.partial = recorder.frame()
+            error.partial = recorder.frame() if sink is None else _handed(recorder)
             for observer in observers:
                 observer.fail(error)
             raise
         execution.close()
-        result = RunResult(recorder.table(), time.perf_counter() - started, steps, execution.step_seconds, stopped)
+        table = recorder.table() if sink is None else _handed(recorder)
+        result = RunResult(table, time.perf_counter() - started, steps, execution.step_seconds, stopped)
     result.notes.extend(problem for p in closed for problem in getattr(p, "problems", ()))
     for observer in observers:
         observer.finish(result)
     return result
+
+
+def _handed(recorder: Recorder) -> Table:
+    """The rest of a sink's rows handed over (finish); what is left: a table of no rows."""
+    recorder.finish()
+    return recorder.table()
 
 
 def _last_row(participants: list[Participant], execution: Execution, values: np.ndarray, times: np.ndarray,
@@ -263,12 +272,16 @@ def _run_stretches(execution: Execution, values: np.ndarray, times: np.ndarray, 
     record = np.ascontiguousarray(recorder.slots, dtype=np.int64)
     for first in range(start, n_steps, NATIVE_STRETCH):
         last = min(first + NATIVE_STRETCH, n_steps)
+        recorder.room(last - first)  # a recorder with a sink hands its rows over first
+        base = recorder.base  # rows[i] is point base + i: the stepper counts from there
         try:
-            reached, failed = execution.run_stretch(values, times, first, last, record, recorder.rows)
+            reached, failed = execution.run_stretch(values, times[base:], first - base, last - base, record,
+                                                    recorder.rows)
         except RunError:
             assert execution.native is not None
-            recorder.filled = execution.native.reached + 1  # the rows before the failed step
+            recorder.filled = base + execution.native.reached + 1  # the rows before the failed step
             raise
+        reached += base
         recorder.filled = reached + 1
         execution.check_native(failed, values, float(times[reached + 1]) if failed >= 0 else 0.0)
         for watcher in watchers:

@@ -1,5 +1,7 @@
-"""Recorded values of a run: one row per communication point, in a preallocated array; the
-:class:`Table` of typed columns it gives, and the :class:`RunResult` a run returns.
+"""Recorded values of a run: one row per communication point, in a preallocated array (or, with
+a ``sink``, in a buffer of CHUNK_ROWS rows handed to the sink whenever it is full, so that a run's
+memory does not grow with its length); the :class:`Table` of typed columns it gives, and the
+:class:`RunResult` a run returns.
 
 Neither imports pandas: a command that only writes its rows (``rover-cosim run``) does not pay
 for it; ``Table.frame()`` and ``RunResult.data`` build the DataFrame when asked.
@@ -7,7 +9,7 @@ for it; ``Table.frame()`` and ``RunResult.data`` build the DataFrame when asked.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -48,37 +50,82 @@ class Table:
         return pd.DataFrame(dict(zip(self.names, self.columns)), columns=list(self.names))
 
 
+#: Rows a recorder with a sink holds before it hands them over (more than a native stretch).
+CHUNK_ROWS = 8192
+
+
 class Recorder:
     """One row per communication point ``times``; :meth:`sample` copies the recorded slots of the
     value vector into row ``k``; :meth:`table` gives time [s] and one column per port (the rows
     sampled so far, when a run stops early), typed as the variables (``types``: their FMI types;
     whole-number and Enumeration columns as integers, Boolean ones as true/false, String ones as
-    text from the run's ``strings``; default Real)."""
+    text from the run's ``strings``; default Real).
+
+    ``sink``: called with each full buffer of rows as a Table (and with the rest by
+    :meth:`finish`); the recorder then holds CHUNK_ROWS rows at most, ``rows[i]`` being the
+    communication point ``base + i``, and :meth:`table` gives the rows not yet handed over."""
 
     def __init__(self, ports: list[Port], slots: np.ndarray, times: np.ndarray, types: list[str] | None = None,
-                 strings: StringTable | None = None, every: int = 1):
+                 strings: StringTable | None = None, every: int = 1, sink: Callable[[Table], None] | None = None):
         self.columns = [str(port) for port in ports]
         self.types = types or ["Real"] * len(ports)
         self.strings = strings
         self.every = every  # rows kept in the table: every ``every``-th communication point, and the last
         self.slots = slots
         self.times = times
-        self.rows = np.empty((len(times), slots.size))
-        self.filled = 0
+        self.sink = sink
+        self.rows = np.empty((len(times) if sink is None else min(len(times), CHUNK_ROWS), slots.size))
+        self.base = 0     # the communication point of rows[0]
+        self.filled = 0   # communication points sampled (rows[filled - 1 - base] is the last)
+        self.handed = 0   # rows handed to the sink
 
     def sample(self, k: int, values: np.ndarray) -> None:
-        self.rows[k] = values[self.slots]
+        if k - self.base >= len(self.rows):
+            self.hand_over(k)
+        self.rows[k - self.base] = values[self.slots]
         self.filled = k + 1
 
-    def table(self) -> Table:
-        kept: Any = slice(0, self.filled)
-        if self.every > 1 and self.filled:
-            kept = np.union1d(np.arange(0, self.filled, self.every), [self.filled - 1])
-        rows = self.rows[kept]
-        columns: list[np.ndarray] = [np.array(self.times[kept])]
+    def room(self, rows: int) -> None:
+        """Make room for ``rows`` more rows after the last sampled (a native stretch writes them in place)."""
+        if self.sink is not None and self.filled + rows - self.base > len(self.rows):
+            self.hand_over(self.filled)
+
+    def hand_over(self, upto: int) -> None:
+        """Give the sink the rows before communication point ``upto`` (and start the buffer there)."""
+        assert self.sink is not None, "a recorder without a sink holds every row"
+        if upto > self.base:
+            self.sink(self._table(self.base, upto, last=False))
+            self.handed += len(self._kept(self.base, upto, last=False))
+        self.base = upto
+
+    def finish(self) -> None:
+        """Give the sink the rows not yet handed over (the last one always)."""
+        if self.sink is not None and self.filled > self.base:
+            self.sink(self._table(self.base, self.filled, last=True))
+            self.handed += len(self._kept(self.base, self.filled, last=True))
+            self.base = self.filled
+
+    def _kept(self, start: int, stop: int, last: bool) -> np.ndarray:
+        """The communication points from ``start`` to ``stop`` kept in the table: every
+        ``every``-th, and ``stop - 1`` where ``last``."""
+        kept = np.arange(start + (-start) % self.every, stop, self.every)
+        if last and stop > start and (not len(kept) or kept[-1] != stop - 1):
+            kept = np.append(kept, stop - 1)
+        return kept
+
+    def _table(self, start: int, stop: int, last: bool) -> Table:
+        if self.every == 1:  # every row: slices, not copies
+            rows, times = self.rows[start - self.base:stop - self.base], self.times[start:stop]
+        else:
+            kept = self._kept(start, stop, last)
+            rows, times = self.rows[kept - self.base], self.times[kept]
+        columns: list[np.ndarray] = [np.array(times)]
         for j, kind in enumerate(self.types):
             columns.append(typed(rows[:, j], kind, self.strings))
         return Table(("time", *self.columns), tuple(columns))
+
+    def table(self) -> Table:
+        return self._table(self.base, self.filled, last=True)
 
     def frame(self) -> Any:
         """The rows so far as a pandas DataFrame."""

@@ -5,6 +5,7 @@ are quoted where they need it; Parquet keeps every column's type."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -108,6 +109,116 @@ def table_bytes(data: Any, path: Path) -> bytes:
     return buffer.getvalue()
 
 
+class TableStream:
+    """A run's rows written to ``path``'s format as they come (a recorder's sink: one call per
+    chunk of rows), into a temporary file beside ``path`` that :meth:`publish` renames into place
+    with the JSON sidecar (or :meth:`publish_partial` beside it as NAME.partial.*): the memory of
+    a run no longer grows with its length. The bytes equal :func:`table_bytes` of the whole table.
+    Should the disk refuse a chunk, the rest is kept in memory and the whole saved elsewhere when
+    published (``common.outputs.publish`` says where)."""
+
+    def __init__(self, path: Path):
+        from rover_cosim.common.outputs import staging_file
+
+        self.path = Path(path)
+        handle, self.temporary = staging_file(self.path)
+        self.stream: Any = os.fdopen(handle, "wb")
+        self.writer: Any = None
+        self.rows = 0
+        self.last_time: float | None = None
+        self.held: list[Table] = []   # chunks the disk refused, and every one after them
+        self.failure: OSError | None = None
+
+    def __call__(self, table: Table) -> None:
+        if not len(table):
+            return
+        self.rows += len(table)
+        self.last_time = float(table.columns[0][-1])
+        if self.failure is None:
+            try:
+                self._write(table)
+                return
+            except OSError as error:
+                self.failure = error
+        self.held.append(table)
+
+    def _write(self, table: Table) -> None:
+        import pyarrow as pa
+
+        arrow = pa.Table.from_arrays([arrow_column(column) for column in table.columns], names=list(table.names))
+        if self.writer is None:
+            if self.path.suffix.lower() == ".parquet":
+                import pyarrow.parquet as pq
+
+                self.writer = pq.ParquetWriter(self.stream, arrow.schema)
+            else:
+                import csv
+                import io
+
+                import pyarrow.csv as pc
+
+                header = io.StringIO()
+                csv.writer(header, lineterminator="\n").writerow([str(c) for c in arrow.column_names])
+                self.stream.write(header.getvalue().encode())
+                self.writer = pc.CSVWriter(self.stream, arrow.schema,
+                                           write_options=pc.WriteOptions(include_header=False, quoting_style="needed"))
+        self.writer.write_table(arrow)
+
+    def _close(self) -> dict[Path, bytes]:
+        """Close the file; what must still be written as bytes (nothing, unless the disk refused)."""
+        try:
+            if self.writer is not None:
+                self.writer.close()
+            self.stream.close()
+        except OSError as error:
+            self.failure = self.failure or error
+        if self.failure is None:
+            return {}
+        data = self.temporary.read_bytes() if self.temporary.exists() else b""
+        for table in self.held:  # what the disk refused: as the rest of the same file
+            data = _joined(data, table_bytes(table, self.path), self.path)
+        self.temporary.unlink(missing_ok=True)
+        return {self.path: data}
+
+    def publish(self, system: System, result: RunResult, command: str = "rover-cosim run",
+                extra: dict[str, Any] | None = None) -> list[Path]:
+        """The rows at ``path`` and its JSON sidecar, both or neither (``common.outputs.publish``)."""
+        from rover_cosim.common.outputs import publish
+
+        rest = self._close()
+        record = sidecar(system, result, command, extra)
+        publish({} if rest else {self.path: self.temporary}, {**rest, sidecar_path(self.path): json_bytes(record)})
+        return [self.path, sidecar_path(self.path)]
+
+    def publish_partial(self, system: System, failure: str, command: str = "rover-cosim run") -> list[Path]:
+        """The rows so far as NAME.partial.* with a record saying why the run failed."""
+        from rover_cosim.common.outputs import publish
+
+        rest = self._close()
+        target = partial_path(self.path)
+        record = _partial_record(system, command, failure, self.rows, self.last_time)
+        written = {} if rest else {target: self.temporary}
+        rows = {target: rest[self.path]} if rest else {}
+        publish(written, {**rows, sidecar_path(target): json_bytes(record)}, complete=False)
+        return [target, sidecar_path(target)]
+
+    def discard(self) -> None:
+        """Remove the temporary file (a run that wrote nothing to keep)."""
+        try:
+            self.stream.close()
+        except OSError:
+            pass
+        self.temporary.unlink(missing_ok=True)
+
+
+def _joined(first: bytes, second: bytes, path: Path) -> bytes:
+    """Two CSV texts of the same columns as one (the second's header dropped); Parquet is not
+    joined (the first file, whole, is kept: the rows after it are lost with the disk)."""
+    if path.suffix.lower() == ".parquet" or not first:
+        return first or second
+    return first + second.split(b"\n", 1)[1]
+
+
 def arrow_column(values: np.ndarray) -> Any:
     """A recorded column as an Arrow array over the same memory, built from its buffers: pyarrow's
     converters (``pa.array``) import pandas (0.15-0.25 s) to ask whether the values are a Series."""
@@ -132,15 +243,21 @@ def partial_path(csv_path: Path) -> Path:
     return csv_path.with_name(f"{csv_path.stem}.partial{csv_path.suffix}")
 
 
+def _partial_record(system: System, command: str, failure: str, rows: int,
+                    last_time: float | None) -> dict[str, Any]:
+    record = run_record(command, {"algorithm": system.algorithm, "step_s": system.step,
+                                  "stop_time_s": system.stop_time})
+    record.update({"partial": True, "failure": failure, "rows": rows, "last_time_s": last_time,
+                   "system_file": str(system.path) if system.path else None})
+    return record
+
+
 def write_partial(system: System, data: Any, csv_path: Path, failure: str,
                   command: str = "rover-cosim run") -> list[Path]:
     """The rows a failed run recorded, marked as partial in their file name and sidecar."""
     target = partial_path(csv_path)
-    record = run_record(command, {"algorithm": system.algorithm, "step_s": system.step,
-                                  "stop_time_s": system.stop_time})
-    record.update({"partial": True, "failure": failure, "rows": len(data),
-                   "last_time_s": float(data["time"].iloc[-1]) if len(data) else None,
-                   "system_file": str(system.path) if system.path else None})
+    record = _partial_record(system, command, failure, len(data),
+                             float(data["time"].iloc[-1]) if len(data) else None)
     json_path = sidecar_path(target)
     write_all({target: table_bytes(data, target), json_path: json_bytes(record)}, complete=False)  # not the result
     return [target, json_path]

@@ -203,9 +203,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra: dict[str, Any] | None) -> int:
+    from rover_cosim.common.outputs import OutputError
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.master import run as run_system
-    from rover_cosim.orchestrator.runs import PartialWriter, partial_path, sidecar_path, write_run
+    from rover_cosim.orchestrator.runs import TableStream, partial_path, sidecar_path
     from rover_cosim.progress import ProgressBar
 
     output = args.output or Path("results") / f"{system_file.stem}.csv"
@@ -221,18 +222,27 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
         fail("run", f"output {output}: {problem}")
         return 2
     bar = ProgressBar(system_file.stem, enabled=not args.quiet)
-    partial = PartialWriter(system, output)
+    stream = TableStream(output)  # the rows go to a file beside the output as they come: memory bounded
     try:
-        result = run_system(system, progress=bar, observers=[partial])
+        result = run_system(system, progress=bar, sink=stream)
     except RunError as error:
         bar.close()
         kept = ""
-        if partial.written:
-            kept = f"; the {len(error.partial)} rows computed before it are in {partial.written[0]} (partial)"
+        if stream.rows > 1:
+            try:
+                written = stream.publish_partial(system, str(error))
+                kept = f"; the {stream.rows} rows computed before it are in {written[0]} (partial)"
+            except OutputError as lost:
+                kept = f"; the rows computed before it: {lost}"
+        else:
+            stream.discard()
         fail("run", f"{error} ({output} not written{kept})")
         return 1
+    except BaseException:
+        stream.discard()
+        raise
     bar.close()
-    print_written(write_run(system, result, output, extra=extra))
+    print_written(stream.publish(system, result, extra=extra))
     for note in result.notes:
         fail("run", f"warning: {note} (after the last step; {output} is complete)")
     if result.stopped:

@@ -113,25 +113,54 @@ def _exchange(folder: Path, files: Mapping[Path, bytes], stale: Collection[str],
     return done
 
 
-def _rename_each(files: Mapping[Path, bytes], complete: bool) -> None:
-    """Temporaries beside the targets, renamed into place under the folders' locks."""
+def staging_file(target: Path) -> tuple[int, Path]:
+    """A new temporary file beside ``target`` (an open descriptor and its path), where a result
+    is written before it is renamed into place (:func:`publish`)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    handle, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
+    return handle, Path(name)
+
+
+def _rename_each(files: Mapping[Path, bytes], complete: bool, written: Mapping[Path, Path] | None = None) -> None:
+    """Temporaries beside the targets (``written``: target -> a temporary already written), all
+    renamed into place under the folders' locks, or none."""
     global _COMMITTED
-    staged: list[tuple[Path, Path]] = []
+    given: list[tuple[Path, Path]] = [(temporary, target) for target, temporary in (written or {}).items()]
+    made: list[tuple[Path, Path]] = []
     try:
         for target, payload in files.items():
-            target.parent.mkdir(parents=True, exist_ok=True)
-            handle, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
-            staged.append((Path(name), target))
+            handle, name = staging_file(target)
+            made.append((name, target))
             with os.fdopen(handle, "wb") as stream:
                 stream.write(payload)
-            os.chmod(name, result_mode())  # mkstemp makes 0600; results are ordinary files
+        staged = given + made
+        for temporary, _ in staged:
+            os.chmod(temporary, result_mode())  # mkstemp makes 0600; results are ordinary files
         with folder_locks(sorted({target.parent for _, target in staged})), _signals_held():
             for temporary, target in staged:
                 os.replace(temporary, target)
             _COMMITTED += complete
     finally:
-        for temporary, _ in staged:
+        for temporary, _ in made:  # the caller's own (``written``) are the caller's to remove
             temporary.unlink(missing_ok=True)
+
+
+def publish(written: Mapping[Path, Path], files: Mapping[Path, bytes], complete: bool = True) -> None:
+    """Like :func:`write_all` without a folder, for results of which some were written as they
+    were computed: ``written`` maps targets to temporaries from :func:`staging_file` (removed
+    whatever happens), ``files`` holds the rest as bytes. A failure saves every file elsewhere and
+    raises OutputError saying where."""
+    try:
+        _rename_each(files, complete, written)
+    except OSError as error:
+        everything = dict(files)
+        for target, temporary in written.items():
+            try:
+                everything[target] = temporary.read_bytes()
+            except OSError:
+                pass
+            temporary.unlink(missing_ok=True)
+        raise OutputError(_saved(everything, None, error)) from None
 
 
 def _saved(files: Mapping[Path, bytes], folder: Path | None, error: OSError) -> str:
