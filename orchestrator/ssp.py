@@ -319,7 +319,8 @@ def _unpack(archive: Path, folder: Path, limit: int) -> None:
     try:
         unpack_archive(archive, folder, limit)
     except UnpackError as error:
-        raise SspError(str(error).replace(LIMIT_VARIABLE, "ROVER_COSIM_SSP_MAX_BYTES")) from None
+        raise SspError(str(error).replace(LIMIT_VARIABLE, "ROVER_COSIM_SSP_MAX_BYTES")
+                       .replace("not a readable zip archive", "not a readable SSP archive")) from None
 
 
 def inside(folder: Path, source: str | None, what: str) -> Path:
@@ -505,8 +506,43 @@ def _annotation(root: etree._Element, ns: dict[str, str]) -> dict[str, Any]:
                 raise SspError(f"the {ANNOTATION_TYPE} annotation is not valid JSON ({error})") from None
             if not isinstance(settings, dict):
                 raise SspError(f"the {ANNOTATION_TYPE} annotation: expected a JSON object")
+            _check_shapes(settings)
             return settings
     return {}
+
+
+#: The keys of our annotation, and what each must be (checked before any is used: an archive's
+#: author chooses them): a JSON type, or for lists and objects that of their items.
+ANNOTATION_SHAPES: dict[str, tuple[type, type | None]] = {
+    "step": (float, None), "algorithm": (str, None), "order": (list, str), "record": (list, str),
+    "iteration": (dict, float), "allow_algebraic_loops": (bool, None), "blocks": (list, dict),
+    "interfaces": (dict, str), "block_connections": (list, dict)}
+
+
+def _check_shapes(settings: dict[str, Any]) -> None:
+    """SspError naming the first key of our annotation that is unknown or of another shape."""
+    names = {"float": "a number", "str": "text", "bool": "true or false", "dict": "an object", "list": "a list"}
+    for key, value in settings.items():
+        if key not in ANNOTATION_SHAPES:
+            raise SspError(f"the {ANNOTATION_TYPE} annotation: unknown key {key!r}; expected "
+                           f"{', '.join(ANNOTATION_SHAPES)}")
+        kind, item = ANNOTATION_SHAPES[key]
+        wanted = (int, float) if kind is float else kind
+        items = value.values() if isinstance(value, dict) else value if isinstance(value, list) else ()
+        item_types = (int, float) if item is float else item
+        if not isinstance(value, wanted) or isinstance(value, bool) != (kind is bool) or (
+                item_types is not None and not all(isinstance(v, item_types) and not isinstance(v, bool)
+                                                   for v in items)):
+            plural = {"float": "numbers", "str": "texts", "dict": "objects"}
+            said = names[kind.__name__] + (f" of {plural[item.__name__]}" if item else "")
+            raise SspError(f"the {ANNOTATION_TYPE} annotation: {key} = {str(value)[:80]!r}: expected {said}")
+    for k, connection in enumerate(settings.get("block_connections", []), 1):
+        if set(connection) != {"from", "to"} or not all(isinstance(v, str) for v in connection.values()):
+            raise SspError(f"the {ANNOTATION_TYPE} annotation: block_connections {k}: expected "
+                           "{\"from\": \"instance.variable\", \"to\": \"instance.variable\"}")
+    for k, block in enumerate(settings.get("blocks", []), 1):
+        if not isinstance(block.get("name"), str) or not isinstance(block.get("type"), str):
+            raise SspError(f"the {ANNOTATION_TYPE} annotation: block {k}: expected a name and a type (text)")
 
 
 def _bound_values(element: etree._Element, folder: Path, ns: dict[str, str]) -> dict[str, Value]:

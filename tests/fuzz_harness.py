@@ -112,7 +112,7 @@ class Harness:
 
         self.work = work
         self.system = tomllib.loads(example("single_wheel_step").read_text())
-        self.fmu_dir = example("single_wheel_step").parent
+        self.fmu_dir = Path(__file__).parents[1] / "fmus"  # the built FMUs (make fmus)
         studies = Path(__file__).parents[1] / "rover_cosim" / "jobs" / "montecarlo" / "studies"
         self.study = tomllib.loads((studies / "lunar_regolith.toml").read_text())
         self.sentinel = work / "sentinel"
@@ -218,7 +218,46 @@ class Harness:
         return ["report", "--results", str(results), "--out", str(folder / "report.html")]
 
 
-KINDS = ("system", "study", "soil", "option", "description", "report")
+    def _exported(self) -> Path:
+        """The single-wheel example as an SSP archive (made once)."""
+        from rover_cosim.cli import main as cli
+
+        archive = self.work / "single_wheel.ssp"
+        if not archive.is_file():
+            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+                cli(["export-ssp", "single_wheel_step", "-o", str(archive), "--fmu-dir", str(self.fmu_dir)])
+        return archive
+
+    def ssp_case(self, rng: random.Random, folder: Path) -> list[str]:
+        """The exported archive with its master annotation (JSON) or an XML attribute made odd."""
+        import re
+
+        source = self._exported()
+        archive = folder / "system.ssp"
+        with zipfile.ZipFile(source) as zf, zipfile.ZipFile(archive, "w") as out:
+            for item in zf.infolist():
+                data = zf.read(item)
+                if item.filename == "SystemStructure.ssd":
+                    text = data.decode()
+                    found = re.search(r"(<[^>]*Master[^>]*>)(.*?)(</)", text, re.S)
+                    if found and rng.random() < 0.7:
+                        settings = json.loads(found.group(2).replace("&quot;", '"'))
+                        shown = _mutated(settings, rng) if settings else {"x": 1}
+                        if rng.random() < 0.3:
+                            shown[rng.choice(["blocks", "interfaces", "iteration", "record", "block_connections",
+                                              "allow_algebraic_loops", "order", "bogus"])] = rng.choice(ODD)
+                        body = json.dumps(shown).replace("&", "&amp;").replace("<", "&lt;")
+                        text = text[:found.start(2)] + body + text[found.end(2):]
+                    else:
+                        attributes = re.findall(r'(\w+)="([^"]*)"', text)
+                        name, value = rng.choice(attributes)
+                        text = text.replace(f'{name}="{value}"', f'{name}="{rng.choice(VALUES)[:50]}"', 1)
+                    data = text.encode()
+                out.writestr(item, data)
+        return ["run", str(archive), "-q", "-o", str(folder / "out.csv"), "--stop-time", "0.05"]
+
+
+KINDS = ("system", "study", "soil", "option", "description", "report", "ssp")
 
 
 def run_case(harness: Harness, kind: str, rng: random.Random, folder: Path) -> tuple[str, str]:
@@ -236,7 +275,11 @@ def run_case(harness: Harness, kind: str, rng: random.Random, folder: Path) -> t
     except SystemExit as exit_:
         code = exit_.code
     except BaseException as error:  # noqa: BLE001 - what the fuzz looks for
-        return "traceback", f"{command}: {type(error).__name__}: {str(error)[:300]}"
+        import traceback
+
+        frame = traceback.extract_tb(error.__traceback__)[-1]
+        return "traceback", (f"{command}: {type(error).__name__}: {str(error)[:300]} (at {Path(frame.filename).name}:"
+                             f"{frame.lineno})")
     said = err.getvalue()
     if code not in (0, 1, 2):
         return "exit", f"{command}: exit {code!r}"

@@ -128,3 +128,27 @@ def test_identify_refuses_an_fmu_that_is_not_a_test_bed_before_any_run(misbehave
     _refused(["identify", "--fmu", str(misbehave), "--out", str(tmp_path / "id")],
              "not a SingleWheel FMU (no variables ['W', 'tau'", capsys)
     assert not (tmp_path / "id").exists()
+
+
+@pytest.mark.parametrize(("settings", "said"), [
+    ({"interfaces": ["a"]}, "interfaces = \"['a']\": expected an object of texts"),
+    ({"blocks": [1]}, "blocks = '[1]': expected a list of objects"),
+    ({"iteration": 3}, "iteration = '3': expected an object of numbers"),
+    ({"record": "a.x"}, "record = 'a.x': expected a list of texts"),
+    ({"allow_algebraic_loops": "yes"}, "allow_algebraic_loops = 'yes': expected true or false"),
+    ({"step": True}, "step = 'True': expected a number"),
+    ({"block_connections": [{"from": "a.y"}]}, "block_connections 1: expected"),
+    ({"blocks": [{"type": "step"}]}, "block 1: expected a name and a type"),
+    ({"bogus": 1}, "unknown key 'bogus'"),
+])
+def test_an_ssp_annotation_of_odd_shapes_is_refused(settings, said):
+    """The master annotation is the archive author's JSON: each key is checked for its shape
+    before use (a list where an object belongs was a traceback, "yes" was taken as true)."""
+    from rover_cosim.orchestrator.ssp import SspError, _check_shapes
+
+    with pytest.raises(SspError, match=re.escape(said)):
+        _check_shapes(settings)
+    _check_shapes({"step": 0.001, "algorithm": "jacobi", "order": ["a"], "record": ["a.x"],
+                   "iteration": {"tolerance": 1e-6}, "allow_algebraic_loops": False,
+                   "blocks": [{"name": "u", "type": "step"}], "interfaces": {"a": "x"},
+                   "block_connections": [{"from": "u.y", "to": "a.u"}]})
