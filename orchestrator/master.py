@@ -190,9 +190,9 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
         execution.close()
         table = recorder.table() if sink is None else _handed(recorder)
         result = RunResult(table, time.perf_counter() - started, steps, execution.step_seconds, stopped)
+        for observer in observers:  # before the FMUs are freed: an observer may write the results now
+            observer.finish(result)
     result.notes.extend(problem for p in closed for problem in getattr(p, "problems", ()))
-    for observer in observers:
-        observer.finish(result)
     return result
 
 

@@ -211,6 +211,24 @@ class TableStream:
         self.temporary.unlink(missing_ok=True)
 
 
+class Publisher(Observer):
+    """Publishes a :class:`TableStream`'s file and its sidecar when the run finishes, before its
+    FMUs are terminated and freed (a crash or hang there cannot lose a finished run);
+    ``written``: the files, once it did."""
+
+    def __init__(self, stream: TableStream, system: System, extra: dict[str, Any] | None = None):
+        self.stream, self.system, self.extra = stream, system, extra
+        self.written: list[Path] = []
+
+    def finish(self, result: RunResult) -> None:
+        self.written = self.stream.publish(self.system, result, extra=self.extra)
+
+    def noted(self, result: RunResult) -> None:
+        """The sidecar again, with what went wrong after the results were written (``result.notes``)."""
+        if result.notes and self.written:
+            write_all({self.written[1]: json_bytes(sidecar(self.system, result, "rover-cosim run", self.extra))})
+
+
 def _joined(first: bytes, second: bytes, path: Path) -> bytes:
     """Two CSV texts of the same columns as one (the second's header dropped); Parquet is not
     joined (the first file, whole, is kept: the rows after it are lost with the disk)."""

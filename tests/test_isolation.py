@@ -246,3 +246,16 @@ def test_an_fmu_isolated_inside_a_pool_worker_crashes_alone(misbehave):
 
     said = list(parallel_map(_crash_in_a_worker, [(str(misbehave),)] * 2, workers=2, lost=lambda a, why: why))
     assert len(said) == 2 and all("fmi2DoStep at t = 0.5 s: the FMU's process ended with SIGSEGV" in s for s in said)
+
+
+def test_in_this_process_a_crash_while_freeing_comes_after_the_results_are_written(misbehave, tmp_path):
+    """--isolation none: the FMU's crash in fmi2FreeInstance ends the command (nothing can stop a
+    crash in the same process), but the run's files are already written: the results are
+    published when the run finishes, before the FMUs are freed."""
+    out = tmp_path / "out.csv"
+    done = subprocess.run([sys.executable, "-m", "rover_cosim", "run", str(misbehave), "--isolation", "none", "-q",
+                           "--start", f"mode={MODES['free-segfault']}", "-o", str(out)], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == -signal.SIGSEGV
+    assert out.is_file() and (tmp_path / "out.json").is_file()
+    assert out.read_text().count("\n") == 12  # the header and 11 rows, 0 to 1 s

@@ -206,7 +206,7 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
     from rover_cosim.common.outputs import OutputError
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.master import run as run_system
-    from rover_cosim.orchestrator.runs import TableStream, partial_path, sidecar_path
+    from rover_cosim.orchestrator.runs import Publisher, TableStream, partial_path, sidecar_path
     from rover_cosim.progress import ProgressBar
 
     output = args.output or Path("results") / f"{system_file.stem}.csv"
@@ -223,8 +223,9 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
         return 2
     bar = ProgressBar(system_file.stem, enabled=not args.quiet)
     stream = TableStream(output)  # the rows go to a file beside the output as they come: memory bounded
+    publisher = Publisher(stream, system, extra)  # the result written before the FMUs are freed
     try:
-        result = run_system(system, progress=bar, sink=stream)
+        result = run_system(system, progress=bar, sink=stream, observers=[publisher])
     except RunError as error:
         bar.close()
         kept = ""
@@ -242,7 +243,8 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
         stream.discard()
         raise
     bar.close()
-    print_written(stream.publish(system, result, extra=extra))
+    publisher.noted(result)
+    print_written(publisher.written)
     for note in result.notes:
         fail("run", f"warning: {note} (after the last step; {output} is complete)")
     if result.stopped:
