@@ -47,9 +47,11 @@ def _row_name(row: int, lines: Sequence[int] | None) -> str:
     return f"row {row + 1}" + (f" (line {lines[row]})" if lines is not None else "")
 
 
+#: N, the largest wheel load a measurement may give (a thousand times a rover's wheel).
+MAX_LOAD = 1e6
 #: Per column: (test of a value, what is expected) beyond being a finite number.
 _RANGES: dict[str, tuple[Callable[[FloatArray], NDArray[np.bool_]], str]] = {
-    "load_N": (lambda v: v > 0, "a load > 0 N"),
+    "load_N": (lambda v: (v > 0) & (v <= MAX_LOAD), f"a load > 0 N and at most {MAX_LOAD:g} N"),
     "slip": (lambda v: np.abs(v) <= 1, "a slip ratio in [-1, 1]"),
     "slip_angle_deg": (lambda v: np.abs(v) < 90, "a slip angle in (-90, 90) deg"),
     "sinkage_m": (lambda v: v >= 0, "a sinkage >= 0 m"),
@@ -227,8 +229,11 @@ def _text(path: Path) -> str:
 def parse_testbed_csv(text: str, source: str = "data") -> TestBedData:
     """:class:`TestBedData` of CSV ``text`` (see the module docstring); ValueError naming the row,
     line and column of the first bad value, an unknown or repeated column, or a missing one."""
-    records = [(number, row) for number, row in enumerate(csv.reader(io.StringIO(text)), start=1)
-               if row and any(cell.strip() for cell in row) and not row[0].lstrip().startswith("#")]
+    try:
+        records = [(number, row) for number, row in enumerate(csv.reader(io.StringIO(text)), start=1)
+                   if row and any(cell.strip() for cell in row) and not row[0].lstrip().startswith("#")]
+    except csv.Error as error:  # e.g. a field of more than csv.field_size_limit() characters
+        raise ValueError(f"{source}: not a CSV table of numbers ({error})") from None
     if not records:
         raise ValueError(f"{source}: empty: expected a header line (e.g. load_N,slip,Fx_N,Tx_Nm,sinkage_m) and "
                          "one line per measurement")

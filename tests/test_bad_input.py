@@ -152,3 +152,16 @@ def test_an_ssp_annotation_of_odd_shapes_is_refused(settings, said):
                    "iteration": {"tolerance": 1e-6}, "allow_algebraic_loops": False,
                    "blocks": [{"name": "u", "type": "step"}], "interfaces": {"a": "x"},
                    "block_connections": [{"from": "u.y", "to": "a.u"}]})
+
+
+def test_estimate_soil_refuses_an_absurd_load_and_a_huge_field(tmp_path, capsys):
+    data = tmp_path / "data.csv"
+    assert main(["testbed-data", "--out", str(data)]) == 0
+    lines = data.read_text().splitlines()
+    big, huge = tmp_path / "big.csv", tmp_path / "huge.csv"
+    big.write_text("\n".join([lines[0], "1e300" + lines[1][lines[1].index(","):], *lines[2:]]) + "\n")
+    huge.write_text("\n".join([lines[0], "x" * 200_000 + lines[1][lines[1].index(","):], *lines[2:]]) + "\n")
+    capsys.readouterr()
+    _refused(["estimate-soil", str(big), "--out", str(tmp_path / "e1")], "1e+300 N: expected a load > 0 N and at most",
+             capsys)
+    _refused(["estimate-soil", str(huge), "--out", str(tmp_path / "e2")], "not a CSV table of numbers", capsys)
