@@ -165,3 +165,10 @@ def test_estimate_soil_refuses_an_absurd_load_and_a_huge_field(tmp_path, capsys)
     _refused(["estimate-soil", str(big), "--out", str(tmp_path / "e1")], "1e+300 N: expected a load > 0 N and at most",
              capsys)
     _refused(["estimate-soil", str(huge), "--out", str(tmp_path / "e2")], "not a CSV table of numbers", capsys)
+
+
+def test_a_study_of_an_unknown_soil_is_bad_input_before_any_work(tmp_path, capsys):
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.read_text().replace('soil = "paper"', 'soil = "nosuchsoil"', 1))
+    _refused(["montecarlo", "--study", str(study), "--out", str(tmp_path / "mc"), "-q"],
+             "soil = 'nosuchsoil': soil 'nosuchsoil': expected one of paper", capsys)

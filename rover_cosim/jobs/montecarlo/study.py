@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from rover_cosim.control.adaptive import Calibration
-from rover_cosim.terramechanics import Soil, Wheel
+from rover_cosim.terramechanics import Soil, Wheel, library
 from rover_cosim.terramechanics.library import DEGREES
 
 from .scenarios import ADAPTIVE_VARIANT, RUN_SCENARIOS
@@ -234,6 +234,16 @@ def _calibration(where: str, table: Any) -> Calibration:
         raise StudyError(f"{where}: {error}") from None
 
 
+def _check_library(where: str, kind: str, value: Any) -> None:
+    """The nominal soil or wheel: a name of the library or a TOML file, known before any work."""
+    if not isinstance(value, str):
+        raise StudyError(f"{where}: {kind} = {value!r}: expected the name of a {kind} of the library or a TOML file")
+    try:
+        library.entry(kind, value)
+    except ValueError as error:
+        raise StudyError(f"{where}: {kind} = {value!r}: {error}") from None
+
+
 def _top(where: str, data: dict[str, Any]) -> dict[str, Any]:
     unknown = sorted(set(data) - TOP_KEYS)
     if unknown:
@@ -255,6 +265,8 @@ def _top(where: str, data: dict[str, Any]) -> dict[str, Any]:
         path_stop_time = _number(where, "path_stop_time", path_stop_time)
         if not 0.01 <= path_stop_time <= 600:
             raise StudyError(f"{where}: path_stop_time = {path_stop_time!r} s: expected 0.01 .. 600 s")
+    for kind in ("soil", "wheel"):
+        _check_library(where, kind, data.get(kind, "paper"))
     return {"runs": runs, "seed": seed, "scenarios": tuple(dict.fromkeys(scenarios)), "stop_time": stop_time,
             "path_stop_time": path_stop_time, "calibration": _calibration(where, data.get("calibration", {})),
             "title": str(data.get("title", "")), "source": str(data.get("source", "")),
