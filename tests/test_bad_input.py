@@ -172,3 +172,4 @@ def test_a_study_of_an_unknown_soil_is_bad_input_before_any_work(tmp_path, capsy
     study.write_text(STUDY.read_text().replace('soil = "paper"', 'soil = "nosuchsoil"', 1))
     _refused(["montecarlo", "--study", str(study), "--out", str(tmp_path / "mc"), "-q"],
              "soil = 'nosuchsoil': soil 'nosuchsoil': expected one of paper", capsys)
+

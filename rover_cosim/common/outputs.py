@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -232,13 +233,39 @@ def _version(package: str) -> str | None:
         return None
 
 
-def _git_commit() -> str | None:
+def _git(*arguments: str) -> bytes | None:
+    """git's output run in the tool's own source tree, None where there is no git or no tree."""
     try:
-        result = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=10,
+        result = subprocess.run(["git", *arguments], capture_output=True, timeout=10,
                                 cwd=Path(__file__).resolve().parent)
     except (OSError, subprocess.SubprocessError):
         return None
-    return result.stdout.strip() or None if result.returncode == 0 else None
+    return result.stdout if result.returncode == 0 else None
+
+
+def _working_directory() -> str | None:
+    """The process's working directory (None where it was removed meanwhile)."""
+    try:
+        return os.getcwd()
+    except OSError:
+        return None
+
+
+@functools.lru_cache(maxsize=1)
+def source_tree() -> dict[str, object]:
+    """The tool's source tree (once per process): its git commit, whether it had uncommitted
+    changes (``git_dirty``) and, when it had, the SHA-256 of ``git diff HEAD`` (``git_diff_sha256``:
+    two runs with the same digest ran the same code). None values where it is not a git checkout."""
+    commit = _git("rev-parse", "HEAD")
+    if commit is None:
+        return {"git_commit": None, "git_dirty": None}
+    status = _git("status", "--porcelain", "--untracked-files=no")
+    dirty = bool(status.strip()) if status is not None else None
+    tree: dict[str, object] = {"git_commit": commit.decode().strip() or None, "git_dirty": dirty}
+    if dirty:
+        diff = _git("diff", "HEAD")
+        tree["git_diff_sha256"] = hashlib.sha256(diff).hexdigest() if diff is not None else None
+    return tree
 
 
 def file_sha256(path: Path) -> str:
@@ -266,14 +293,16 @@ def set_command_line(arguments: Sequence[str] | None) -> None:
 
 
 def run_record(command: str, parameters: Mapping[str, object]) -> dict[str, object]:
-    """What a run did: command (and the process's whole command line), parameters, versions, git
-    commit, machine, time."""
+    """What a run did: command (and the process's whole command line), parameters, versions, the
+    working directory, git commit (and whether the tree had uncommitted changes, with the diff's
+    digest), machine, time."""
     return {
         "command": command,
         "command_line": list(_COMMAND_LINE) if _COMMAND_LINE is not None else list(sys.argv),
         "parameters": parameters,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-        "git_commit": _git_commit(),
+        "working_directory": _working_directory(),
+        **source_tree(),
         "python": sys.version.split()[0],
         "platform": platform.platform(),
         "versions": {name: _version(name) for name in PACKAGES},
