@@ -122,5 +122,5 @@ def test_rows_are_recorded_at_the_output_interval(typed, tmp_path):
     assert data["t.counter"].tolist() == [0, 4, 8, 12, 16, 20, 21]
     with pytest.raises(SystemFileError, match="output_interval: 0.07: expected a whole number of communication steps"):
         SystemBuilder("bad").simulation(stop_time=1.0, step=0.05, output_interval=0.07)
-    with pytest.raises(SystemFileError, match="output_interval: inf: expected an interval > 0 s and at most the run.s length"):
+    with pytest.raises(SystemFileError, match="output_interval: inf: expected an interval > 0 s and at most"):
         SystemBuilder("bad").simulation(stop_time=1.0, step=0.05, output_interval=float("inf"))  # was an OverflowError
