@@ -33,6 +33,7 @@ from rover_cosim.common.outputs import result_mode
 from rover_cosim.common.units import base_units
 
 from .archives import LIMIT_VARIABLE, UnpackError, unpack_archive
+from .archives import size_limit as archive_limit
 from .blocks import BLOCK_TYPES, REGISTERED_FACTORIES, make_block
 from .builder import SystemBuilder
 from .model import BlockEntry, Connection, System, Value
@@ -300,16 +301,10 @@ SIZE_LIMIT = 4 * 2**30
 
 def size_limit() -> int:
     """The size limit of SSP archives [bytes]: ROVER_COSIM_SSP_MAX_BYTES, else :data:`SIZE_LIMIT`."""
-    text = os.environ.get("ROVER_COSIM_SSP_MAX_BYTES")
-    if text is None:
-        return SIZE_LIMIT
     try:
-        limit = int(text)
-    except ValueError:
-        raise SspError(f"ROVER_COSIM_SSP_MAX_BYTES = {text!r}: expected a whole number of bytes") from None
-    if limit <= 0:
-        raise SspError(f"ROVER_COSIM_SSP_MAX_BYTES = {text!r}: expected a number of bytes > 0")
-    return limit
+        return archive_limit("ROVER_COSIM_SSP_MAX_BYTES", SIZE_LIMIT)
+    except UnpackError as error:
+        raise SspError(str(error)) from None
 
 
 def _unpack(archive: Path, folder: Path, limit: int) -> None:

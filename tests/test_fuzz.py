@@ -8,9 +8,9 @@ from __future__ import annotations
 import copy
 import math
 import random
-from typing import Any
 
 import pytest
+from fuzz_harness import _paths, _set
 
 from rover_cosim.cli import main
 from rover_cosim.orchestrator.examples import example
@@ -21,26 +21,6 @@ from rover_cosim.terramechanics import library
 SEED = 20261201
 ODD = [-1, 0, 1, 1e300, -1e300, 1e-300, math.inf, -math.inf, math.nan, True, False, "x", "", "1e3", "a" * 5000,
        [], [1, 2], {}, {"a": 1}, 2**63, -(2**63) - 1, 0.5, "wheel.W", "nosuch.var"]
-
-
-def _paths(data: Any, prefix: tuple = ()) -> list[tuple]:
-    """Every (key path) of a nested dict/list structure."""
-    found = []
-    if isinstance(data, dict):
-        for key, value in data.items():
-            found.append((*prefix, key))
-            found += _paths(value, (*prefix, key))
-    elif isinstance(data, list):
-        for k, value in enumerate(data):
-            found.append((*prefix, k))
-            found += _paths(value, (*prefix, k))
-    return found
-
-
-def _set(data: Any, path: tuple, value: Any) -> None:
-    for key in path[:-1]:
-        data = data[key]
-    data[path[-1]] = value
 
 
 def test_system_files_with_odd_values_end_in_a_message(fmu_dir, fmus):

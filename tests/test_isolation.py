@@ -8,7 +8,6 @@ The misbehaving FMU is our own (tests/fmus/misbehave.c)."""
 
 from __future__ import annotations
 
-import os
 import signal
 import subprocess
 import sys
@@ -20,6 +19,7 @@ import pytest
 from c_fmu import built_or_skip
 from integrator_fmu import build_integrator
 from misbehave_fmu import MODES, build_misbehave
+from processes import alive, children
 from typed_fmu import build_typed_fmu
 
 from rover_cosim.cli import main
@@ -105,36 +105,13 @@ def test_no_child_process_outlives_the_run(misbehave):
         (fmu,) = participants
         assert isinstance(fmu, IsolatedFmu)
         pid = fmu.pid
-        assert pid is not None and _alive(pid)
-    assert not _alive(pid)
-    before = {p for p in _children() if _alive(p)}
+        assert pid is not None and alive(pid)
+    assert not alive(pid)
+    before = {p for p in children() if alive(p)}
     with pytest.raises(RunError):
         run(_system(misbehave, "busy", timeout=0.3))
     time.sleep(0.1)
-    assert not {p for p in _children() if _alive(p)} - before
-
-
-def _alive(pid: int) -> bool:
-    """Whether process ``pid`` runs (a zombie, ended but not waited for, counts as ended)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (FileNotFoundError, ProcessLookupError):
-        return False
-    return state != "Z"
-
-
-def _children() -> list[int]:
-    """This process's children that run an FMU (their command line names it)."""
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
-            except OSError:
-                continue
-            if int(fields[1]) == os.getpid():
-                found.append(int(entry.name))
-    return found
+    assert not {p for p in children() if alive(p)} - before
 
 
 def test_sigterm_ends_a_command_waiting_on_a_hanging_fmu_at_once(misbehave, tmp_path):

@@ -8,9 +8,9 @@ from __future__ import annotations
 import os
 import signal
 import time
-from pathlib import Path
 
 import pytest
+from processes import children
 
 from rover_cosim.common.parallel import cores, parallel_map
 from rover_cosim.identification.sweep import Case
@@ -37,7 +37,7 @@ def _lost(arguments: tuple[int], reason: str) -> tuple[int, str]:
 
 @pytest.mark.parametrize("workers", [1, 2])
 def test_a_crash_an_exit_a_hang_and_an_exception_each_lose_one_call_only(workers):
-    before = set(_children())
+    before = set(children())
     started = time.monotonic()
     results = list(parallel_map(_call, [(k,) for k in range(8)], workers=workers, lost=_lost, timeout=1.0))
     assert time.monotonic() - started < 30
@@ -47,7 +47,7 @@ def test_a_crash_an_exit_a_hang_and_an_exception_each_lose_one_call_only(workers
     assert "SIGSEGV" in lost[2] and "exit status 0" in lost[3]
     assert "longer than 1 s" in lost[4] and lost[5] == "it raised ValueError: five"
     time.sleep(0.2)
-    assert not set(_children()) - before, "no worker outlives the pool"
+    assert not set(children()) - before, "no worker outlives the pool"
 
 
 def test_without_lost_one_worker_runs_here_and_a_lost_call_is_an_error():
@@ -78,17 +78,3 @@ def test_more_workers_than_cores_are_said_and_capped(capsys, tmp_path):
         capsys.readouterr().err
     assert main(["identify", "--run-timeout", "nan", "--out", str(tmp_path / "id")]) == 2
     assert "--run-timeout nan: expected a time limit > 0 s" in capsys.readouterr().err
-
-
-def _children() -> list[int]:
-    """This process's living children."""
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
-            except OSError:
-                continue
-            if int(fields[1]) == os.getpid() and fields[0] != "Z":
-                found.append(int(entry.name))
-    return found
