@@ -26,3 +26,13 @@ def test_every_record_says_the_working_directory_and_whether_the_tree_was_dirty(
     record = outputs.run_record("rover-cosim fig3", {})
     outputs.source_tree.cache_clear()
     assert record["git_dirty"] is False and "git_diff_sha256" not in record
+
+
+def test_the_report_names_the_folder_it_was_made_from(tmp_path):
+    from rover_cosim.cli import main
+
+    results = tmp_path / "results_msl"
+    assert main(["fig3", "--out", str(results), "--loads", "300", "--slip-step", "0.1"]) == 0
+    assert main(["report", "--results", str(results)]) == 0
+    page = (results / "report.html").read_text()
+    assert f"files under <code>{results.as_posix()}/</code>" in page and "<code>results/</code>" not in page

@@ -16,13 +16,14 @@ def build_report(results: Path) -> str:
     identification, simulation = results / "identification", results / "simulation"
     paper_soil = sections.on_paper_soil(results)
     label = html.escape(sections.soil_label(results))
+    folder = html.escape(results.as_posix().rstrip("/") + "/")  # the folder it was made from, as given
     if paper_soil:
         parts = ["<h1>rover-cosim: reproduction of Yoshikawa et al. (paper's soil and wheel)</h1>",
-                 ("<p>Every number below is read from the files under <code>results/</code> written by "
+                 (f"<p>Every number below is read from the files under <code>{folder}</code> written by "
                   "<code>make run</code>; the paper's values are quoted beside ours.</p>")]
     else:
         parts = [f"<h1>rover-cosim: the paper's pipeline on {label}</h1>",
-                 ("<p>Every number below is read from the files under <code>results/</code>. The soil or wheel "
+                 (f"<p>Every number below is read from the files under <code>{folder}</code>. The soil or wheel "
                   "is not the paper's, so the paper's numbers are not set beside these.</p>")]
     parts += sections.soil_section(results)
     parts += sections.fig3_section(results)
