@@ -36,3 +36,20 @@ def test_the_report_names_the_folder_it_was_made_from(tmp_path):
     assert main(["report", "--results", str(results)]) == 0
     page = (results / "report.html").read_text()
     assert f"files under <code>{results.as_posix()}/</code>" in page and "<code>results/</code>" not in page
+
+
+def test_a_figure_names_the_record_it_was_written_with(tmp_path):
+    import hashlib
+
+    from PIL import Image
+
+    from rover_cosim.cli import main
+    from rover_cosim.common.outputs import PNG_RECORD_KEY, png_text
+
+    assert main(["fig3", "--out", str(tmp_path), "--loads", "300", "--slip-step", "0.1"]) == 0
+    png = (tmp_path / "fig3_fx_vs_slip.png").read_bytes()
+    record = (tmp_path / "fig3_fx_vs_slip.json").read_bytes()
+    assert png_text(png)[PNG_RECORD_KEY] == f"fig3_fx_vs_slip.json sha256:{hashlib.sha256(record).hexdigest()}"
+    with Image.open(tmp_path / "fig3_fx_vs_slip.png") as image:  # still a valid PNG, its text readable
+        image.load()
+        assert image.text[PNG_RECORD_KEY].startswith("fig3_fx_vs_slip.json sha256:")

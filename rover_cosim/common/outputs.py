@@ -52,7 +52,7 @@ def write_all(files: Mapping[Path, bytes], folder: Path | None = None, stale: Co
     ``complete``: the files are a command's result set (counted by :func:`committed`), not what
     is kept of a failed run.
     """
-    files = _with_other_renderings(files)
+    files = with_provenance(_with_other_renderings(files))
     try:
         if folder is None or not _exchange(Path(folder), files, stale, complete):
             _rename_each(files, complete)
@@ -224,6 +224,58 @@ def _with_other_renderings(files: Mapping[Path, bytes]) -> dict[Path, bytes]:
         for suffix, data in getattr(payload, "others", {}).items():
             expanded[Path(target).with_suffix(suffix)] = data
     return expanded
+
+
+#: The PNG text chunk that names the record a figure was written with.
+PNG_RECORD_KEY = "rover-cosim record"
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def with_provenance(files: Mapping[Path, bytes]) -> dict[Path, bytes]:
+    """``files`` with every PNG among them carrying the record written with it: a text chunk
+    ``rover-cosim record`` = "<record's file name> sha256:<its digest>" (the record: the JSON
+    of the same name, else the one JSON written into the same folder), so that a figure found
+    alone says what produced it. A PNG without such a record is left as it is."""
+    records = {target: payload for target, payload in files.items() if Path(target).suffix == ".json"}
+    out: dict[Path, bytes] = {}
+    for target, payload in files.items():
+        target = Path(target)
+        record = None
+        if target.suffix == ".png" and bytes(payload[:8]) == _PNG_SIGNATURE:
+            same = target.with_suffix(".json")
+            beside = [r for r in records if Path(r).parent == target.parent]
+            record = same if same in records else (beside[0] if len(beside) == 1 else None)
+        if record is None:
+            out[target] = payload
+            continue
+        text = f"{Path(record).name} sha256:{hashlib.sha256(records[record]).hexdigest()}"
+        out[target] = png_with_text(bytes(payload), PNG_RECORD_KEY, text)
+    return out
+
+
+def png_with_text(png: bytes, key: str, text: str) -> bytes:
+    """``png`` with a tEXt chunk ``key`` = ``text`` after its header chunk (Latin-1 text)."""
+    import struct
+    import zlib
+
+    data = key.encode("latin-1") + b"\0" + text.encode("latin-1", errors="replace")
+    chunk = struct.pack(">I", len(data)) + b"tEXt" + data + struct.pack(">I", zlib.crc32(b"tEXt" + data))
+    header_end = 8 + 4 + 4 + 13 + 4  # signature, then IHDR: length, type, 13 bytes, CRC
+    return png[:header_end] + chunk + png[header_end:]
+
+
+def png_text(png: bytes) -> dict[str, str]:
+    """The tEXt chunks of ``png`` (key -> text)."""
+    import struct
+
+    found, at = {}, 8
+    while at + 8 <= len(png):
+        (length,), kind = struct.unpack(">I", png[at:at + 4]), png[at + 4:at + 8]
+        if kind == b"tEXt":
+            key, _, value = png[at + 8:at + 8 + length].partition(b"\0")
+            found[key.decode("latin-1")] = value.decode("latin-1")
+        at += 12 + length
+    return found
 
 
 def _version(package: str) -> str | None:
