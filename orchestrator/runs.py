@@ -62,8 +62,22 @@ def sidecar(system: System, result: RunResult, command: str,
         "participant_seconds": result.step_seconds,
         "master_overhead_seconds": result.master_overhead_seconds,
         "columns": list(result.columns),
+        "units": {"time": "s", **recorded_units(system)},
         **(extra or {}),
     }
+
+
+def recorded_units(system: System) -> dict[str, str]:
+    """The unit each recorded FMU variable declares (its own, else its type's), by column."""
+    units: dict[str, str] = {}
+    entries = {fmu.name: fmu for fmu in system.fmus}
+    for port in system.record:
+        entry = entries.get(port.instance)
+        variable = entry.variables().get(port.variable) if entry is not None else None
+        unit = getattr(variable, "unit", None) or getattr(getattr(variable, "declaredType", None), "unit", None)
+        if unit:
+            units[str(port)] = str(unit)
+    return units
 
 
 #: The file types a run's trajectories are written as.

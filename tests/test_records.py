@@ -52,4 +52,34 @@ def test_a_figure_names_the_record_it_was_written_with(tmp_path):
     assert png_text(png)[PNG_RECORD_KEY] == f"fig3_fx_vs_slip.json sha256:{hashlib.sha256(record).hexdigest()}"
     with Image.open(tmp_path / "fig3_fx_vs_slip.png") as image:  # still a valid PNG, its text readable
         image.load()
-        assert image.text[PNG_RECORD_KEY].startswith("fig3_fx_vs_slip.json sha256:")
+        assert image.info[PNG_RECORD_KEY].startswith("fig3_fx_vs_slip.json sha256:")
+
+
+def test_a_record_says_the_units_of_the_tables_beside_it(tmp_path):
+    """The CSV headers stay plain (what pandas users index by); the record written with them
+    says each column's unit."""
+    import json
+
+    from rover_cosim.cli import main
+    from rover_cosim.common.units import column_unit
+
+    assert main(["fig3", "--out", str(tmp_path), "--loads", "300", "--slip-step", "0.1"]) == 0
+    header = (tmp_path / "fig3_fx_vs_slip.csv").read_text().splitlines()[0]
+    assert header == "load_N,slip,sinkage_m,Fx_N,Fz_N,Tx_Nm"
+    units = json.loads((tmp_path / "fig3_fx_vs_slip.json").read_text())["units"]["fig3_fx_vs_slip.csv"]
+    assert units == {"load_N": "N", "slip": "1", "sinkage_m": "m", "Fx_N": "N", "Fz_N": "N", "Tx_Nm": "N.m"}
+    assert (column_unit("Fz_3"), column_unit("sinkage_6"), column_unit("omega_2"), column_unit("nonsense")) == (
+        "N", "m", "rad/s", None)
+
+
+
+def test_a_runs_record_gives_each_recorded_variable_its_declared_unit(fmu_dir, tmp_path):
+    import json
+
+    from rover_cosim.cli import main
+
+    assert main(["run", str(fmu_dir / "SingleWheel.fmu"), "-q", "-o", str(tmp_path / "out.csv"), "--start", "tau=20",
+                 "--stop-time", "0.05"]) == 0
+    units = json.loads((tmp_path / "out.json").read_text())["units"]
+    assert units["time"] == "s" and units["model.Fx"] == "N" and units["model.Tx"] == "N.m"
+    assert units["model.omega"] == "rad/s" and units["model.sinkage"] == "m"

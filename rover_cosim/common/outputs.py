@@ -52,7 +52,7 @@ def write_all(files: Mapping[Path, bytes], folder: Path | None = None, stale: Co
     ``complete``: the files are a command's result set (counted by :func:`committed`), not what
     is kept of a failed run.
     """
-    files = with_provenance(_with_other_renderings(files))
+    files = with_provenance(with_units(_with_other_renderings(files)))
     try:
         if folder is None or not _exchange(Path(folder), files, stale, complete):
             _rename_each(files, complete)
@@ -224,6 +224,42 @@ def _with_other_renderings(files: Mapping[Path, bytes]) -> dict[Path, bytes]:
         for suffix, data in getattr(payload, "others", {}).items():
             expanded[Path(target).with_suffix(suffix)] = data
     return expanded
+
+
+def with_units(files: Mapping[Path, bytes]) -> dict[Path, bytes]:
+    """``files`` with the record written beside CSV tables (the JSON of the same name, else the one
+    JSON written into the same folder) saying each table's column units: ``"units": {"table.csv":
+    {"Fz_1": "N", ...}}`` (``common.units.column_unit``); the tables' bytes are not touched, so
+    their headers stay the plain names pandas users index by."""
+    from .units import column_units
+
+    out = dict(files)
+    units: dict[Path, dict[str, dict[str, str]]] = {}
+    jsons = [Path(t) for t in files if Path(t).suffix == ".json"]
+    for target, payload in files.items():
+        target = Path(target)
+        if target.suffix != ".csv":
+            continue
+        same = target.with_suffix(".json")
+        beside = [j for j in jsons if j.parent == target.parent]
+        record = same if same in jsons else (beside[0] if len(beside) == 1 else None)
+        if record is None:
+            continue
+        import csv
+        import io
+
+        header = next(csv.reader(io.StringIO(bytes(payload[:65536]).decode(errors="replace").split("\n", 1)[0])), [])
+        found = column_units(header)
+        if found:
+            units.setdefault(record, {})[target.name] = found
+    for record, tables in units.items():
+        try:
+            data = json.loads(files[record])
+        except ValueError:
+            continue
+        if isinstance(data, dict) and "units" not in data:
+            out[record] = json_bytes({**data, "units": tables})
+    return out
 
 
 #: The PNG text chunk that names the record a figure was written with.

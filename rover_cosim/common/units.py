@@ -56,3 +56,33 @@ def base_units(unit: str) -> tuple[dict[str, int], float]:
                 exponents[i] += power * e
             factor *= symbol_factor ** power
     return {b: e for b, e in zip(BASE, exponents) if e}, factor
+
+
+#: The unit of each column name the jobs write (trajectories, sweeps, metrics), by its stem: the
+#: name without a wheel's number ``_1``..``_N``. SI; "1" for ratios.
+COLUMN_UNITS: dict[str, str] = {
+    "time": "s", "x": "m", "y": "m", "z": "m", "yaw": "rad", "v": "m/s", "vy": "m/s", "yawRate": "rad/s",
+    "s": "m", "s_ref": "m", "x_t": "m", "cross_track": "m", "heading_error": "rad", "tau": "N.m", "Tx": "N.m",
+    "steer": "rad", "Fx": "N", "Fy": "N", "Fz": "N", "Fx_des": "N", "Fy_des": "N", "W": "N", "slip": "1",
+    "slipAngle": "rad", "beta": "rad", "sinkage": "m", "omega": "rad/s", "v_hub": "m/s", "pitch": "rad",
+}
+#: Units said by a column name's ending (load_N, torque_N_m, sinkage_m, rms_Fx_max_N, wall_s, ...).
+_ENDINGS = (("_N_m", "N.m"), ("_Nm", "N.m"), ("_N", "N"), ("_m_s", "m/s"), ("_rad_s", "rad/s"), ("_deg", "deg"),
+            ("_rad", "rad"), ("_percent", "%"), ("_J_m", "J/m"), ("_m", "m"), ("_s", "s"), ("_Pa", "Pa"))
+
+
+def column_unit(name: str) -> str | None:
+    """The unit of a column the jobs write (``Fz_3`` -> N, ``load_N`` -> N), None where its name
+    does not say."""
+    stem = re.sub(r"_\d+$", "", name)
+    if stem in COLUMN_UNITS:
+        return COLUMN_UNITS[stem]
+    for ending, unit in _ENDINGS:
+        if stem.endswith(ending) and len(stem) > len(ending):
+            return unit
+    return None
+
+
+def column_units(names: list[str]) -> dict[str, str]:
+    """Each of ``names`` whose unit is known, with it."""
+    return {name: unit for name in names if (unit := column_unit(name)) is not None}
