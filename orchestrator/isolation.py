@@ -119,7 +119,8 @@ class _Wire:
                 raise EOFError
             got += more
         size = int.from_bytes(self.buffer[:4], "little") + 4
-        if size > len(self.buffer):
+        if size > len(self.buffer):  # a message longer than the buffer: grow it (no view may hold it then)
+            view.release()
             self.buffer.extend(bytes(size - len(self.buffer)))
             view = memoryview(self.buffer)
         while got < size:
@@ -158,6 +159,7 @@ class IsolatedFmu:
         self.inputs: list[str] = []
         self.outputs: list[str] = []
         self.problems: list[str] = []
+        self.long_messages: list[str] = []  # the child's participant's, fetched when closing
         self.takes_signals = entry.interface == "model-exchange"
         self.version = entry.fmi_version
         self.can_interpolate = self.version == 2 and entry.interface == "co-simulation" and bool(
@@ -312,6 +314,7 @@ class IsolatedFmu:
             return
         limit = min(self.timeout, CLOSE_SECONDS) if self.timeout is not None else CLOSE_SECONDS
         try:
+            self.long_messages = self._call("its messages", "long_messages", (), None, limit)
             self._call(f"fmi{self.version}Terminate/FreeInstance", "close", (), None, limit)
         except RunError as error:
             self.problems.append(str(error))
@@ -425,6 +428,9 @@ class _Child:
 
     def free_state(self, key: int) -> None:
         self.fmu.free_state(self.states.pop(key))
+
+    def long_messages(self) -> list[str]:
+        return list(self.fmu.long_messages)
 
     def close(self) -> None:
         self.fmu.close()

@@ -148,11 +148,31 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
     watched = _observed_ports(system, observers)
     wiring = wire(system, watched)
     times = communication_points(system.start_time, system.stop_time, system.step)
-    n_steps = len(times) - 1
     strings = StringTable()
     closed: list[Participant] = []
+    try:
+        result = _run(system, progress, observers, sink, watched, wiring, times, strings, closed, started)
+    except RunError as error:
+        error.fmu_log = fmu_log(closed)
+        raise
+    result.notes.extend(problem for p in closed for problem in getattr(p, "problems", ()))
+    result.fmu_log = fmu_log(closed)
+    return result
+
+
+def fmu_log(participants: Sequence[Participant]) -> dict[str, list[str]]:
+    """Per FMU, its error messages too long to print, whole (``long_messages``; after closing)."""
+    found = {p.name: getattr(p, "long_messages", None) for p in participants}
+    return {name: list(messages) for name, messages in found.items() if messages}
+
+
+def _run(system: System, progress: Callable[[float], None] | None, observers: Sequence[Observer],
+         sink: Callable[[Table], None] | None, watched: list[Port], wiring: Wiring, times: np.ndarray,
+         strings: StringTable, closed: list[Participant], started: float) -> RunResult:
+    """The run of :func:`run`; ``closed``: filled with the participants (looked at after they closed)."""
+    n_steps = len(times) - 1
     with participants_of(system, wiring, strings) as participants, ExitStack() as stack:
-        closed = participants
+        closed.extend(participants)
         values = wiring.initial_values(strings)
         initialize(participants, wiring, values, system.start_time, system.stop_time)
         execution = make_execution(system, participants, wiring)
@@ -192,7 +212,6 @@ def run(system: System, *, progress: Callable[[float], None] | None = None,
         result = RunResult(table, time.perf_counter() - started, steps, execution.step_seconds, stopped)
         for observer in observers:  # before the FMUs are freed: an observer may write the results now
             observer.finish(result)
-    result.notes.extend(problem for p in closed for problem in getattr(p, "problems", ()))
     return result
 
 

@@ -47,6 +47,8 @@ class RunError(RuntimeError):
     ``partial``: the rows recorded before the failure (a DataFrame), when the run got that far."""
 
     partial: Any = None
+    #: Per FMU instance, its error messages too long to print, whole (``master.fmu_log``).
+    fmu_log: dict[str, list[str]] = {}
 
 
 class Terminated(RunError):
@@ -205,6 +207,14 @@ class BlockParticipant:
 
 #: How many of an FMU's error messages a participant keeps, and how long one may be (characters).
 MESSAGES_KEPT, MESSAGE_LENGTH = 20, 500
+#: Characters of an FMU's messages longer than MESSAGE_LENGTH kept whole for the run's FMU log.
+LONG_KEPT = 1 << 20
+
+
+def log_text(raw: bytes | str) -> str:
+    """An FMU's message for a log file: whole, control characters but line ends and tabs as \\xNN."""
+    text = raw.decode(errors="replace") if isinstance(raw, bytes) else str(raw)
+    return "".join(c if c.isprintable() or c in "\n\t" else f"\\x{ord(c):02x}" for c in text)
 
 
 def clean_message(raw: bytes | str | None) -> str:
@@ -233,6 +243,8 @@ class FmuParticipant:
         self.version = entry.fmi_version
         self.strings = strings if strings is not None else StringTable()
         self.messages: list[str] = []
+        #: error messages longer than MESSAGE_LENGTH, whole (at most LONG_KEPT characters in all)
+        self.long_messages: list[str] = []
         md = entry.description
         variables = entry.variables()  # the elements of FMI 3.0 arrays too, as name[i]
         self.refs = {name: v.valueReference for name, v in variables.items()}
@@ -284,6 +296,9 @@ class FmuParticipant:
         if status >= 2:  # discard, error, fatal: kept (the last MESSAGES_KEPT) to name in an error
             self.messages.append(clean_message(message))
             del self.messages[:-MESSAGES_KEPT]
+            if message is not None and len(message) > MESSAGE_LENGTH \
+                    and sum(map(len, self.long_messages)) < LONG_KEPT:
+                self.long_messages.append(log_text(message)[:LONG_KEPT])
 
     def _log3(self, env, status, category, message) -> None:
         self._log(env, None, status, category, message)

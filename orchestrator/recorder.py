@@ -163,6 +163,8 @@ class RunResult:
     #: What went wrong after the last step, the rows being complete (e.g. an FMU that crashed or
     #: hung in fmi2Terminate or fmi2FreeInstance, in its child process).
     notes: list[str] = field(default_factory=list)
+    #: Per FMU instance, its error messages too long to print, whole (for a log file beside the results).
+    fmu_log: dict[str, list[str]] = field(default_factory=dict)
 
     @cached_property
     def data(self) -> Any:

@@ -11,7 +11,7 @@ from c_fmu import compile_fmu
 GUID = "{8a1e0f37-misbehave-rover-cosim-tests}"
 #: The misbehaviours by the value of the parameter ``mode``.
 MODES = {"fine": 0, "segfault": 1, "abort": 2, "exit": 3, "busy": 4, "sleep": 5, "free-segfault": 6,
-         "terminate-hang": 7, "getreal-segfault": 8, "exit-at-init": 9}
+         "terminate-hang": 7, "getreal-segfault": 8, "exit-at-init": 9, "long-message": 10}
 
 
 def model_description() -> str:

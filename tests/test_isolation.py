@@ -236,3 +236,16 @@ def test_in_this_process_a_crash_while_freeing_comes_after_the_results_are_writt
     assert done.returncode == -signal.SIGSEGV
     assert out.is_file() and (tmp_path / "out.json").is_file()
     assert out.read_text().count("\n") == 12  # the header and 11 rows, 0 to 1 s
+
+
+@pytest.mark.parametrize("isolation", ["none", "process"])
+def test_a_message_too_long_to_print_is_kept_whole_in_the_fmu_log(misbehave, tmp_path, capsys, isolation):
+    out = tmp_path / "out.csv"
+    assert main(["run", str(misbehave), "-q", "-o", str(out), "--isolation", isolation,
+                 "--start", f"mode={MODES['long-message']}"]) == 1
+    said = capsys.readouterr()
+    assert max(map(len, said.err.splitlines())) < 1500 and "\x1b" not in said.err  # cut, no escape sequence
+    assert "... (100000 characters)" in said.err and "out.fmu.log" in said.out
+    log = (tmp_path / "out.fmu.log").read_text()
+    assert log.startswith("# rover-cosim run: FMU messages too long to print, whole") and "## model" in log
+    assert "\\x1b[31mred" + "x" * (100_000 - 8) in log and "\x1b" not in log

@@ -238,6 +238,7 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
         else:
             stream.discard()
         fail("run", f"{error} ({output} not written{kept})")
+        _write_fmu_log(output, error.fmu_log)
         return 1
     except BaseException:
         stream.discard()
@@ -245,12 +246,43 @@ def _run_system(args: argparse.Namespace, system: Any, system_file: Path, extra:
     bar.close()
     publisher.noted(result)
     print_written(publisher.written)
+    _write_fmu_log(output, result.fmu_log)
     for note in result.notes:
         fail("run", f"warning: {note} (after the last step; {output} is complete)")
     if result.stopped:
         print(f"stopped: {result.stopped}")
     print(f"{result.steps} steps of {system.step:g} s ({system.algorithm}) in {result.wall_seconds:.2f} s")
     return 0
+
+
+#: The first line of the FMU log a run writes beside its output (how a later run knows it is its own).
+FMU_LOG_HEADER = "# rover-cosim run: FMU messages too long to print, whole"
+
+
+def fmu_log_path(output: Path) -> Path:
+    """Where a run's FMU log goes: ``NAME.fmu.log`` beside ``NAME.csv``."""
+    return output.with_name(f"{output.stem}.fmu.log")
+
+
+def _write_fmu_log(output: Path, log: dict[str, list[str]]) -> None:
+    """The FMUs' error messages that were too long to print, whole, beside the output (not over a
+    file of that name that a run did not write)."""
+    from rover_cosim.common.outputs import OutputError, write_all
+
+    if not log:
+        return
+    target = fmu_log_path(output)
+    if target.exists() and not target.read_bytes().startswith(FMU_LOG_HEADER.encode()):
+        fail("run", f"the FMUs' long messages are not written: {target} exists and is not a run's FMU log")
+        return
+    text = FMU_LOG_HEADER + "\n" + "".join(f"\n## {name}\n" + "\n".join(messages) + "\n"
+                                          for name, messages in log.items())
+    try:
+        write_all({target: text.encode()}, complete=False)
+    except OutputError as error:
+        fail("run", f"the FMUs' long messages: {error}")
+        return
+    print(f"wrote {target} (the FMUs' messages too long to print, whole)")
 
 
 def _run_bytes(system: Any) -> float:

@@ -7,7 +7,8 @@
  * Integer  0 mode   parameter  0 fine, 1 DoStep segfaults, 2 DoStep aborts, 3 DoStep calls exit(0),
  *                              4 DoStep busy-loops, 5 DoStep sleeps for ever, 6 FreeInstance
  *                              segfaults, 7 Terminate hangs, 8 GetReal segfaults, 9 ExitInitializationMode
- *                              calls exit(3)
+ *                              calls exit(3), 10 DoStep fails logging a 100,000-character message
+ *                              that starts with an escape sequence
  * An instance whose name contains "segv_at_instantiate" segfaults in fmi2Instantiate.
  */
 #include <signal.h>
@@ -145,6 +146,12 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h, fmi2Boole
         case 3: exit(0);
         case 4: hang(1); break;
         case 5: hang(0); break;
+        case 10: {
+            static char text[100001];
+            memset(text, 'x', sizeof text - 1);
+            memcpy(text, "\x1b[31mred", 8);
+            return refuse(component, text);
+        }
         default: break;
         }
     }
