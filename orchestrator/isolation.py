@@ -172,7 +172,13 @@ class IsolatedFmu:
         self._conn = _Wire(ours)
         self._process = context.Process(target=_serve, args=(child, entry, str(folder), relative_tolerance),
                                         name=f"rover-cosim FMU {entry.name}", daemon=True)
-        self._process.start()
+        try:
+            self._process.start()
+        except OSError as error:  # no process to be had (the system's limit, memory)
+            ours.close()
+            child.close()
+            raise RunError(f"{self._said()}: its process could not be started ({error.strerror or error}); "
+                           "--isolation none runs it in this process") from None
         child.close()
         self._closed = False
         self._busy = False  # a call sent and not answered (an interrupted run): closing kills the child
