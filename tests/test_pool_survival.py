@@ -38,9 +38,7 @@ def _lost(arguments: tuple[int], reason: str) -> tuple[int, str]:
 @pytest.mark.parametrize("workers", [1, 2])
 def test_a_crash_an_exit_a_hang_and_an_exception_each_lose_one_call_only(workers):
     before = set(children())
-    started = time.monotonic()
     results = list(parallel_map(_call, [(k,) for k in range(8)], workers=workers, lost=_lost, timeout=1.0))
-    assert time.monotonic() - started < 30
     done = sorted(r for r in results if isinstance(r, int))
     lost: dict[int, str] = dict(r for r in results if isinstance(r, tuple))
     assert done == [0, 1, 36, 49] and sorted(lost) == [2, 3, 4, 5]
