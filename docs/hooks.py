@@ -40,6 +40,7 @@ def library_page() -> str:
     """The shipped soils and wheels: every value in SI, its title and source."""
     lines = ["# Soils and wheels", "", "Generated from the library files "
              "(`rover_cosim/terramechanics/library/*.toml`); `rover-cosim soils NAME` shows one with its notes.", ""]
+    lines += format_section()
     folder = resources.files("rover_cosim.terramechanics") / "library"
     for kind in ("soils", "wheels"):
         tables: dict[str, Any] = tomllib.loads((folder / f"{kind}.toml").read_text())
@@ -49,6 +50,37 @@ def library_page() -> str:
             lines += [f"### {name}", "", f"{table.get('title', '')}", "", f"Source: {table.get('source', '')}", "",
                       values or "(the paper's values)", ""]
     return "\n".join(lines)
+
+
+def format_section() -> list[str]:
+    """The TOML format of a soil or wheel file: every key with its unit, default and accepted range
+    (from the parameter classes, their units and ranges)."""
+    from dataclasses import fields
+
+    from rover_cosim.terramechanics import Soil, Wheel
+    from rover_cosim.terramechanics.library import DEGREES, METADATA
+    from rover_cosim.terramechanics.parameters import RANGES, UNITS
+
+    lines = ["## The file format", "",
+             "A soil or wheel file is TOML: one table of keys (a file of one soil or wheel), or one table per "
+             "name (`[my_soil]`; pick one with `FILE:NAME`). Every value is SI; a key left out keeps the "
+             "paper's value (Table 2). Besides the keys below: "
+             + ", ".join(f"`{k}`" for k in METADATA) + " (text, shown by `rover-cosim soils`; `notes` a table "
+             "of remarks), and for a soil " + ", ".join(f"`{k}` (= `{v}` in degrees)" for k, v in DEGREES.items())
+             + ". Use it with `--soil FILE` / `--wheel FILE` on any command, or `make run SOIL=FILE WHEEL=FILE`.",
+             ""]
+    for kind, cls in (("soil", Soil), ("wheel", Wheel)):
+        default = cls()
+        lines += [f"### {kind.capitalize()} keys", "", "| key | unit | default (paper) | accepted |",
+                  "|---|---|---|---|"]
+        for field in fields(cls):
+            low, high = RANGES.get(field.name, (None, None))
+            accepted = (f"{low:.6g}" if low is not None else "-inf") + " .. " + (f"{high:.6g}" if high is not None
+                                                                                 else "inf")
+            lines.append(f"| `{field.name}` | {UNITS.get(field.name, '')} | {getattr(default, field.name):.6g} | "
+                         f"{accepted} |")
+        lines.append("")
+    return lines
 
 
 REPOSITORY = Path(__file__).resolve().parent.parent
