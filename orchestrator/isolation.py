@@ -39,7 +39,7 @@ import numpy as np
 
 from .fmi_access import StringTable
 from .model import FmuEntry
-from .participants import RunError, Terminated
+from .participants import RunError, Terminated, interpolates_inputs
 
 #: The first byte of a step message (t, h and the inputs as float64) and of its answer (the outputs).
 STEP = b"S"
@@ -162,8 +162,7 @@ class IsolatedFmu:
         self.long_messages: list[str] = []  # the child's participant's, fetched when closing
         self.takes_signals = entry.interface == "model-exchange"
         self.version = entry.fmi_version
-        self.can_interpolate = self.version == 2 and entry.interface == "co-simulation" and bool(
-            getattr(entry.capabilities, "canInterpolateInputs", False))
+        self.can_interpolate = interpolates_inputs(entry)
         self._last, self._at = np.zeros(0), math.nan
         self._string_in: list[int] = []
         self._string_out: list[int] = []

@@ -1,6 +1,6 @@
 """Observers: what watches a run without stepping it. ``master.run`` composes the engine's own
-(the recorder, the finite-value check, progress) with any the caller passes; the partial-file
-writer of a failed run is one too (``runs.PartialWriter``).
+(the recorder, the finite-value check, progress) with any the caller passes; ``rover-cosim
+run``'s result writer is one too (``runs.Publisher``).
 
 A user observer subclasses :class:`Observer` and overrides what it needs:
 

@@ -229,6 +229,13 @@ def clean_message(raw: bytes | str | None) -> str:
     return shown + (f"... ({len(text)} characters)" if len(text) > MESSAGE_LENGTH else "")
 
 
+def interpolates_inputs(entry: FmuEntry) -> bool:
+    """Whether the master may give ``entry``'s inputs slopes over a step: an FMI 2.0 FMU run as
+    Co-Simulation that says canInterpolateInputs (FMI 3.0 has no fmi3SetRealInputDerivatives)."""
+    return entry.fmi_version == 2 and entry.interface == "co-simulation" and bool(
+        getattr(entry.capabilities, "canInterpolateInputs", False))
+
+
 class FmuParticipant:
     """An FMU instance run through its Co-Simulation interface (FMI 2.0 or 3.0); ``inputs`` are
     its connected inputs, ``outputs`` the variables read from it (connected or recorded), both
@@ -265,8 +272,7 @@ class FmuParticipant:
         self.outputs: list[str] = []
         self.input_values = np.zeros(0)
         self.read_values = np.zeros(0)
-        # FMI 3.0 has no fmi3SetRealInputDerivatives: its FMUs get the held values
-        self.can_interpolate = self.version == 2 and bool(getattr(entry.capabilities, "canInterpolateInputs", False))
+        self.can_interpolate = interpolates_inputs(entry)
         self.configure([], [])
 
     def _instantiate(self, md: Any, folder: Path) -> Any:

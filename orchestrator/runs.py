@@ -16,7 +16,6 @@ from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, writ
 from .isolation import isolated
 from .model import System
 from .observers import Observer
-from .participants import RunError
 from .recorder import RunResult, Table
 
 
@@ -284,36 +283,3 @@ def _partial_record(system: System, command: str, failure: str, rows: int,
     return record
 
 
-def write_partial(system: System, data: Any, csv_path: Path, failure: str,
-                  command: str = "rover-cosim run") -> list[Path]:
-    """The rows a failed run recorded, marked as partial in their file name and sidecar."""
-    target = partial_path(csv_path)
-    record = _partial_record(system, command, failure, len(data),
-                             float(data["time"].iloc[-1]) if len(data) else None)
-    json_path = sidecar_path(target)
-    write_all({target: table_bytes(data, target), json_path: json_bytes(record)}, complete=False)  # not the result
-    return [target, json_path]
-
-
-def write_run(system: System, result: RunResult, csv_path: Path, command: str = "rover-cosim run",
-              extra: dict[str, Any] | None = None) -> list[Path]:
-    """Write ``csv_path`` and ``csv_path`` with suffix ``.json`` atomically; returns both paths.
-    ``extra``: more for the record (e.g. the soil and wheel the run was given)."""
-    csv_path = Path(csv_path)
-    json_path = sidecar_path(csv_path)
-    record = sidecar(system, result, command, extra)
-    write_all({csv_path: table_bytes(result.table, csv_path), json_path: json_bytes(record)})
-    return [csv_path, json_path]
-
-
-class PartialWriter(Observer):
-    """An observer that writes the rows of a failed run (more than the start) with
-    :func:`write_partial`; ``written``: the files, once it did."""
-
-    def __init__(self, system: System, csv_path: Path, command: str = "rover-cosim run"):
-        self.system, self.csv_path, self.command = system, Path(csv_path), command
-        self.written: list[Path] = []
-
-    def fail(self, error: RunError) -> None:
-        if error.partial is not None and len(error.partial) > 1:
-            self.written = write_partial(self.system, error.partial, self.csv_path, str(error), self.command)
