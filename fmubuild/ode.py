@@ -28,6 +28,7 @@ from .expressions import (
     is_symbolic,
     literal,
     scalar_name,
+    subscript_values,
 )
 from .functions import FunctionLibrary
 from .implicit import implicit_solves
@@ -332,6 +333,7 @@ def translate(model: Any, name: str) -> OdeModel:
     for scalar, (info, _, _) in infos.items():
         if _is_parameter(info):
             parameters(scalar)
+    _fold_subscripts(flat["equations"], parameters, name)
 
     state_names = _states(flat["equations"])
     inputs = [s for s, (info, _, flat_name) in infos.items()
@@ -426,6 +428,31 @@ def _public_name(scalar: str, parameters: _Parameters) -> str:
 
 def _mx(value: Value) -> ca.MX:
     return value if isinstance(value, ca.MX) else ca.MX(float(value))
+
+
+def _fold_subscripts(node: Any, parameters: _Parameters, name: str) -> None:
+    """Subscripts that are expressions of structural parameters (``W[j + rover.nAxles]`` in a
+    for-loop rumoca unrolled) replaced in place by their integer value, so that an equation's
+    incidence sees which element it names."""
+    if isinstance(node, list):
+        for item in node:
+            _fold_subscripts(item, parameters, name)
+        return
+    if not isinstance(node, dict):
+        return
+    ref = node.get("VarRef")
+    if isinstance(ref, dict) and isinstance(ref.get("subscripts"), list):
+        where = f"{name}: subscript of {ref.get('name', {}).get('name', '?')}"
+        evaluate = Evaluator(parameters, parameters.library.call, where)
+        folded = []
+        for sub in ref["subscripts"]:
+            try:
+                folded.append({"Index": {"value": subscript_values([sub], evaluate, where)[0]}} if "Expr" in sub else sub)
+            except (UnsupportedConstruct, KeyError):  # a run-time subscript: refused where it is used
+                folded.append(sub)
+        ref["subscripts"] = folded
+    for value in node.values():
+        _fold_subscripts(value, parameters, name)
 
 
 def _element(binding: Mapping[str, Any], indices: list[int], where: str) -> Mapping[str, Any]:

@@ -1,6 +1,6 @@
 within RoverTerramechanics.Components;
 model Chassis "Rover body in the pitch plane (x, z, pitch) on six vertical compliant limbs, cut at the wheel hubs"
-  extends RoverTerramechanics.Interfaces.BodyHubs;
+  extends RoverTerramechanics.Interfaces.BodyHubs(final nWheels=2*rover.nAxles);
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity";
@@ -9,20 +9,23 @@ model Chassis "Rover body in the pitch plane (x, z, pitch) on six vertical compl
   output Real pitch(unit="rad", start=0, fixed=true) "Pitch angle, nose up positive";
   Real w(unit="m/s", start=0, fixed=true) "Heave velocity";
   Real q(unit="rad/s", start=0, fixed=true) "Pitch rate";
-  Real deflection[6](each unit="m") "Limb compression";
-  Real deflectionRate[6](each unit="m/s") "Limb compression rate";
-  Real xHubWorld[6](each unit="m") "Hub position ahead of the centre of gravity";
-  Real zHubWorld[6](each unit="m") "Hub height relative to the centre of gravity";
+  Real deflection[nWheels](each unit="m") "Limb compression";
+  Real deflectionRate[nWheels](each unit="m/s") "Limb compression rate";
+  Real xHubWorld[nWheels](each unit="m") "Hub position ahead of the centre of gravity";
+  Real zHubWorld[nWheels](each unit="m") "Hub height relative to the centre of gravity";
 protected
-  parameter Real xHub[6](each unit="m") = {rover.xLimb[1], rover.xLimb[2], rover.xLimb[3], rover.xLimb[1], rover.xLimb[2], rover.xLimb[3]} "Hub positions in the body frame; limbs 4-6 mirror 1-3";
-  parameter Real staticDeflection(unit="m") = rover.M*rover.g*cos(slope)/(6*rover.kLimb) "Limb compression at rest";
+  parameter Real staticDeflection(unit="m") = rover.M*rover.g*cos(slope)/(nWheels*rover.kLimb) "Limb compression at rest";
 equation
   der(x) = v;
   der(z) = w;
   der(pitch) = q;
-  for i in 1:6 loop
-    xHubWorld[i] = xHub[i]*cos(pitch) + rover.hCoG*sin(pitch);
-    zHubWorld[i] = xHub[i]*sin(pitch) - rover.hCoG*cos(pitch);
+  for j in 1:rover.nAxles loop
+    xHubWorld[j] = rover.xLimb[j]*cos(pitch) + rover.hCoG*sin(pitch);
+    zHubWorld[j] = rover.xLimb[j]*sin(pitch) - rover.hCoG*cos(pitch);
+    xHubWorld[j + rover.nAxles] = rover.xLimb[j]*cos(pitch) + rover.hCoG*sin(pitch) "the right side mirrors the left";
+    zHubWorld[j + rover.nAxles] = rover.xLimb[j]*sin(pitch) - rover.hCoG*cos(pitch);
+  end for;
+  for i in 1:nWheels loop
     deflection[i] = staticDeflection - z - (zHubWorld[i] + rover.hCoG);
     deflectionRate[i] = -w - q*xHubWorld[i];
     W[i] = noEvent(max(rover.kLimb*deflection[i] + rover.dLimb*deflectionRate[i], 0.0));
@@ -30,7 +33,7 @@ equation
   end for;
   rover.M*der(v) = sum(Fx) - rover.M*rover.g*sin(slope);
   rover.M*der(w) = sum(W) - rover.M*rover.g*cos(slope);
-  rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*Fx[i] + tau[i] for i in 1:6);
+  rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*Fx[i] + tau[i] for i in 1:nWheels);
   assert(rover.M > 0, "rover.M: the mass must be > 0 kg");
   assert(rover.g > 0, "rover.g: the gravity must be > 0 m/s2");
   assert(rover.Iyy > 0, "rover.Iyy: the pitch inertia must be > 0 kg.m2");

@@ -1,7 +1,6 @@
 within RoverTerramechanics.Components;
 model SteerableChassis "Rover body moving in the plane (x, y, yaw) with heave, pitch and roll on six compliant limbs, every wheel steered, cut at the wheel hubs"
-  extends RoverTerramechanics.Interfaces.SteerableBodyHubs;
-  extends RoverTerramechanics.Interfaces.GroundContacts;
+  extends RoverTerramechanics.Interfaces.SteerableBodyHubs(final nWheels=2*rover.nAxles);
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, inertia, geometry and limbs";
   parameter RoverTerramechanics.Parameters.TerrainParameters terrain "Ground plane: slope and downhill direction (default level)";
   output Real x(unit="m", start=0, fixed=true) "Position of the centre of gravity along the ground's x axis (world x on level ground)";
@@ -16,25 +15,23 @@ model SteerableChassis "Rover body moving in the plane (x, y, yaw) with heave, p
   Real w(unit="m/s", start=0, fixed=true) "Heave velocity";
   Real q(unit="rad/s", start=0, fixed=true) "Pitch rate";
   Real p(unit="rad/s", start=0, fixed=true) "Roll rate";
-  Real deflection[6](each unit="m") "Limb compression";
-  Real deflectionRate[6](each unit="m/s") "Limb compression rate";
-  Real yRolled[6](each unit="m") "Hub position to the left of the centre of gravity after the roll";
-  Real zRolled[6](each unit="m") "Hub height relative to the centre of gravity after the roll";
-  Real xHubWorld[6](each unit="m") "Hub position ahead of the centre of gravity (heading frame)";
-  Real zHubWorld[6](each unit="m") "Hub height relative to the centre of gravity";
-  Real vxHub[6](each unit="m/s") "Hub velocity along the heading";
-  Real vyHub[6](each unit="m/s") "Hub velocity to the left of the heading";
-  Real FxBody[6](each unit="N") "Hub force along the heading";
-  Real FyBody[6](each unit="N") "Hub force to the left of the heading";
-  Real FxHub[6](each unit="N") "Force of the ground on each hub along the heading: FxBody and the load's component on the local gradient";
-  Real FyHub[6](each unit="N") "Force of the ground on each hub to the left of the heading: FyBody and the load's component on the local gradient";
+  Real deflection[nWheels](each unit="m") "Limb compression";
+  Real deflectionRate[nWheels](each unit="m/s") "Limb compression rate";
+  Real yRolled[nWheels](each unit="m") "Hub position to the left of the centre of gravity after the roll";
+  Real zRolled[nWheels](each unit="m") "Hub height relative to the centre of gravity after the roll";
+  Real xHubWorld[nWheels](each unit="m") "Hub position ahead of the centre of gravity (heading frame)";
+  Real zHubWorld[nWheels](each unit="m") "Hub height relative to the centre of gravity";
+  Real vxHub[nWheels](each unit="m/s") "Hub velocity along the heading";
+  Real vyHub[nWheels](each unit="m/s") "Hub velocity to the left of the heading";
+  Real FxBody[nWheels](each unit="N") "Hub force along the heading";
+  Real FyBody[nWheels](each unit="N") "Hub force to the left of the heading";
+  Real FxHub[nWheels](each unit="N") "Force of the ground on each hub along the heading: FxBody and the load's component on the local gradient";
+  Real FyHub[nWheels](each unit="N") "Force of the ground on each hub to the left of the heading: FyBody and the load's component on the local gradient";
   Real gAlong(unit="m/s2") "Gravity's component along the heading, in the ground plane (TerrainParameters)";
   Real gLateral(unit="m/s2") "Gravity's component to the left of the heading, in the ground plane (TerrainParameters)";
 protected
-  parameter Real xHub[6](each unit="m") = {rover.xLimb[1], rover.xLimb[2], rover.xLimb[3], rover.xLimb[1], rover.xLimb[2], rover.xLimb[3]} "Hub positions ahead of the centre of gravity; limbs 4-6 mirror 1-3";
-  parameter Real yHub[6](each unit="m") = {rover.yLimb, rover.yLimb, rover.yLimb, -rover.yLimb, -rover.yLimb, -rover.yLimb} "Hub positions to the left: limbs 1-3 left, 4-6 right";
   parameter Real gNormal(unit="m/s2") = rover.g*cos(terrain.slope) "Gravity's component into the ground, along its normal";
-  parameter Real staticDeflection(unit="m") = rover.M*gNormal/(6*rover.kLimb) "Limb compression at rest";
+  parameter Real staticDeflection(unit="m") = rover.M*gNormal/(nWheels*rover.kLimb) "Limb compression at rest";
 equation
   gAlong = rover.g*sin(terrain.slope)*cos(terrain.downhill - yaw);
   gLateral = rover.g*sin(terrain.slope)*sin(terrain.downhill - yaw);
@@ -44,11 +41,17 @@ equation
   der(z) = w;
   der(pitch) = q;
   der(roll) = p;
-  for i in 1:6 loop
-    yRolled[i] = yHub[i]*cos(roll) + rover.hCoG*sin(roll);
-    zRolled[i] = yHub[i]*sin(roll) - rover.hCoG*cos(roll);
-    xHubWorld[i] = xHub[i]*cos(pitch) - zRolled[i]*sin(pitch);
-    zHubWorld[i] = xHub[i]*sin(pitch) + zRolled[i]*cos(pitch);
+  for j in 1:rover.nAxles loop
+    yRolled[j] = rover.yLimb*cos(roll) + rover.hCoG*sin(roll) "limbs 1..nAxles: the left side";
+    zRolled[j] = rover.yLimb*sin(roll) - rover.hCoG*cos(roll);
+    xHubWorld[j] = rover.xLimb[j]*cos(pitch) - zRolled[j]*sin(pitch);
+    zHubWorld[j] = rover.xLimb[j]*sin(pitch) + zRolled[j]*cos(pitch);
+    yRolled[j + rover.nAxles] = (-rover.yLimb)*cos(roll) + rover.hCoG*sin(roll) "the right side mirrors the left";
+    zRolled[j + rover.nAxles] = (-rover.yLimb)*sin(roll) - rover.hCoG*cos(roll);
+    xHubWorld[j + rover.nAxles] = rover.xLimb[j]*cos(pitch) - zRolled[j + rover.nAxles]*sin(pitch);
+    zHubWorld[j + rover.nAxles] = rover.xLimb[j]*sin(pitch) + zRolled[j + rover.nAxles]*cos(pitch);
+  end for;
+  for i in 1:nWheels loop
     deflection[i] = staticDeflection - z - (zHubWorld[i] + rover.hCoG) + groundHeight[i];
     deflectionRate[i] = -w - q*xHubWorld[i] - p*cos(pitch)*yRolled[i] + groundHeightRate[i];
     W[i] = noEvent(max(rover.kLimb*deflection[i] + rover.dLimb*deflectionRate[i], 0.0));
@@ -63,10 +66,10 @@ equation
   end for;
   rover.M*(der(v) - yawRate*vy) = sum(FxHub) + rover.M*gAlong;
   rover.M*(der(vy) + yawRate*v) = sum(FyHub) + rover.M*gLateral;
-  rover.Izz*der(yawRate) = sum(xHubWorld[i]*FyHub[i] - yRolled[i]*FxHub[i] for i in 1:6);
+  rover.Izz*der(yawRate) = sum(xHubWorld[i]*FyHub[i] - yRolled[i]*FxHub[i] for i in 1:nWheels);
   rover.M*der(w) = sum(W) - rover.M*gNormal;
-  rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*FxHub[i] + tau[i]*cos(steer[i]) for i in 1:6);
-  rover.Ixx*der(p) = sum(yRolled[i]*W[i] - zHubWorld[i]*FyHub[i] + tau[i]*sin(steer[i]) for i in 1:6);
+  rover.Iyy*der(q) = sum(xHubWorld[i]*W[i] - zHubWorld[i]*FxHub[i] + tau[i]*cos(steer[i]) for i in 1:nWheels);
+  rover.Ixx*der(p) = sum(yRolled[i]*W[i] - zHubWorld[i]*FyHub[i] + tau[i]*sin(steer[i]) for i in 1:nWheels);
   assert(rover.M > 0, "rover.M: the mass must be > 0 kg");
   assert(rover.g > 0, "rover.g: the gravity must be > 0 m/s2");
   assert(rover.Iyy > 0, "rover.Iyy: the pitch inertia must be > 0 kg.m2");

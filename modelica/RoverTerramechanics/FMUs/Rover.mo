@@ -1,6 +1,6 @@
 within RoverTerramechanics.FMUs;
 model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechanics wheels (monolithic)"
-  extends RoverTerramechanics.Interfaces.PitchPlaneRover;
+  extends RoverTerramechanics.Interfaces.PitchPlaneRover(final nWheels=2*rover.nAxles);
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
@@ -11,9 +11,9 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   RoverTerramechanics.Components.Chassis body(rover=rover, slope=slope) "Body and limbs";
-  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each soilB=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
+  RoverTerramechanics.Components.RigidWheel wheels[nWheels](each soil=soil, each soilB=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
-  for i in 1:6 loop
+  for i in 1:nWheels loop
     wheels[i].tau = tau[i];
     wheels[i].W = body.W[i];
     wheels[i].v_hub = body.v_hub[i];

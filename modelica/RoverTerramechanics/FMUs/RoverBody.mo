@@ -1,6 +1,6 @@
 within RoverTerramechanics.FMUs;
 model RoverBody "Rover body alone for co-simulation: inputs Fx[i] and tau[i], outputs wheel loads W[i] and hub speeds v_hub[i]"
-  extends RoverTerramechanics.Interfaces.BodyHubs;
+  extends RoverTerramechanics.Interfaces.BodyHubs(final nWheels=2*rover.nAxles);
   extends RoverTerramechanics.Components.Chassis;
   annotation (
     experiment(StartTime=0, StopTime=10, Interval=0.01),

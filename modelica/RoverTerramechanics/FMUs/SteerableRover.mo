@@ -1,6 +1,6 @@
 within RoverTerramechanics.FMUs;
 model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every wheel driven and steered, with six terramechanics wheels (monolithic)"
-  extends RoverTerramechanics.Interfaces.GroundContacts;
+  extends RoverTerramechanics.Interfaces.GroundContacts(final nWheels=2*rover.nAxles);
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2): the soil under a wheel where its soilShare = 0";
   parameter RoverTerramechanics.Parameters.SoilParameters soilB "Second soil: the soil under a wheel where its soilShare = 1 (default Table 2's)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
@@ -11,9 +11,9 @@ model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every whe
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
-  input Real tau[6](each unit="N.m") "Drive torque of each wheel";
-  input Real steer[6](each unit="rad") "Steering angle of each wheel, positive to the left";
-  input Real soilShare[6](each unit="1", each min=0, each max=1, each start=0) "Share of the second soil (soilB) in the soil under each wheel, from a soil map (0: soil)";
+  input Real tau[nWheels](each unit="N.m") "Drive torque of each wheel";
+  input Real steer[nWheels](each unit="rad") "Steering angle of each wheel, positive to the left";
+  input Real soilShare[nWheels](each unit="1", each min=0, each max=1, each start=0) "Share of the second soil (soilB) in the soil under each wheel, from a soil map (0: soil)";
   output Real x(unit="m") "Position of the centre of gravity along the ground's x axis (world x on level ground)";
   output Real y(unit="m") "Position of the centre of gravity along the ground's y axis (world y on level ground)";
   output Real yaw(unit="rad") "Heading against the ground's x axis, positive to the left";
@@ -22,18 +22,18 @@ model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every whe
   output Real yawRate(unit="rad/s") "Yaw rate";
   output Real pitch(unit="rad") "Pitch angle, nose up positive";
   output Real roll(unit="rad") "Roll angle, left side up positive";
-  output Real Fz[6](each unit="N") "Vertical force of each wheel, Eq. (11) (= its load)";
-  output Real Fx[6](each unit="N") "Longitudinal force of each wheel, along its heading";
-  output Real Fy[6](each unit="N") "Lateral force of each wheel, to its left";
-  output Real Tx[6](each unit="N.m") "Resistance torque of each wheel, Eq. (13)";
-  output Real slip[6](each unit="1") "Slip ratio of each wheel, Eq. (4)";
-  output Real slipAngle[6](each unit="rad") "Slip angle of each wheel's hub velocity";
-  output Real sinkage[6](each unit="m") "Sinkage of each wheel";
-  output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
+  output Real Fz[nWheels](each unit="N") "Vertical force of each wheel, Eq. (11) (= its load)";
+  output Real Fx[nWheels](each unit="N") "Longitudinal force of each wheel, along its heading";
+  output Real Fy[nWheels](each unit="N") "Lateral force of each wheel, to its left";
+  output Real Tx[nWheels](each unit="N.m") "Resistance torque of each wheel, Eq. (13)";
+  output Real slip[nWheels](each unit="1") "Slip ratio of each wheel, Eq. (4)";
+  output Real slipAngle[nWheels](each unit="rad") "Slip angle of each wheel's hub velocity";
+  output Real sinkage[nWheels](each unit="m") "Sinkage of each wheel";
+  output Real omega[nWheels](each unit="rad/s") "Angular velocity of each wheel";
   RoverTerramechanics.Components.SteerableChassis body(rover=rover, terrain=terrain) "Body and limbs";
-  RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each soilB=soilB, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
+  RoverTerramechanics.Components.RigidWheel wheels[nWheels](each soil=soil, each soilB=soilB, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
-  for i in 1:6 loop
+  for i in 1:nWheels loop
     wheels[i].tau = tau[i];
     wheels[i].W = body.W[i];
     wheels[i].v_hub = body.v_hub[i];

@@ -1,6 +1,6 @@
 within RoverTerramechanics.FMUs;
 model SteerableRoverBody "Steerable rover body alone for co-simulation: inputs Fx[i], Fy[i], tau[i], steer[i]; outputs wheel loads W[i] and hub velocities v_hub[i], v_lat[i]"
-  extends RoverTerramechanics.Interfaces.SteerableBodyHubs;
+  extends RoverTerramechanics.Interfaces.SteerableBodyHubs(final nWheels=2*rover.nAxles);
   extends RoverTerramechanics.Components.SteerableChassis;
   annotation (
     experiment(StartTime=0, StopTime=10, Interval=0.01),

@@ -1,9 +1,10 @@
 within RoverTerramechanics.Interfaces;
 partial model BodyHubs "The body side of the cut at the six wheel hubs of the pitch-plane rover: hub forces and drive torques in; wheel loads and hub speeds out"
-  input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub";
-  input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the body";
-  output Real W[6](each unit="N") "Wheel loads: the limb forces pressing each wheel into the soil";
-  output Real v_hub[6](each unit="m/s") "Forward speed of each wheel hub";
+  parameter Integer nWheels = 6 "Number of wheels (structural: an FMU is built for one value; wheels 1..nWheels/2 on the left from front to rear, the others mirror them on the right)";
+  input Real Fx[nWheels](each unit="N") "Longitudinal force of each wheel on its hub";
+  input Real tau[nWheels](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the body";
+  output Real W[nWheels](each unit="N") "Wheel loads: the limb forces pressing each wheel into the soil";
+  output Real v_hub[nWheels](each unit="m/s") "Forward speed of each wheel hub";
   annotation (Documentation(info="<html>
 <p>What the body of the pitch-plane rover exchanges with its six wheels (limb 1 front, 2 middle,
 3 rear of one side, 4-6 mirror them). Inputs: the hub forces <code>Fx[i]</code> [N] of the

@@ -1,15 +1,16 @@
 within RoverTerramechanics.Interfaces;
 partial model PitchPlaneRover "Inputs and outputs of the six-wheel rover in the pitch plane: drive torques in; body motion and per-wheel forces, slip, sinkage and spin out"
-  input Real tau[6](each unit="N.m") "Drive torque of each wheel";
+  parameter Integer nWheels = 6 "Number of wheels (structural: an FMU is built for one value; wheels 1..nWheels/2 on the left from front to rear, the others mirror them on the right)";
+  input Real tau[nWheels](each unit="N.m") "Drive torque of each wheel";
   output Real x(unit="m") "Position of the centre of gravity";
   output Real v(unit="m/s") "Forward velocity of the centre of gravity";
   output Real pitch(unit="rad") "Pitch angle, nose up positive";
-  output Real Fz[6](each unit="N") "Vertical force of each wheel, Eq. (11) (= its load)";
-  output Real Fx[6](each unit="N") "Longitudinal force of each wheel, Eq. (12)";
-  output Real Tx[6](each unit="N.m") "Resistance torque of each wheel, Eq. (13)";
-  output Real slip[6](each unit="1") "Slip ratio of each wheel, Eq. (4)";
-  output Real sinkage[6](each unit="m") "Sinkage of each wheel";
-  output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
+  output Real Fz[nWheels](each unit="N") "Vertical force of each wheel, Eq. (11) (= its load)";
+  output Real Fx[nWheels](each unit="N") "Longitudinal force of each wheel, Eq. (12)";
+  output Real Tx[nWheels](each unit="N.m") "Resistance torque of each wheel, Eq. (13)";
+  output Real slip[nWheels](each unit="1") "Slip ratio of each wheel, Eq. (4)";
+  output Real sinkage[nWheels](each unit="m") "Sinkage of each wheel";
+  output Real omega[nWheels](each unit="rad/s") "Angular velocity of each wheel";
   annotation (Documentation(info="<html>
 <p>The rover as its user sees it, whether it is one model (<code>FMUs.Rover</code>) or the body
 and six wheels wired through the hub cut (<code>Examples.RoverReconnected</code>): inputs the

@@ -3,7 +3,8 @@ record RoverParameters "ATHLETE-like rover body: mass, gravity, inertia, geometr
   parameter Real M(unit="kg") = 1570 "Total rover mass (paper Sec. 4), carried by the six limbs";
   parameter Real g(unit="m/s2") = 1.62 "Lunar gravity (paper Sec. 4)";
   parameter Real Iyy(unit="kg.m2") = 1120 "Pitch moment of inertia about the centre of gravity";
-  parameter Real xLimb[3](each unit="m") = {1.5, 0.0, -1.5} "Longitudinal wheel-hub position of the front, middle and rear limb of a side, relative to the centre of gravity";
+  parameter Integer nAxles = 3 "Number of wheels on each side (structural: an FMU is built for one value): wheels 1..nAxles on the left from front to rear, nAxles+1..2 nAxles mirror them on the right";
+  parameter Real xLimb[nAxles](each unit="m") = {1.5, 0.0, -1.5} "Longitudinal wheel-hub position of the limbs of a side from front to rear, relative to the centre of gravity";
   parameter Real hCoG(unit="m") = 1.0 "Height of the centre of gravity above the wheel hubs";
   parameter Real yLimb(unit="m") = 1.5 "Lateral wheel-hub position of the limbs of a side (half the track width): limbs 1-3 at +yLimb (left), 4-6 at -yLimb (right); used by the steerable rover";
   parameter Real Ixx(unit="kg.m2") = 1120 "Roll moment of inertia about the centre of gravity (steerable rover)";
