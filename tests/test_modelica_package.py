@@ -51,7 +51,7 @@ INTERFACES = {"WheelHub": ("Components.RigidWheel", "FMUs.Wheel"),
               "BodyHubs": ("Components.Chassis", "FMUs.RoverBody"),
               "SteerableBodyHubs": ("Components.SteerableChassis", "FMUs.SteerableRoverBody"),
               "PitchPlaneRover": ("FMUs.Rover", "Examples.RoverReconnected"),
-              "GroundContacts": ("Components.SteerableChassis", "FMUs.SteerableRover")}
+              "GroundContacts": ("Interfaces.SteerableBodyHubs", "FMUs.SteerableRover")}
 DECLARATION_RE = re.compile(r"^\s*(input|output)\s+Real\s+(\w+)", re.MULTILINE)
 
 
