@@ -240,25 +240,31 @@ def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries
 
 
 def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Sequence[str] = (HOST,),
-              compile_jobs: int | None = None, step: StepReport | None = None, fmi_version: int = 2) -> BuildResult:
+              compile_jobs: int | None = None, step: StepReport | None = None, fmi_version: int = 2,
+              axles: int | None = None) -> BuildResult:
     """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date) with binaries
     for ``platforms`` (``host``: this machine's, by its C compiler; other names: cross-compiled by
     zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time; ``step`` hears of
     each stage as it ends. ``fmi_version`` 3: an FMI 3.0 FMU of the same model code (the runtime's
-    FMI 3.0 layer, the FMI 3.0 model description and platform folders)."""
+    FMI 3.0 layer, the FMI 3.0 model description and platform folders). ``axles``: a rover FMU
+    built for that many wheels per side (:func:`source.variant_source`; None: the package's own)."""
     _check_version(fmi_version)
+    if axles is not None:
+        source.variant_source(name, axles)  # a clear error for a model or count it cannot take
+    variant = "" if axles is None or axles == source.DEFAULT_AXLES else f"-axles{axles}"
     started = time.perf_counter()
     out_dir = Path(out_dir)
     target = out_dir / f"{name}.fmu"
     chosen = targets(platforms)
-    digest = platforms_digest(name, chosen) + ("" if fmi_version == 2 else f"-fmi{fmi_version}")
+    digest = platforms_digest(name, chosen) + ("" if fmi_version == 2 else f"-fmi{fmi_version}") + variant
     if not force and target.exists() and stored_digest(target) == digest:
         return BuildResult(name, target, False, time.perf_counter() - started)
     stages: dict[str, float] = {}
     with tempfile.TemporaryDirectory(prefix=f"fmubuild-{name}-") as tmp_name:
         tmp = Path(tmp_name)
         t0 = time.perf_counter()
-        model = ode.translate(source.load(source.fmu_class(name)), name)
+        loaded = source.load_variant(name, axles) if variant and axles else source.load(source.fmu_class(name))
+        model = ode.translate(loaded, name)
         model_layout = codegen.layout(model)
         stages["translate"] = time.perf_counter() - t0
         if step:
@@ -286,6 +292,8 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
         optional = [v for v in model.inputs if model.variables[v].start is not None]
         host = [t for t in chosen if "-target" not in t.command]
         record = {"input_sha256": digest, "backend": "builtin", "model": source.fmu_class(name),
+                  **({"structural": {"rover.nAxles": axles}, "variant_source": source.variant_source(name, axles)}
+                     if variant and axles is not None else {}),
                   "optional_inputs": optional,
                   "guid": guid, "rover_cosim": version,
                   "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")},

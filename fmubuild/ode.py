@@ -447,7 +447,8 @@ def _fold_subscripts(node: Any, parameters: _Parameters, name: str) -> None:
         folded = []
         for sub in ref["subscripts"]:
             try:
-                folded.append({"Index": {"value": subscript_values([sub], evaluate, where)[0]}} if "Expr" in sub else sub)
+                value = subscript_values([sub], evaluate, where)[0] if "Expr" in sub else None
+                folded.append(sub if value is None else {"Index": {"value": value}})
             except (UnsupportedConstruct, KeyError):  # a run-time subscript: refused where it is used
                 folded.append(sub)
         ref["subscripts"] = folded

@@ -57,6 +57,35 @@ def load(name: str):  # -> rumoca.Model (rumoca has no type stubs)
     return session.load(str(package_file()), model=name)
 
 
+#: The FMUs whose number of wheels is a structural parameter (``rover.nAxles``, wheels per side).
+ROVER_MODELS = ("Rover", "RoverBody", "SteerableRover", "SteerableRoverBody")
+#: The package's own number of wheels per side: the FMUs of ``make fmus``.
+DEFAULT_AXLES = 3
+
+
+def variant_source(name: str, axles: int) -> str:
+    """Modelica source of the FMU ``name`` built for ``axles`` wheels per side: a class of the same
+    name extending the package's, with ``rover.nAxles`` and start positions ``rover.xLimb`` of that
+    size (evenly spaced from +1.5 to -1.5 m; a rover sets its own at run time)."""
+    if name not in ROVER_MODELS:
+        raise ValueError(f"model {name!r}: the number of wheels is a parameter of {', '.join(ROVER_MODELS)} only")
+    if isinstance(axles, bool) or not isinstance(axles, int) or not 1 <= axles <= 16:
+        raise ValueError(f"axles = {axles!r}: expected 1 to 16 wheels per side")
+    positions = [0.0] if axles == 1 else [1.5 - 3.0 * i / (axles - 1) for i in range(axles)]
+    return (f'model {name} "{name} with {2 * axles} wheels ({axles} per side)"\n'
+            f"  extends {fmu_class(name)}(rover(nAxles={axles}, xLimb={{{', '.join(map(repr, positions))}}}));\n"
+            f"end {name};\n")
+
+
+def load_variant(name: str, axles: int):  # -> rumoca.Model
+    """:func:`load` of the FMU class ``name`` built for ``axles`` wheels per side (:func:`variant_source`)."""
+    import rumoca
+
+    text = variant_source(name, axles)
+    session = rumoca.Session(roots=[str(catalog.MODELICA_ROOT)])
+    return session.loads(text, model=name, filename=f"{name}_{axles}axles.mo")
+
+
 @dataclass(frozen=True)
 class Experiment:
     """The ``experiment`` annotation of a model: times in seconds."""

@@ -207,16 +207,19 @@ def lateral_table(runs: dict[Case, pd.DataFrame]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def fit_points(table: pd.DataFrame) -> pd.DataFrame:
-    """The rows that enter the fits: rolling, torque <= FIT_TORQUE_MAX, slip in SLIP_FIT_RANGE."""
-    keep = (table["rolling"].astype(bool) & (table["torque_N_m"] <= FIT_TORQUE_MAX)
+def fit_points(table: pd.DataFrame, torque_max: float = FIT_TORQUE_MAX) -> pd.DataFrame:
+    """The rows that enter the fits: rolling, torque <= ``torque_max`` [N·m] (the plan's; the
+    paper's FIT_TORQUE_MAX), slip in SLIP_FIT_RANGE."""
+    keep = (table["rolling"].astype(bool) & (table["torque_N_m"] <= torque_max)
             & (table["slip"] >= SLIP_FIT_RANGE[0]) & (table["slip"] <= SLIP_FIT_RANGE[1]))
     return table[keep]
 
 
-def identify_lateral(table: pd.DataFrame, form: LateralForm = RECOMMENDED_FORM) -> LateralModel:
-    """The model of ``form`` by linear least squares over the settled points of all loads."""
-    points = fit_points(table)
+def identify_lateral(table: pd.DataFrame, form: LateralForm = RECOMMENDED_FORM,
+                     torque_max: float = FIT_TORQUE_MAX) -> LateralModel:
+    """The model of ``form`` by linear least squares over the settled points of all loads (torques
+    up to ``torque_max`` [N·m])."""
+    points = fit_points(table, torque_max)
     if points["load_N"].nunique() < form.load_degree + 1:
         raise ValueError(f"{points['load_N'].nunique()} loads with usable lateral runs, need "
                          f"{form.load_degree + 1} for coefficients of degree {form.load_degree} in W")
@@ -228,10 +231,11 @@ def identify_lateral(table: pd.DataFrame, form: LateralForm = RECOMMENDED_FORM) 
     return LateralModel(form, solution.reshape(form.shape()) * unscale)
 
 
-def per_load_coefficients(table: pd.DataFrame, form: LateralForm = RECOMMENDED_FORM) -> pd.DataFrame:
+def per_load_coefficients(table: pd.DataFrame, form: LateralForm = RECOMMENDED_FORM,
+                          torque_max: float = FIT_TORQUE_MAX) -> pd.DataFrame:
     """Per load, the c_ik of ``form`` fitted to that load's points alone: load_N, c{i}{k} [N]."""
     rows = []
-    for load, part in fit_points(table).groupby("load_N"):
+    for load, part in fit_points(table, torque_max).groupby("load_N"):
         design = form.columns(part["load_N"].to_numpy(), np.radians(part["slip_angle_deg"].to_numpy()),
                               part["slip"].to_numpy(), with_load=False)
         solution, *_ = np.linalg.lstsq(design, part["Fy_N"].to_numpy(), rcond=None)
@@ -241,18 +245,18 @@ def per_load_coefficients(table: pd.DataFrame, form: LateralForm = RECOMMENDED_F
     return pd.DataFrame(rows)
 
 
-def training_rms(model: LateralModel, table: pd.DataFrame) -> float:
+def training_rms(model: LateralModel, table: pd.DataFrame, torque_max: float = FIT_TORQUE_MAX) -> float:
     """RMS [N] of the model against the fitted settled points."""
-    points = fit_points(table)
+    points = fit_points(table, torque_max)
     predicted = model.fy(points["load_N"].to_numpy(), np.radians(points["slip_angle_deg"].to_numpy()),
                          points["slip"].to_numpy())
     return float(math.sqrt(np.mean((predicted - points["Fy_N"].to_numpy()) ** 2)))
 
 
-def ishigami_trends(table: pd.DataFrame) -> pd.DataFrame:
+def ishigami_trends(table: pd.DataFrame, torque_max: float = FIT_TORQUE_MAX) -> pd.DataFrame:
     """The side-force trends Ishigami et al. (2007) report from their single-wheel experiments,
     measured on the sweep's fitted points: trend, holds (bool), measured (what was compared)."""
-    points = fit_points(table).assign(magnitude=lambda t: t["Fy_N"].abs())
+    points = fit_points(table, torque_max).assign(magnitude=lambda t: t["Fy_N"].abs())
     rises, levels, falls, grows = [], [], [], []
     for _, part in points.groupby(["load_N", "torque_N_m"]):
         ordered = part.sort_values("slip_angle_deg")["magnitude"].to_numpy()

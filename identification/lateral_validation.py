@@ -22,7 +22,7 @@ import pandas as pd
 from .fits import fit_percent
 from .lateral import LateralModel
 from .testbed import Staircase, WheelTestBed
-from .validate import HOLD, SAMPLE_TIME, START_SPEED, VALIDATION_LOADS, staircase
+from .validate import HOLD, SAMPLE_TIME, START_SPEED, VALIDATION_LOADS, VALIDATION_TORQUES, staircase
 
 LATERAL_VALIDATION_ANGLES_DEG = (7.5, 12.5)
 
@@ -40,9 +40,11 @@ def track_turns(angle: float, levels: int) -> Staircase:
 
 
 def validate_lateral(bed: WheelTestBed, models: dict[str, LateralModel], loads: tuple[float, ...] = VALIDATION_LOADS,
-                     angles_deg: tuple[float, ...] = LATERAL_VALIDATION_ANGLES_DEG) -> LateralValidation:
-    """``models`` by label; the first is reported as ``fit_percent``."""
-    torque = staircase()
+                     angles_deg: tuple[float, ...] = LATERAL_VALIDATION_ANGLES_DEG,
+                     torques: tuple[float, ...] = VALIDATION_TORQUES) -> LateralValidation:
+    """``models`` by label; the first is reported as ``fit_percent``. ``loads`` [N] and
+    ``torques`` [N·m]: the plan's (the paper's by default)."""
+    torque = staircase(torques)
     levels = len(torque.levels)
     stop = HOLD * levels - SAMPLE_TIME
     runs, fits, detail = {}, [], []

@@ -35,16 +35,19 @@ class Validation:
     detail: pd.DataFrame              # per load and torque level
 
 
-def staircase() -> TorqueProfile:
-    return TorqueProfile.staircase(VALIDATION_TORQUES, HOLD)
+def staircase(torques: tuple[float, ...] = VALIDATION_TORQUES) -> TorqueProfile:
+    """The validation staircase through ``torques`` [N·m], each held HOLD."""
+    return TorqueProfile.staircase(tuple(torques), HOLD)
 
 
 def validate(bed: WheelTestBed, models: dict[str, IdentifiedModel],
-             loads: tuple[float, ...] = VALIDATION_LOADS) -> Validation:
+             loads: tuple[float, ...] = VALIDATION_LOADS,
+             torques: tuple[float, ...] = VALIDATION_TORQUES) -> Validation:
     """``models`` by label (e.g. "linear", "quadratic"); the first is the one reported as
-    ``fit_percent``, each also gets its own column."""
-    profile = staircase()
-    stop = HOLD * len(VALIDATION_TORQUES) - SAMPLE_TIME
+    ``fit_percent``, each also gets its own column. ``loads`` [N] and ``torques`` [N·m]: the
+    plan's (the paper's Table 1 by default)."""
+    profile = staircase(torques)
+    stop = HOLD * len(torques) - SAMPLE_TIME
     runs, fits, detail = {}, [], []
     for load in loads:
         run = bed.run(load, profile, stop, SAMPLE_TIME, start_speed=START_SPEED)
@@ -62,7 +65,7 @@ def validate(bed: WheelTestBed, models: dict[str, IdentifiedModel],
             row[f"slip_fit_percent_{label}"] = fit_percent(slip, run["slip"].to_numpy())
         row["paper_fit_percent"] = PAPER_FIT.get(load, float("nan"))
         fits.append(row)
-        for level_index, level in enumerate(VALIDATION_TORQUES):
+        for level_index, level in enumerate(torques):
             segment = (time >= level_index * HOLD + HOLD / 2) & (time < (level_index + 1) * HOLD)
             entry = {"load_N": load, "torque_N_m": level, "Fx_plant_N": float(run["Fx"][segment].mean()),
                      "slip_plant": float(run["slip"][segment].mean())}

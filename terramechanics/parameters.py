@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 FloatArray = NDArray[np.float64]
 
 
-def _check(name: str, value: float, ok: bool, expected: str) -> None:
+def _check(name: str, value: object, ok: bool, expected: str) -> None:
     """Raise ValueError naming the field, its value and the accepted range unless ``ok``."""
     if not ok:
         raise ValueError(f"{name}={value!r} is not physical: expected {expected}")
@@ -182,3 +182,81 @@ class Soil:
     def bekker_modulus(self, b: float) -> float:
         """k = kc / b + kphi [N/m^(n+2)], the Bekker pressure-sinkage modulus for width b [m]."""
         return self.kc / b + self.kphi
+
+
+@dataclass(frozen=True)
+class Rover:
+    """A rover's body and limbs: what the rover FMUs (Modelica ``RoverParameters``) take besides the
+    soil and wheel. The wheels sit on two mirrored sides, ``len(x_limb)`` per side: wheels
+    1..n on the left from front to rear, n+1..2n on the right at the same x. The gravity is the
+    soil's (``Soil.gravity``): where the rover drives.
+
+    Attributes:
+        mass: total mass carried by the limbs [kg] (paper Sec. 4: 1570 kg).
+        Iyy: pitch moment of inertia about the centre of gravity [kg·m²].
+        Ixx: roll moment of inertia [kg·m²] (the steerable rover).
+        Izz: yaw moment of inertia [kg·m²] (the steerable rover).
+        h_cog: height of the centre of gravity above the wheel hubs [m].
+        x_limb: longitudinal hub positions of one side, front to rear, from the centre of gravity [m].
+        y_limb: lateral hub position of the left side, half the track width [m].
+        k_limb: vertical stiffness of one limb [N/m].
+        d_limb: vertical damping of one limb [N·s/m].
+    """
+
+    mass: float = 1570.0
+    Iyy: float = 1120.0
+    Ixx: float = 1120.0
+    Izz: float = 1980.0
+    h_cog: float = 1.0
+    x_limb: tuple[float, ...] = (1.5, 0.0, -1.5)
+    y_limb: float = 1.5
+    k_limb: float = 2.0e4
+    d_limb: float = 2.0e3
+
+    def __post_init__(self) -> None:
+        positions = self.x_limb
+        if isinstance(positions, (str, bytes)) or not hasattr(positions, "__iter__"):
+            raise TypeError(f"x_limb={positions!r}: expected a list of hub positions [m], front to rear")
+        values: list[float] = []
+        for value in positions:
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+                raise TypeError(f"x_limb={list(positions)!r}: expected finite numbers [m]")
+            values.append(float(value))
+        _check("x_limb", values, 1 <= len(values) <= 16, "1 to 16 hub positions per side [m]")
+        _check("x_limb", values, all(a > b for a, b in zip(values, values[1:])),
+               "positions from front to rear, strictly decreasing [m]")
+        object.__setattr__(self, "x_limb", tuple(values))
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "x_limb":
+                continue
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise TypeError(f"{f.name}={value!r}: expected a real number")
+            _check(f.name, value, math.isfinite(float(value)), "a finite number")
+            object.__setattr__(self, f.name, float(value))
+        _check("mass", self.mass, self.mass > 0, "mass > 0 kg")
+        for name in ("Iyy", "Ixx", "Izz"):
+            _check(name, getattr(self, name), getattr(self, name) > 0, f"{name} > 0 kg·m²")
+        _check("h_cog", self.h_cog, self.h_cog >= 0, "h_cog >= 0 m (the centre of gravity at or above the hubs)")
+        _check("y_limb", self.y_limb, self.y_limb > 0, "y_limb > 0 m")
+        _check("k_limb", self.k_limb, self.k_limb > 0, "k_limb > 0 N/m")
+        _check("d_limb", self.d_limb, self.d_limb >= 0, "d_limb >= 0 N·s/m")
+
+    @property
+    def axles(self) -> int:
+        """Wheels per side."""
+        return len(self.x_limb)
+
+    @property
+    def wheels(self) -> int:
+        """Number of wheels: two sides of :attr:`axles`."""
+        return 2 * len(self.x_limb)
+
+    def static_wheel_load(self, gravity: float) -> float:
+        """The mean load of a wheel at rest on level ground, M g / N [N], under ``gravity`` [m/s²]."""
+        return self.mass * gravity / self.wheels
+
+
+#: The unit of every Rover field.
+ROVER_UNITS = {"mass": "kg", "Iyy": "kg.m^2", "Ixx": "kg.m^2", "Izz": "kg.m^2", "h_cog": "m", "x_limb": "m",
+               "y_limb": "m", "k_limb": "N/m", "d_limb": "N.s/m"}

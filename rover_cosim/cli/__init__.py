@@ -18,8 +18,8 @@ from .systems import EXAMPLES as EXAMPLES  # noqa: F401 - the shipped example sy
 
 #: The commands, one module of this package each (its ``COMMAND``), in the order ``--help`` lists
 #: them: a new command is a new module and its line here.
-MODULES = ("fig3", "run", "export_ssp", "cosim_study", "identify", "simulate", "montecarlo", "soils", "blocks",
-           "estimate_soil", "testbed_data", "report", "build_fmus")
+MODULES = ("fig3", "run", "export_ssp", "cosim_study", "identify", "simulate", "montecarlo", "soils", "rovers",
+           "blocks", "estimate_soil", "testbed_data", "report", "build_fmus")
 
 #: Each command by its name.
 COMMANDS: dict[str, Command] = {

@@ -29,6 +29,11 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--record-interval", type=float, default=0.001,
                         help="rows kept in runs.csv [s] (a whole number of the sweep's 0.1 ms samples; default "
                         "0.001; 0.0001: every sample); the fits use every sample")
+    parser.add_argument("--plan", type=path, default=None, metavar="FILE",
+                        help="the identification plan as a TOML file (loads, torques, fit_torque_max, "
+                        "validation_loads, validation_torques; SI). Default: the paper's for the paper's soil, wheel "
+                        "and rover, else the paper's scaled to the rover's static wheel load and the wheel's torque "
+                        "on the soil (printed before the sweep)")
     add_soil_options(parser)
     add_quiet(parser)
 
@@ -56,6 +61,27 @@ def _not_a_test_bed(fmu: Path) -> str | None:
         return f"its modelDescription.xml cannot be read ({error})"
 
 
+def plan_of(args: argparse.Namespace, choice: object) -> object:
+    """The identification plan (--plan, or the one for the choice), said before the sweep; None
+    after saying why there is none (a plan file it cannot read, a rover that cannot be driven)."""
+    from rover_cosim.identification.plan import NotDrivable, plan_for, read_plan
+
+    try:
+        plan = read_plan(args.plan) if args.plan is not None else plan_for(choice)  # type: ignore[arg-type]
+    except NotDrivable as error:
+        fail("identify", f"not drivable: {error} (nothing run)")
+        return None
+    except ValueError as error:
+        fail("identify", f"--plan: {error}")
+        return None
+    if not plan.is_paper:
+        print(f"identification plan: {plan.basis}")
+        print(f"  loads {', '.join(f'{w:g}' for w in plan.loads)} N; torques {', '.join(f'{t:g}' for t in plan.torques)}"
+              f" N·m; fits: torque <= {plan.fit_torque_max:g} N·m, slip in {plan.slip_window}; validation at "
+              f"{', '.join(f'{w:g}' for w in plan.validation_loads)} N")
+    return plan
+
+
 def run(args: argparse.Namespace) -> int:
     from rover_cosim.jobs.identify import check_record_interval, run_identification
 
@@ -79,9 +105,12 @@ def run(args: argparse.Namespace) -> int:
     choice = choice_of(args, "identify")
     if choice is None:
         return 2
+    plan = plan_of(args, choice)
+    if plan is None:
+        return 2
     outcome = with_progress("identify", "sweep", args.quiet, lambda bar: run_identification(
         args.fmu, args.out, workers=args.workers, scheduler=args.scheduler, cache_dir=args.cache, progress=bar,
-        choice=choice, record_interval=args.record_interval, run_timeout=args.run_timeout),
+        choice=choice, record_interval=args.record_interval, run_timeout=args.run_timeout, identification=plan),
         (OSError, RuntimeError, ValueError))
     if outcome is None:
         return 1

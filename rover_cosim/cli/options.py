@@ -104,14 +104,19 @@ def figure_formats(text: str) -> tuple[str, ...]:
 
 
 def add_soil_options(parser: argparse.ArgumentParser) -> None:
-    """--soil, --wheel and --set: the soil and wheel a command runs on."""
+    """--soil, --wheel, --rover and --set: the soil, wheel and rover a command runs on."""
     parser.add_argument("--soil", type=path_text, default=None, help="soil: a name of the shipped library "
                         "(rover-cosim soils lists them), a TOML file, or FILE:NAME (default: paper)")
     parser.add_argument("--wheel", type=path_text, default=None,
-                        help="wheel: a name of the shipped library, a TOML file, or FILE:NAME (default: paper)")
+                        help="wheel: a name of the shipped library, a TOML file, or FILE:NAME (default: the rover's "
+                        "wheel; the paper's)")
+    parser.add_argument("--rover", type=path_text, default=None,
+                        help="rover: a name of the shipped library (rover-cosim rovers lists them), a TOML file, or "
+                        "FILE:NAME (default: paper); its wheel unless --wheel names one")
     parser.add_argument("--set", dest="assignments", action="append", default=[], metavar="KIND.NAME=VALUE",
                         help="change one value, SI units or *_deg for angles: --set soil.c=500 "
-                        "--set soil.phi_deg=30 --set wheel.b=0.2 (repeatable)")
+                        "--set soil.phi_deg=30 --set wheel.b=0.2 --set rover.mass=740 --set rover.x_limb=1.2,-1.2 "
+                        "(repeatable)")
 
 
 def add_out(parser: argparse.ArgumentParser, default: str, help: str = "output folder") -> None:  # noqa: A002
@@ -159,11 +164,11 @@ def fail(command: str, message: str) -> None:
 
 
 def choice_of(args: argparse.Namespace, command: str) -> Any:
-    """The soil and wheel of the command line (terramechanics.library.Choice), or None after saying why not."""
+    """The soil, wheel and rover of the command line (terramechanics.library.Choice), or None after saying why not."""
     from rover_cosim.terramechanics.library import choose
 
     try:
-        return choose(args.soil, args.wheel, args.assignments)
+        return choose(args.soil, args.wheel, args.assignments, getattr(args, "rover", None))
     except (ValueError, TypeError) as error:
         fail(command, str(error))
         return None

@@ -55,12 +55,14 @@ class Campaign:
             found[name] = next(iter(values.values())) if len(set(values.values())) == 1 else values
         return found
 
-    def record(self, parameters: Mapping[str, Any], *, fmu_dir: Path, fmus: Collection[str], model: Path,
+    def record(self, parameters: Mapping[str, Any], *, fmu_dir: Path, fmus: Collection[str | Path], model: Path,
                choice: Choice, mismatch: str | None, **results: Any) -> dict[str, Any]:
         """The job's record: ``parameters`` with the master's settings (``settings``); the FMUs'
-        and the model's SHA-256; the soil and wheel; the systems; the wall times; then ``results``."""
+        (names in ``fmu_dir``, or paths: an FMU built for the rover's wheel count is recorded as
+        ``wheels4/Rover``) and the model's SHA-256; the soil, wheel and rover; the systems; the wall
+        times; then ``results``."""
         record: dict[str, Any] = run_record(self.command, {**parameters, **self.settings()})
-        record.update({"fmus": {name: file_sha256(Path(fmu_dir) / f"{name}.fmu") for name in fmus},
+        record.update({"fmus": {_fmu_key(fmu, fmu_dir): file_sha256(_fmu_path(fmu, fmu_dir)) for fmu in fmus},
                        "model_sha256": file_sha256(model), "run_wall_seconds": self.walls, **describe(choice),
                        "model_mismatch": mismatch, "systems": self.systems,
                        "wall_seconds": time.perf_counter() - self.started, **results})
@@ -71,3 +73,17 @@ class Campaign:
         job's earlier files to remove); the files, sorted."""
         write_all(files, folder=Path(out), stale=stale)
         return sorted(files)
+
+
+def _fmu_path(fmu: str | Path, fmu_dir: Path) -> Path:
+    return fmu if isinstance(fmu, Path) else Path(fmu_dir) / f"{fmu}.fmu"
+
+
+def _fmu_key(fmu: str | Path, fmu_dir: Path) -> str:
+    """How the record names an FMU: its name, or its path under ``fmu_dir`` without ``.fmu``."""
+    if not isinstance(fmu, Path):
+        return fmu
+    try:
+        return Path(fmu).resolve().relative_to(Path(fmu_dir).resolve()).with_suffix("").as_posix()
+    except ValueError:
+        return str(fmu)

@@ -35,7 +35,7 @@ import pandas as pd
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.rows import csv_bytes, every, steps_between_rows
 from rover_cosim.identification import figures, lateral_figures
-from rover_cosim.identification.fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE, fx_per_load, identify, step_table
+from rover_cosim.identification.fits import SLIP_FIT_RANGE, fx_per_load, identify, step_table
 from rover_cosim.identification.lateral import (
     FORMS,
     LATERAL_SAMPLE_TIME,
@@ -49,6 +49,7 @@ from rover_cosim.identification.lateral import (
 )
 from rover_cosim.identification.lateral_validation import LateralValidation, validate_lateral
 from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.identification.plan import IdentificationPlan, plan_for
 from rover_cosim.identification.sweep import SweepOutcome, SweepPlan, run_sweep
 from rover_cosim.identification.testbed import RECORDED, shared_test_bed
 from rover_cosim.identification.validate import validate
@@ -99,7 +100,8 @@ def _long(runs: dict, columns: list[str], interval: float | None = None, sample_
 
 
 def _lateral_files(out: Path, sweep: SweepOutcome, table: pd.DataFrame, models: dict[str, LateralModel],
-                   validation: LateralValidation) -> tuple[dict[Path, bytes], pd.DataFrame]:
+                   validation: LateralValidation, middle: float,
+                   torque_max: float) -> tuple[dict[Path, bytes], pd.DataFrame]:
     """lateral_*.csv and the lateral figures (``table``: the sweep's lateral_table), and the fit table."""
     recommended = next(iter(models.values()))
     detail = validation.detail
@@ -110,7 +112,7 @@ def _lateral_files(out: Path, sweep: SweepOutcome, table: pd.DataFrame, models: 
     fit = fit.rename(columns={"error": "max_settled_error_N", "relative": "max_settled_error_percent"})
     forms = pd.DataFrame([{"form": name, "basis": m.form.basis, "scales_deg": " ".join(map(str, m.form.scales_deg)),
                            "slip_degree": m.form.slip_degree, "load_degree": m.form.load_degree,
-                           "coefficients": m.coefficients.size, "training_rms_N": training_rms(m, table),
+                           "coefficients": m.coefficients.size, "training_rms_N": training_rms(m, table, torque_max),
                            "min_fit_percent": validation.fit[f"fit_percent_{name}"].min(),
                            "mean_fit_percent": validation.fit[f"fit_percent_{name}"].mean()}
                           for name, m in models.items()])
@@ -121,12 +123,13 @@ def _lateral_files(out: Path, sweep: SweepOutcome, table: pd.DataFrame, models: 
         out / "lateral_fit_table.csv": fit.to_csv(index=False, float_format="%.3f").encode(),
         out / "lateral_fit_detail.csv": detail.to_csv(index=False, float_format="%.6g").encode(),
         out / "lateral_forms.csv": forms.to_csv(index=False, float_format="%.4g").encode(),
-        out / "lateral_trends.csv": ishigami_trends(table).to_csv(index=False).encode(),
+        out / "lateral_trends.csv": ishigami_trends(table, torque_max).to_csv(index=False).encode(),
         out / "fig_lateral_fy.png": lateral_figures.fy_against_beta_and_slip(table, recommended),
         out / "fig_lateral_coefficients.png":
-            lateral_figures.coefficient_curves(per_load_coefficients(table, recommended.form), recommended),
+            lateral_figures.coefficient_curves(per_load_coefficients(table, recommended.form, torque_max),
+                                               recommended),
         out / "fig_lateral_validation_575N.png":
-            lateral_figures.validation_run(validation.runs[575.0, 12.5], 575.0, 12.5, recommended.form.name),
+            lateral_figures.validation_run(validation.runs[middle, 12.5], middle, 12.5, recommended.form.name),
     }, fit
 
 
@@ -135,22 +138,39 @@ def check_record_interval(record_interval: float, plan: SweepPlan | None = None)
     steps_between_rows(record_interval, (plan or SweepPlan()).sample_time)
 
 
+def identification_plan(choice: Choice, plan: SweepPlan | None = None,
+                        given: IdentificationPlan | None = None) -> IdentificationPlan:
+    """The plan of a run: ``given``; else the loads and torques of an explicit sweep ``plan`` with
+    the paper's fits and validation; else the plan for the choice (``plan.plan_for``: the paper's
+    for the paper's soil, wheel and rover; NotDrivable before any sweep where it cannot be driven)."""
+    if given is not None:
+        return given
+    if plan is not None:
+        return IdentificationPlan(loads=plan.loads, torques=plan.torques, basis="the sweep plan given in code")
+    return plan_for(choice)
+
+
 def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None = None,
                        lateral_plan: SweepPlan | None = None, workers: int | None = None,
                        scheduler: str | None = None, cache_dir: Path | None = None,
                        progress: Callable[[float], None] | None = None,
                        choice: Choice | Soil | Wheel | None = None,
                        record_interval: float = RECORD_INTERVAL,
-                       run_timeout: float | None = None) -> IdentificationResult:
+                       run_timeout: float | None = None,
+                       identification: IdentificationPlan | None = None) -> IdentificationResult:
     """Sweep, fit, validate and write every file of ``results/identification/`` (all or none):
     the paper's longitudinal model (``plan``) and the lateral model (``lateral_plan``), on the
-    soil and wheel of ``choice`` (default: the paper's). runs.csv keeps a row every
-    ``record_interval`` [s] of each run (a whole number of the plan's samples)."""
+    soil, wheel and rover of ``choice`` (default: the paper's), by the ``identification`` plan
+    (loads, torques, fits and validation; default :func:`identification_plan`). runs.csv keeps a
+    row every ``record_interval`` [s] of each run (a whole number of the plan's samples)."""
     started = time.perf_counter()
     choice = as_choice(choice)
-    plan = replace(plan or SweepPlan(), soil=choice.soil, wheel=choice.wheel)
+    ident = identification_plan(choice, plan, identification)
+    plan = replace(plan or SweepPlan(), loads=ident.loads, torques=ident.torques, soil=choice.soil,
+                   wheel=choice.wheel)
     check_record_interval(record_interval, plan)  # a bad interval refused before anything runs
-    lateral_plan = replace(lateral_plan or LATERAL_PLAN, soil=choice.soil, wheel=choice.wheel)
+    lateral_plan = replace(lateral_plan or replace(LATERAL_PLAN, loads=ident.loads, torques=ident.torques),
+                           soil=choice.soil, wheel=choice.wheel)
     cache_dir = cache_dir or out_dir / "cache"
     first, second = len(plan.cases()), len(lateral_plan.cases())
 
@@ -162,14 +182,16 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     sweep = _sweep(fmu_path, plan, cache_dir, workers, scheduler, share(0, first), run_timeout)
     lateral_sweep = _sweep(fmu_path, lateral_plan, cache_dir, workers, scheduler, share(first, second), run_timeout)
     table = step_table(sweep.at_slip_angle(0.0))
-    models = {label: identify(table, degree) for label, degree in MODELS.items()}
-    per_load = fx_per_load(table, 1)
+    torque_max = ident.fit_torque_max
+    models = {label: identify(table, degree, torque_max) for label, degree in MODELS.items()}
+    per_load = fx_per_load(table, 1, torque_max)
     bed = shared_test_bed(Path(fmu_path))
     bed.parameters = plan.parameters
-    validation = validate(bed, models)
+    validation = validate(bed, models, ident.validation_loads, ident.validation_torques)
     lateral_table_ = lateral_table(lateral_sweep.runs)
-    lateral_models = {form.name: identify_lateral(lateral_table_, form) for form in FORMS}
-    lateral_validation = validate_lateral(bed, lateral_models)
+    lateral_models = {form.name: identify_lateral(lateral_table_, form, torque_max) for form in FORMS}
+    lateral_validation = validate_lateral(bed, lateral_models, ident.validation_loads,
+                                          torques=ident.validation_torques)
 
     long = _long(sweep.runs, ["load_N", "torque_N_m", "time", "tau", *[c for c in RECORDED if c not in ("Fy", "beta")]],
                  record_interval, plan.sample_time)
@@ -181,8 +203,9 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     fmu_sha = file_sha256(Path(fmu_path))
     model_set = ModelSet(RECOMMENDED, models, recommended_lateral, {
         "lut_interpolation": "linear in 1/W and tau, extended linearly beyond the grid",
-        "fx_fit": {"torque_max_N_m": FIT_TORQUE_MAX, "slip_range": list(SLIP_FIT_RANGE)},
+        "fx_fit": {"torque_max_N_m": torque_max, "slip_range": list(SLIP_FIT_RANGE)},
         "plan": asdict(plan),
+        "identification_plan": ident.to_dict(),
         "fmu": {"path": str(fmu_path), "sha256": fmu_sha},
         **describe(choice),
         "failures": len(sweep.failures),
@@ -192,6 +215,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
     })
     fit_models = validation.fit.drop(columns=["fit_percent"])
     record = run_record("rover-cosim identify", {"plan": asdict(plan), "lateral_plan": asdict(lateral_plan),
+                                                 "identification_plan": ident.to_dict(),
                                                  "workers": workers, "scheduler": scheduler,
                                                  "record_interval_s": record_interval})
     record.update({**describe(choice), "fmu_sha256": fmu_sha, "runs_computed": sweep.computed + lateral_sweep.computed,
@@ -199,6 +223,7 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
                    "runs_failed": len(failed), "sweep_wall_seconds": sweep.wall_seconds + lateral_sweep.wall_seconds,
                    "wall_seconds": time.perf_counter() - started, "cache_folder": str(sweep.cache_folder)})
     out = Path(out_dir)
+    middle = ident.validation_loads[len(ident.validation_loads) // 2]  # 575 N: the paper's Fig. 8
     files = {
         out / "runs.csv": csv_bytes(long, "%.10g"),
         out / "steps.csv": table.to_csv(index=False, float_format="%.10g").encode(),
@@ -213,14 +238,14 @@ def run_identification(fmu_path: Path, out_dir: Path, *, plan: SweepPlan | None 
                                                           "Fig. 6: slope a of Fx = a slip + b against load"),
         out / "fig7_b_of_W.png": figures.fig_coefficient(per_load, models["linear"], 0, "b(W)", "N",
                                                           "Fig. 7: offset b of Fx = a slip + b against load"),
-        out / "fig8_validation_575N.png": figures.fig8_validation(validation.runs[575.0], 575.0, list(MODELS),
+        out / "fig8_validation_575N.png": figures.fig8_validation(validation.runs[middle], middle, list(MODELS),
                                                                   soil_label(choice)),
         out / "fig_model_coefficients.png":
             figures.fig_model_coefficients(fx_per_load(table, MODELS[RECOMMENDED]), models[RECOMMENDED]),
         out / "identification.json": json_bytes(record),
     }
     lateral_files, lateral_fit = _lateral_files(out, lateral_sweep, lateral_table_, lateral_models,
-                                                lateral_validation)
+                                                lateral_validation, middle, torque_max)
     files.update(lateral_files)
     write_all(files, folder=out, stale=("*.png", "*.pdf", "*.svg"))  # its figures: all written anew
     return IdentificationResult(sorted(files), validation.fit, sweep, record, json.loads(files[out / "model.json"]),

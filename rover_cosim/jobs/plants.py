@@ -16,12 +16,35 @@ from functools import cache
 from pathlib import Path
 
 from rover_cosim.orchestrator.builder import SystemBuilder
-from rover_cosim.terramechanics.library import Choice, fmu_parameters
+from rover_cosim.terramechanics.library import Choice, fmu_parameters, rover_parameters
+
+#: The rover FMUs' own number of wheels (``make fmus``): other rovers get FMUs built for theirs.
+PACKAGE_WHEELS = 6
 
 
 def soil_values(choice: Choice | None) -> dict[str, float]:
-    """The FMU parameters of the chosen soil and wheel (none without a choice: the FMUs' defaults)."""
-    return fmu_parameters(choice.soil, choice.wheel) if choice is not None else {}
+    """The FMU parameters of the chosen soil, wheel and rover (none without a choice: the FMUs'
+    defaults); the rover's gravity is the soil's. An FMU takes those it has."""
+    if choice is None:
+        return {}
+    return {**fmu_parameters(choice.soil, choice.wheel), **rover_parameters(choice.rover, choice.soil.gravity)}
+
+
+def rover_fmu(fmu_dir: str | Path, name: str, choice: Choice | None) -> Path:
+    """The rover FMU ``name`` (Rover, RoverBody, SteerableRover, SteerableRoverBody) for the rover of
+    ``choice``: ``fmu_dir/NAME.fmu`` where it has the rover's number of wheels (the package's six;
+    a missing one is the caller's to report), else ``fmu_dir/wheels<N>/NAME.fmu``, built on demand
+    from the Modelica source for N wheels and kept (rebuilt only when its inputs change)."""
+    path = Path(fmu_dir) / f"{name}.fmu"
+    wheels = choice.rover.wheels if choice is not None else PACKAGE_WHEELS
+    if wheels == PACKAGE_WHEELS and (not path.is_file() or len(hubs(path)) == wheels):
+        return path
+    if path.is_file() and len(hubs(path)) == wheels:
+        return path
+    from rover_cosim.fmubuild.build import build_fmu
+
+    folder = Path(fmu_dir) / f"wheels{wheels}"
+    return build_fmu(name, folder, axles=wheels // 2).path
 
 
 def add_plant_fmu(builder: SystemBuilder, name: str, path: str | Path, choice: Choice | None,
@@ -54,7 +77,7 @@ def add_rover(builder: SystemBuilder, body_fmu: str | Path, wheel_fmu: str | Pat
               wheel_start: Mapping[str, float] | None = None, wire: bool = True) -> list[str]:
     """A body and ``wheels`` wheel instances (``wheel1`` ...) on the chosen soil, their hubs wired
     unless ``wire`` is False (to wire them in another order); returns the wheels' names."""
-    add_plant_fmu(builder, body, body_fmu, None, body_start)
+    add_plant_fmu(builder, body, body_fmu, choice, body_start)
     names = [f"wheel{i}" for i in range(1, wheels + 1)]
     for name in names:
         add_plant_fmu(builder, name, wheel_fmu, choice, wheel_start)

@@ -1,11 +1,12 @@
 """``make simulate``: the closed-loop rover of the paper's Sec. 4 on two plants, 20 s at 1 ms,
-Gauss-Seidel: the monolithic Rover.fmu and the co-simulated RoverBody + 6 Wheel.
+Gauss-Seidel: the monolithic Rover.fmu and the co-simulated RoverBody + N Wheel (N: the rover's
+wheels; an FMU built for them where the rover has not six, see ``plants.rover_fmu``).
 
 results/simulation/
   trajectories.csv         Rover.fmu: time, x, v and per limb tau_i, Tx_i, Fz_i, sinkage_i, slip_i, Fx_i, Fx_des_i
-  trajectories_cosim.csv   the same for RoverBody + 6 Wheel
+  trajectories_cosim.csv   the same for RoverBody + N Wheel
   rms.csv                  limb, rms_N = RMS(Fx_i - Fx_des_i) on Rover.fmu (Table 3); rms_cosim.csv likewise
-  ablation_fixed_load.csv  RMS per limb with one model at a fixed 424 N instead of the per-load LUT
+  ablation_fixed_load.csv  RMS per limb with one model at the rover's static wheel load (424 N) instead of the LUT
   fig10_closed_loop.png    Fig. 10 (a)-(h), limbs 1-3
   simulation.json          parameters, FMU hashes, versions, wall times, checks
 """
@@ -22,7 +23,6 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import json_bytes, summary_repr
-from rover_cosim.common.paper import STATIC_WHEEL_LOAD
 from rover_cosim.common.rows import csv_bytes, every, indices, steps_between_rows
 from rover_cosim.control.adaptive import AdaptiveController, Calibration
 from rover_cosim.control.controller import InverseModelController
@@ -36,13 +36,12 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, choose
 
 from .campaign import Campaign
-from .plants import add_plant_fmu, add_rover, hubs, wire_hub
+from .plants import add_plant_fmu, add_rover, hubs, rover_fmu, wire_hub
 
 STOP_TIME = 20.0  # s
 STEP = 1e-3       # s
 #: s, the rows the trajectory files keep by default (the runs step at STEP; metrics use every step)
 RECORD_INTERVAL = 1e-2
-STATIC_LOAD = STATIC_WHEEL_LOAD  # N, the fixed load of the ablation
 
 
 @dataclass
@@ -57,7 +56,7 @@ class SimulationResult:
 
     def checks_table(self) -> pd.DataFrame:
         """The checks of each plant (``checks``) by their labels, a column per plant."""
-        plants = {"monolithic": "Rover.fmu", "cosim": "RoverBody + 6 Wheel"}
+        plants = {"monolithic": "Rover.fmu", "cosim": f"RoverBody + {len(self.rms['cosim'])} Wheel"}
         return pd.DataFrame({plants.get(p, p): {CHECKS[k][0]: v for k, v in values.items() if k in CHECKS}
                              for p, values in self.record["checks"].items()})
 
@@ -77,6 +76,16 @@ def controller(models: ModelSet, **options: Any) -> InverseModelController:
     return InverseModelController("ctrl", models, **options)
 
 
+def _rover_options(choice: Choice | None) -> dict[str, Any]:
+    """What the controller knows of the rover: its mass [kg] (the demand is M a, Eq. 16)."""
+    return {"mass": choice.rover.mass} if choice is not None else {}
+
+
+def _geometry(choice: Choice | None) -> dict[str, Any]:
+    """Where the adaptive controller's telemetry places the hubs: x_limb [m], h_cog [m]."""
+    return {"x_limb": choice.rover.x_limb, "h_cog": choice.rover.h_cog} if choice is not None else {}
+
+
 def _closed_loop(name: str) -> SystemBuilder:
     return SystemBuilder(name).simulation(stop_time=STOP_TIME, step=STEP, algorithm="gauss-seidel")
 
@@ -84,9 +93,11 @@ def _closed_loop(name: str) -> SystemBuilder:
 def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
     """The closed loop on Rover.fmu (``options``: the controller's keyword arguments)."""
     builder = _closed_loop("closed loop (monolithic)")
-    limbs = hubs(Path(fmu_dir) / "Rover.fmu")
-    add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
-    builder.add_block("ctrl", controller(models_of(model), **{"wheels": len(limbs), **options}))
+    plant = rover_fmu(fmu_dir, "Rover", choice)
+    limbs = hubs(plant)
+    add_plant_fmu(builder, "rover", plant, choice)
+    builder.add_block("ctrl", controller(models_of(model), **{"wheels": len(limbs), **_rover_options(choice),
+                                                              **options}))
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
     for i in limbs:
         builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
@@ -131,14 +142,16 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
     wheel = soil_and_wheel_of(models)[1]
     adapter = adapter_for(models, fmu_dir, cache_dir)
     builder = _closed_loop("closed loop (adaptive)")
-    add_plant_fmu(builder, "rover", Path(fmu_dir) / "Rover.fmu", choice)
+    plant = rover_fmu(fmu_dir, "Rover", choice)
+    add_plant_fmu(builder, "rover", plant, choice)
     block = AdaptiveController("ctrl", models, adapter, radius=wheel.r, inertia=wheel.J,
-                               calibration=calibration, **options)
+                               calibration=calibration,
+                               **{**_rover_options(choice), **_geometry(choice), **options})
     builder.add_block("ctrl", block)
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
-    for i in hubs(Path(fmu_dir) / "Rover.fmu"):
+    for i in hubs(plant):
         builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
-    connect_telemetry(builder, "rover", calibration, ("pitch",), hubs(Path(fmu_dir) / "Rover.fmu"))
+    connect_telemetry(builder, "rover", calibration, ("pitch",), hubs(plant))
     return builder.build()
 
 
@@ -155,12 +168,13 @@ def connect_telemetry(builder: SystemBuilder, plant: str, calibration: Calibrati
 
 
 def cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
-    """The closed loop on RoverBody + 6 Wheel (``options``: the controller's keyword arguments)."""
+    """The closed loop on RoverBody + N Wheel (``options``: the controller's keyword arguments)."""
     builder = _closed_loop("closed loop (cosim)")
-    limbs = hubs(Path(fmu_dir) / "RoverBody.fmu")
-    wheels = add_rover(builder, Path(fmu_dir) / "RoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(limbs), choice,
-                       wire=False)
-    builder.add_block("ctrl", controller(models_of(model), **{"wheels": len(limbs), **options}))
+    body = rover_fmu(fmu_dir, "RoverBody", choice)
+    limbs = hubs(body)
+    wheels = add_rover(builder, body, Path(fmu_dir) / "Wheel.fmu", len(limbs), choice, wire=False)
+    builder.add_block("ctrl", controller(models_of(model), **{"wheels": len(limbs), **_rover_options(choice),
+                                                              **options}))
     builder.connect("body.x", "ctrl.x").connect("body.v", "ctrl.v")
     for i, wheel in zip(limbs, wheels):
         wire_hub(builder, "body", wheel, i)
@@ -195,8 +209,8 @@ def rms(table: pd.DataFrame) -> pd.DataFrame:
 CHECKS = {"time_to_98_percent_s": ("time to reach 0.98 m/s [s]", "{:.2f}"),
           "max_abs_v_error_after_m_s": ("largest |v - 1 m/s| afterwards [m/s]", "{:.4f}"),
           "final_v_m_s": ("final velocity [m/s]", "{:.4f}"),
-          "Fz1_min_while_accelerating_N": ("least load, limb 1, accelerating [N]", "{:.1f}"),
-          "Fz3_max_while_accelerating_N": ("largest load, limb 3, accelerating [N]", "{:.1f}"),
+          "Fz1_min_while_accelerating_N": ("least load, limb 1 (front), accelerating [N]", "{:.1f}"),
+          "Fz3_max_while_accelerating_N": ("largest load, rear limb (3 of 6), accelerating [N]", "{:.1f}"),
           "Fz_at_start_N": ("load at the start [N]", "{:.1f}")}
 
 
@@ -205,7 +219,8 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
     reached = np.nonzero(v >= 0.98)[0]
     after = v[reached[0]:] if reached.size else np.array([])
     accelerating = table["time"] < (table["time"][reached[0]] if reached.size else 0.0)
-    fz1, fz3 = table["Fz_1"][accelerating], table["Fz_3"][accelerating]
+    rear = len(indices(table.columns, "Fz")) // 2  # the left side's rear limb: 3 of six
+    fz1, fz3 = table["Fz_1"][accelerating], table[f"Fz_{max(rear, 1)}"][accelerating]
     return {"time_to_98_percent_s": float(table["time"][reached[0]]) if reached.size else None,
             "max_abs_v_error_after_m_s": float(np.abs(after - 1.0).max()) if after.size else None,
             "final_v_m_s": float(v[-1]),
@@ -251,11 +266,13 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     tables: dict[str, pd.DataFrame] = {}
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
+    static_load = choice.rover.static_wheel_load(choice.soil.gravity)  # N, the fixed load of the ablation
+    cosim_label = f"RoverBody + {choice.rover.wheels} Wheel"
     for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
         tables[plant] = trajectories(campaign.run(plant, build(fmu_dir, models, choice)).data, plant)
         results[plant] = checks(tables[plant])
     ablation = rms(trajectories(campaign.run("fixed_load_ablation", monolithic_system(
-        fmu_dir, models, choice, fixed_load=STATIC_LOAD)).data, "monolithic"))
+        fmu_dir, models, choice, fixed_load=static_load)).data, "monolithic"))
     adaptation = None
     if adapt is not None:
         system = adaptive_system(fmu_dir, models, choice, calibration=adapt)
@@ -270,8 +287,10 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     ablation_table = pd.DataFrame({"limb": rms_mono["limb"], "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})
     record = campaign.record({"stop_time_s": STOP_TIME, "model": str(model), "record_interval_s": record_interval,
-                              "fixed_load_ablation_N": STATIC_LOAD},
-                             fmu_dir=fmu_dir, fmus=("Rover", "RoverBody", "Wheel"), model=model, choice=choice,
+                              "fixed_load_ablation_N": static_load},
+                             fmu_dir=fmu_dir, fmus=(rover_fmu(fmu_dir, "Rover", choice),
+                                                    rover_fmu(fmu_dir, "RoverBody", choice), "Wheel"),
+                             model=model, choice=choice,
                              mismatch=mismatch, checks=results,
                              rms_N={"monolithic": rms_mono["rms_N"].tolist(), "cosim": rms_cosim["rms_N"].tolist(),
                                     "fixed_load_ablation": ablation["rms_N"].tolist()})
@@ -285,8 +304,8 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
         out / "rms_cosim.csv": rms_cosim.to_csv(index=False, float_format="%.4f").encode(),
         out / "ablation_fixed_load.csv": ablation_table.to_csv(index=False, float_format="%.4f").encode(),
         out / "fig10_closed_loop.png": fig10(tables["monolithic"], "Rover.fmu"),
-        out / "fig10_closed_loop_cosim.png": fig10(tables["cosim"], "RoverBody + 6 Wheel"),
-        out / "fig_tracking.png": tracking(tables["monolithic"], tables["cosim"]),
+        out / "fig10_closed_loop_cosim.png": fig10(tables["cosim"], cosim_label),
+        out / "fig_tracking.png": tracking(tables["monolithic"], tables["cosim"], cosim_label=cosim_label),
         out / "simulation.json": json_bytes(record),
     }
     if adapt is not None:
