@@ -8,18 +8,24 @@ PYTHON ?= python3
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-RESULTS ?= results
 
 .PHONY: run test test-fast fuzz docs lint fig3 fmus fmus3 identify simulate montecarlo report cosim-study bench venv clean
 
 # FMU build: BACKEND=auto uses OpenModelica's omc where it is on PATH, else the built-in
 # rumoca -> CasADi -> C exporter; BACKEND=builtin or BACKEND=omc force one.
 BACKEND ?= auto
-# Soil and wheel of fig3, identify and simulate: names of the shipped library
-# (`rover-cosim soils`) or TOML files; e.g. `make run SOIL=lunar_nominal WHEEL=mer`.
+# Soil, rover and wheel of fig3, identify and simulate: names of the shipped library
+# (`rover-cosim soils`, `rover-cosim rovers`) or TOML files; WHEEL empty: the rover's own wheel.
+# E.g. `make run SOIL=lunar_nominal ROVER=viper` or `make run SOIL=lunar_nominal WHEEL=mer`.
 SOIL ?= paper
-WHEEL ?= paper
-SOIL_OPTIONS := --soil $(SOIL) --wheel $(WHEEL)
+ROVER ?= paper
+WHEEL ?=
+SOIL_OPTIONS := --soil $(SOIL) --rover $(ROVER) $(if $(WHEEL),--wheel $(WHEEL))
+# Results: results/ for the paper's soil, rover and wheel; any other choice gets its own folder
+# (results_<rover>_<soil>[_<wheel>]), so that its files never mix with the paper's.
+name_of = $(basename $(notdir $(1)))
+PAPER_CHOICE := $(and $(filter paper,$(SOIL)),$(filter paper,$(ROVER)),$(if $(WHEEL),$(filter paper,$(WHEEL)),yes))
+RESULTS ?= $(if $(PAPER_CHOICE),results,results_$(call name_of,$(ROVER))_$(call name_of,$(SOIL))$(if $(WHEEL),_$(call name_of,$(WHEEL))))
 # The FMUs are the classes of modelica/RoverTerramechanics/FMUs (its package.order): build-fmus without
 # names builds them all; FMUS=Wheel,Rover (space- or comma-separated) builds some.
 FMUS ?=

@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .figures import finish, png_bytes
+from .fits import FIT_TORQUE_MAX
 from .lateral import LateralModel, fit_points
 
 #: N·m: the torque level of the runs drawn against beta (inside the fits at every load).
@@ -23,14 +24,27 @@ def _colors(count: int) -> np.ndarray:
     return plt.cm.viridis(np.linspace(0, 0.9, count))
 
 
-def fy_against_beta_and_slip(table: pd.DataFrame, model: LateralModel) -> bytes:
-    """(a) settled Fy against beta per load at SHOWN_TORQUE, with the model at the runs' slips;
-    (b) settled Fy against slip per load at SHOWN_ANGLE, with the model."""
+def shown_torque(table: pd.DataFrame, torque_max: float) -> float:
+    """The torque level of panel (a): SHOWN_TORQUE where the sweep has it, else the middle of the
+    sweep's levels up to ``torque_max`` [N·m] (a plan scaled to another wheel)."""
+    torques = sorted(table["torque_N_m"].unique())
+    if SHOWN_TORQUE in torques:
+        return SHOWN_TORQUE
+    fitted = [t for t in torques if t <= torque_max] or torques
+    return float(fitted[len(fitted) // 2])
+
+
+def fy_against_beta_and_slip(table: pd.DataFrame, model: LateralModel, torque_max: float = FIT_TORQUE_MAX) -> bytes:
+    """(a) settled Fy against beta per load at SHOWN_TORQUE (:func:`shown_torque`), with the model
+    at the runs' slips; (b) settled Fy against slip per load at SHOWN_ANGLE, with the model."""
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.8))
     loads = sorted(table["load_N"].unique())
-    used = fit_points(table)
+    used = fit_points(table, torque_max)
+    torque = shown_torque(table, torque_max)
     for color, load in zip(_colors(len(loads)), loads):
-        part = table[(table["load_N"] == load) & (table["torque_N_m"] == SHOWN_TORQUE)].sort_values("slip_angle_deg")
+        part = table[(table["load_N"] == load) & (table["torque_N_m"] == torque)].sort_values("slip_angle_deg")
+        if part.empty:
+            continue
         fitted = part.index.isin(used.index)
         left.plot(part["slip_angle_deg"][fitted], part["Fy_N"][fitted], "o", color=color, label=f"{load:.0f} N")
         left.plot(part["slip_angle_deg"][~fitted], part["Fy_N"][~fitted], "x", color=color)
@@ -44,7 +58,7 @@ def fy_against_beta_and_slip(table: pd.DataFrame, model: LateralModel) -> bytes:
             right.plot(s, model.fy(load, np.radians(SHOWN_ANGLE), s), "-", color=color, lw=1)
     left.set_xlabel("slip angle beta [deg]")
     left.set_ylabel("Fy [N]")
-    left.set_title(f"(a) settled Fy against beta at {SHOWN_TORQUE:g} N·m (x: not fitted); lines: model")
+    left.set_title(f"(a) settled Fy against beta at {torque:.3g} N·m (x: not fitted); lines: model")
     right.set_xlabel("slip ratio [-]")
     right.set_ylabel("Fy [N]")
     right.set_title(f"(b) settled Fy against slip at beta = {SHOWN_ANGLE:g} deg; lines: model")

@@ -115,7 +115,8 @@ def read_plan(path: Path) -> IdentificationPlan:
     unknown = sorted(set(table) - known - {"title", "notes"})
     if unknown:
         raise ValueError(f"plan {path}: unknown key(s) {unknown}; expected {', '.join(sorted(known))}")
-    values = {key: (tuple(value) if isinstance(value, list) else value) for key, value in table.items() if key in known}
+    values: dict[str, Any] = {key: (tuple(value) if isinstance(value, list) else value) for key, value in table.items()
+                              if key in known}
     try:
         return IdentificationPlan(**values, basis=f"the plan file {path}")
     except (ValueError, TypeError) as error:

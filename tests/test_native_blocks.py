@@ -183,7 +183,26 @@ def near_the_path(block: PathFollowingController, s: float, rng: np.random.Gener
     x, y, heading, _ = (float(v) for v in block.path.at(s))
     return np.array([x + rng.normal(0, 0.05), y + rng.normal(0, 0.05), heading + rng.normal(0, 0.05),
                      0.5 + rng.normal(0, 0.2), rng.normal(0, 0.02), rng.normal(0, 0.05),
-                     *rng.uniform(-20.0, 900.0, 6), *rng.normal(0, 0.08, 6)])
+                     *rng.uniform(-20.0, 900.0, block.wheels), *rng.normal(0, 0.08, block.wheels)])
+
+
+@pytest.mark.parametrize("x_limb", [(0.64, -0.64), (1.2, 0.4, -0.4, -1.2)], ids=["4 wheels", "8 wheels"])
+def test_the_path_controllers_c_twin_follows_any_number_of_wheels(model, x_limb):
+    """A rover of another number of wheels (a VIPER-class four, an eight): the twin still gives the
+    Python block's outputs bit for bit, and both allocate the demand over every wheel."""
+    rng = np.random.default_rng(46)
+    block = PathFollowingController("ctrl", str(model), path="turn", x_limb=x_limb, y_limb=0.61, mass=430.0,
+                                    yaw_inertia=161.3)
+    assert block.wheels == 2 * len(x_limb) and len(block.outputs) == 4 * block.wheels + 4
+    block.start(0.0, near_the_path(block, 0.0, rng))
+    twin = Twin(block, "path")
+    t = 0.0
+    for k in range(1, 400):
+        u = near_the_path(block, 0.01 * k, rng)
+        expected, got = block.step(t, 1e-3, u), twin.step(t, 1e-3, u)
+        assert np.array_equal(expected, got), f"step {k}: outputs {np.flatnonzero(expected != got)} differ"
+        t += 1e-3
+    twin.made.close()
 
 
 @pytest.mark.parametrize("path", ["turn", "lane_change"])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 from .command import Command
 from .options import (
@@ -61,13 +62,13 @@ def _not_a_test_bed(fmu: Path) -> str | None:
         return f"its modelDescription.xml cannot be read ({error})"
 
 
-def plan_of(args: argparse.Namespace, choice: object) -> object:
+def plan_of(args: argparse.Namespace, choice: Any) -> Any:
     """The identification plan (--plan, or the one for the choice), said before the sweep; None
     after saying why there is none (a plan file it cannot read, a rover that cannot be driven)."""
     from rover_cosim.identification.plan import NotDrivable, plan_for, read_plan
 
     try:
-        plan = read_plan(args.plan) if args.plan is not None else plan_for(choice)  # type: ignore[arg-type]
+        plan = read_plan(args.plan) if args.plan is not None else plan_for(choice)
     except NotDrivable as error:
         fail("identify", f"not drivable: {error} (nothing run)")
         return None
@@ -76,7 +77,8 @@ def plan_of(args: argparse.Namespace, choice: object) -> object:
         return None
     if not plan.is_paper:
         print(f"identification plan: {plan.basis}")
-        print(f"  loads {', '.join(f'{w:g}' for w in plan.loads)} N; torques {', '.join(f'{t:g}' for t in plan.torques)}"
+        loads, torques = ", ".join(f"{w:g}" for w in plan.loads), ", ".join(f"{t:g}" for t in plan.torques)
+        print(f"  loads {loads} N; torques {torques}"
               f" N·m; fits: torque <= {plan.fit_torque_max:g} N·m, slip in {plan.slip_window}; validation at "
               f"{', '.join(f'{w:g}' for w in plan.validation_loads)} N")
     return plan

@@ -160,11 +160,14 @@ def print_straight(outcome: Any) -> None:
 
     print("Velocity and loads:")
     print(outcome.checks_table().to_string(float_format=lambda v: f"{v:.4g}"))
+    wheels = len(outcome.rms["cosim"])
+    fixed = outcome.record["parameters"].get("fixed_load_ablation_N", float("nan"))
     table = pd.DataFrame({"limb": outcome.rms["monolithic"]["limb"],
                           "RMS(Fx - Fx_des), Rover.fmu [N]": outcome.rms["monolithic"]["rms_N"],
-                          "RMS, RoverBody + 6 Wheel [N]": outcome.rms["cosim"]["rms_N"],
-                          "RMS, one model at 424 N [N]": outcome.ablation["rms_fixed_load_N"]})
-    print("Table 3 (limbs 4-6 mirror 1-3):")
+                          f"RMS, RoverBody + {wheels} Wheel [N]": outcome.rms["cosim"]["rms_N"],
+                          f"RMS, one model at {fixed:.0f} N [N]": outcome.ablation["rms_fixed_load_N"]})
+    side = wheels // 2
+    print(f"Table 3 (limbs {side + 1}-{wheels} mirror 1-{side}):")
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
     adaptation = outcome.record.get("adaptation")
     if adaptation:

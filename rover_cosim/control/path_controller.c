@@ -3,8 +3,9 @@
  * (rover_cosim.orchestrator.native): the same arithmetic in the same order, so that it gives the
  * Python block's outputs bit for bit (compiled with -ffp-contract=off; checked by the tests).
  *
- * Inputs (value references 0 ..): x, y [m], yaw [rad], v, vy [m/s], yawRate [rad/s], W[1..6] [N],
- * slipAngle[1..6] [rad]. Outputs: tau[1..6] [N.m], steer[1..6] [rad], Fx_des[1..6], Fy_des[1..6]
+ * Inputs (value references 0 ..): x, y [m], yaw [rad], v, vy [m/s], yawRate [rad/s], W[1..N] [N],
+ * slipAngle[1..N] [rad] (N wheels: path_new's ``wheels``, six on the paper's rover). Outputs: tau[1..N]
+ * [N.m], steer[1..N] [rad], Fx_des[1..N], Fy_des[1..N]
  * [N], s, s_ref, cross_track [m], heading_error [rad]. The functions follow fmi2SetReal,
  * fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the error's text from path_message).
  *
@@ -24,9 +25,9 @@
 #include "../terramechanics/height_map.h"
 #include "../terramechanics/soil_map.h"
 
-#define WHEELS 6
-#define N_INPUTS (6 + 2 * WHEELS)
-#define N_OUTPUTS (4 * WHEELS + 4)
+#define MAX_WHEELS 16
+#define N_INPUTS (6 + 2 * c->wheels)
+#define N_OUTPUTS (4 * c->wheels + 4)
 #define NEWTON_STEPS 2
 
 enum { MASS, YAW_INERTIA, V_TARGET, KV, KP, A_MAX, K_E, K_DE, A_N_MAX, K_PSI, K_R, ALPHA_MAX, STEP, WN, KINEMATIC,
@@ -43,6 +44,7 @@ typedef struct {
 
 typedef struct {
     double settings[N_SETTINGS];
+    int wheels;                     /* N, at most MAX_WHEELS */
     Law law;
     int n_path;                     /* samples of the path */
     double *arc, *px, *py, *heading, *curvature;   /* per sample: s [m], x, y [m], heading [rad], curvature [1/m] */
@@ -53,13 +55,13 @@ typedef struct {
     Law law_b;
     Lateral lateral_b;
     SoilGrid grid;
-    double shares[WHEELS];
+    double shares[MAX_WHEELS];
     int has_map;                    /* 1: a height map's pull is fed forward (the spline below) */
     HeightSpline spline;          /* the second soil's share under each hub this step [1] */
-    double x_hub[WHEELS], y_hub[WHEELS];
-    double rows[3][2 * WHEELS];     /* the allocation matrix */
-    double steer[WHEELS];           /* the last steering [rad] */
-    double in[N_INPUTS], out[N_OUTPUTS];
+    double x_hub[MAX_WHEELS], y_hub[MAX_WHEELS];
+    double rows[3][2 * MAX_WHEELS]; /* the allocation matrix */
+    double steer[MAX_WHEELS];       /* the last steering [rad] */
+    double in[6 + 2 * MAX_WHEELS], out[4 * MAX_WHEELS + 4];
     char message[256];
 } PathController;
 
@@ -133,11 +135,12 @@ static int solve3(double a[3][4], double *z) {
 
 /* allocation.share: each wheel's (f_x, f_y) in the heading frame for the demand. */
 static int share(PathController *c, const double *demand, const double *loads, double *fx, double *fy) {
-    double d[2 * WHEELS], scaled[3][2 * WHEELS], a[3][4], z[3];
+    double d[2 * MAX_WHEELS], scaled[3][2 * MAX_WHEELS], a[3][4], z[3];
+    const int n_wheels = c->wheels;
     int carrying = 0;
-    for (int i = 0; i < WHEELS; i++) {
+    for (int i = 0; i < n_wheels; i++) {
         double w = 0.0 > loads[i] ? 0.0 : loads[i];
-        d[i] = d[WHEELS + i] = w;
+        d[i] = d[n_wheels + i] = w;
         carrying += w != 0.0;
     }
     if (carrying < 2) {
@@ -145,11 +148,11 @@ static int share(PathController *c, const double *demand, const double *loads, d
         return ERROR;
     }
     for (int p = 0; p < 3; p++)
-        for (int k = 0; k < 2 * WHEELS; k++) scaled[p][k] = c->rows[p][k] * d[k];
+        for (int k = 0; k < 2 * n_wheels; k++) scaled[p][k] = c->rows[p][k] * d[k];
     for (int p = 0; p < 3; p++) {
         for (int q = 0; q < 3; q++) {
             double total = 0.0;
-            for (int k = 0; k < 2 * WHEELS; k++) total += scaled[p][k] * c->rows[q][k];
+            for (int k = 0; k < 2 * n_wheels; k++) total += scaled[p][k] * c->rows[q][k];
             a[p][q] = total;
         }
         a[p][3] = demand[p];
@@ -158,9 +161,9 @@ static int share(PathController *c, const double *demand, const double *loads, d
         snprintf(c->message, sizeof c->message, "the allocation's matrix is singular");
         return ERROR;
     }
-    for (int k = 0; k < 2 * WHEELS; k++) {
+    for (int k = 0; k < 2 * n_wheels; k++) {
         double force = scaled[0][k] * z[0] + scaled[1][k] * z[1] + scaled[2][k] * z[2];
-        if (k < WHEELS) fx[k] = force; else fy[k - WHEELS] = force;
+        if (k < n_wheels) fx[k] = force; else fy[k - n_wheels] = force;
     }
     return OK;
 }
@@ -204,11 +207,12 @@ static void fy_and_slope(const Lateral *c, const double *a, double beta, double 
  * PathFollowingController._outputs. */
 static int outputs(PathController *c, double t, int advance, double h) {
     const double *g = c->settings;
-    double loads[WHEELS], steer[WHEELS], fx_des[WHEELS], fy_des[WHEELS];
-    for (int i = 0; i < WHEELS; i++) loads[i] = 1.0 > c->in[6 + i] ? 1.0 : c->in[6 + i];
+    const int n_wheels = c->wheels;
+    double loads[MAX_WHEELS], steer[MAX_WHEELS], fx_des[MAX_WHEELS], fy_des[MAX_WHEELS];
+    for (int i = 0; i < n_wheels; i++) loads[i] = 1.0 > c->in[6 + i] ? 1.0 : c->in[6 + i];
     /* 1. tracking */
     double x = c->in[0], y = c->in[1], yaw = c->in[2], v = c->in[3], vy = c->in[4], r = c->in[5];
-    if (c->believes) soil_shares(&c->grid, x, y, yaw, c->x_hub, c->y_hub, WHEELS, c->shares);
+    if (c->believes) soil_shares(&c->grid, x, y, yaw, c->x_hub, c->y_hub, n_wheels, c->shares);
     Location where = locate(c, x, y);
     double offset = yaw - where.heading;
     double cs = cos(offset), sn = sin(offset);
@@ -229,7 +233,7 @@ static int outputs(PathController *c, double t, int advance, double h) {
         }
         if (c->has_map) { /* the loads' pull on the map's slopes under the hubs */
             double cm = cos(yaw), sm = sin(yaw), sum_x = 0.0, sum_y = 0.0;
-            for (int i = 0; i < WHEELS; i++) {
+            for (int i = 0; i < n_wheels; i++) {
                 double height, slope_x, slope_y, w = c->in[6 + i];
                 height_at(&c->spline, x + cm * c->x_hub[i] - sm * c->y_hub[i], y + sm * c->x_hub[i] + cm * c->y_hub[i],
                           &height, &slope_x, &slope_y);
@@ -250,18 +254,18 @@ static int outputs(PathController *c, double t, int advance, double h) {
         double rate = along * where.curvature - g[K_PSI] / g[K_R] * offset - g[K_E] / g[K_DE] * where.cross_track;
         double speed = 1e-3 > along ? 1e-3 : along;
         double total = 0.0;
-        for (int i = 0; i < WHEELS; i++) total += loads[i];
-        for (int i = 0; i < WHEELS; i++) {
+        for (int i = 0; i < n_wheels; i++) total += loads[i];
+        for (int i = 0; i < n_wheels; i++) {
             steer[i] = clip(atan2(rate * c->x_hub[i], speed - rate * c->y_hub[i]), -g[MAX_STEER], g[MAX_STEER]);
             fx_des[i] = demand[0] * loads[i] / total;
             fy_des[i] = 0.0;
         }
     } else {
-        double fx[WHEELS], fy[WHEELS], coefficients[16], coefficients_b[16];
+        double fx[MAX_WHEELS], fy[MAX_WHEELS], coefficients[16], coefficients_b[16];
         if (c->lateral.terms > 16 || (c->believes && c->lateral_b.terms > 16)) return ERROR;
         if (share(c, demand, loads, fx, fy) != OK) return ERROR;
-        for (int i = 0; i < WHEELS; i++) {
-            double delta = c->steer[i], angle = c->in[6 + WHEELS + i] + c->steer[i], slip;
+        for (int i = 0; i < n_wheels; i++) {
+            double delta = c->steer[i], angle = c->in[6 + n_wheels + i] + c->steer[i], slip;
             double force = fx[i] * cos(delta) + fy[i] * sin(delta), s = c->believes ? c->shares[i] : 0.0;
             if (slip_for_force(&c->law, loads[i], force, &slip) != OK) return ERROR;
             angle_coefficients(&c->lateral, loads[i], slip, coefficients);
@@ -293,7 +297,7 @@ static int outputs(PathController *c, double t, int advance, double h) {
     double ad[4], bd[2], ad_b[4], bd_b[2];
     law_discretisation(&c->law, advance, h, ad, bd);
     if (c->believes) law_discretisation(&c->law_b, advance, h, ad_b, bd_b);
-    for (int i = 0; i < WHEELS; i++) {
+    for (int i = 0; i < n_wheels; i++) {
         c->steer[i] = steer[i];
         if (law_torque(&c->law, i, loads[i], fx_des[i], advance, ad, bd, &c->out[i]) != OK) return ERROR;
         if (c->believes) { /* both laws move on; the torque blended where the second soil is believed */
@@ -301,14 +305,14 @@ static int outputs(PathController *c, double t, int advance, double h) {
             if (law_torque(&c->law_b, i, loads[i], fx_des[i], advance, ad_b, bd_b, &torque_b) != OK) return ERROR;
             if (s != 0.0) c->out[i] = (1.0 - s) * c->out[i] + s * torque_b;
         }
-        c->out[WHEELS + i] = steer[i];
-        c->out[2 * WHEELS + i] = fx_des[i];
-        c->out[3 * WHEELS + i] = fy_des[i];
+        c->out[n_wheels + i] = steer[i];
+        c->out[2 * n_wheels + i] = fx_des[i];
+        c->out[3 * n_wheels + i] = fy_des[i];
     }
-    c->out[4 * WHEELS] = where.s;
-    c->out[4 * WHEELS + 1] = s_ref;
-    c->out[4 * WHEELS + 2] = where.cross_track;
-    c->out[4 * WHEELS + 3] = offset;
+    c->out[4 * n_wheels] = where.s;
+    c->out[4 * n_wheels + 1] = s_ref;
+    c->out[4 * n_wheels + 2] = where.cross_track;
+    c->out[4 * n_wheels + 3] = offset;
     return OK;
 }
 
@@ -366,17 +370,20 @@ void path_free(void *component) {
  * (``path``: s, x, y, heading, curvature, each n_path long, one after the other) and the last
  * nearest sample ``hint`` (-1: none); the lateral model (``basis``: 0 rational, 1 exponential,
  * 2 polynomial; ``shape``: terms, slip powers, load powers; ``scales`` [rad]; ``lateral``: its
- * coefficients c[i][k][j]); the hubs (``hubs``: x[6], then y[6] [m]) and the last ``steer``
- * [rad]. All arrays are copied. NULL for bad sizes or out of memory. */
+ * coefficients c[i][k][j]); the hubs (``hubs``: x[N], then y[N] [m]) and the last ``steer``
+ * [rad] of its ``wheels`` N wheels (2 to MAX_WHEELS). All arrays are copied. NULL for bad sizes or
+ * out of memory. */
 void *path_new(const double *settings, int n_loads, int n_torques, int degree, const double *inverse,
                const double *torques, const double *settled, const double *log_t, const double *coefficients,
                const double *filter, int n_path, const double *path, int hint, int basis, const int *shape,
-               const double *scales, const double *lateral, const double *hubs, const double *steer) {
+               const double *scales, const double *lateral, const double *hubs, const double *steer, int wheels) {
     if (n_path < 2 || basis < RATIONAL || basis > POLYNOMIAL || shape[0] < 1 || shape[0] > 16 || shape[1] < 1
-        || shape[2] < 1)
+        || shape[2] < 1 || wheels < 2 || wheels > MAX_WHEELS)
         return NULL;
     PathController *c = calloc(1, sizeof *c);
     if (!c) return NULL;
+    c->wheels = wheels;
+    const int n_wheels = wheels;
     memcpy(c->settings, settings, sizeof c->settings);
     size_t n = (size_t)n_path, size = (size_t)(shape[0] * shape[1] * shape[2]);
     c->n_path = n_path;
@@ -389,20 +396,20 @@ void *path_new(const double *settings, int n_loads, int n_torques, int degree, c
     c->curvature = law_copy(path + 4 * n, n);
     c->lateral.scales = law_copy(scales, (size_t)shape[0]);
     c->lateral.coefficients = law_copy(lateral, size);
-    if (law_init(&c->law, WHEELS, n_loads, n_torques, degree, settings[WN], settings[STEP], inverse, torques, settled,
+    if (law_init(&c->law, n_wheels, n_loads, n_torques, degree, settings[WN], settings[STEP], inverse, torques, settled,
                  log_t, coefficients, filter, c->message) != 0
         || !c->arc || !c->px || !c->py || !c->heading || !c->curvature || !c->lateral.scales
         || !c->lateral.coefficients) {
         path_free(c);
         return NULL;
     }
-    for (int i = 0; i < WHEELS; i++) {
+    for (int i = 0; i < n_wheels; i++) {
         c->x_hub[i] = hubs[i];
-        c->y_hub[i] = hubs[WHEELS + i];
+        c->y_hub[i] = hubs[n_wheels + i];
         c->steer[i] = steer[i];
-        c->rows[0][i] = 1.0; c->rows[0][WHEELS + i] = 0.0;
-        c->rows[1][i] = 0.0; c->rows[1][WHEELS + i] = 1.0;
-        c->rows[2][i] = -c->y_hub[i]; c->rows[2][WHEELS + i] = c->x_hub[i];
+        c->rows[0][i] = 1.0; c->rows[0][n_wheels + i] = 0.0;
+        c->rows[1][i] = 0.0; c->rows[1][n_wheels + i] = 1.0;
+        c->rows[2][i] = -c->y_hub[i]; c->rows[2][n_wheels + i] = c->x_hub[i];
     }
     return c;
 }
@@ -416,6 +423,7 @@ int path_believe(void *component, int n_loads, int n_torques, int degree, const 
                  const double *filter, int basis, const int *shape, const double *scales, const double *lateral,
                  int nx, int ny, const double *grid_x, const double *grid_y, const double *share) {
     PathController *c = component;
+    const int n_wheels = c->wheels;
     if (basis < RATIONAL || basis > POLYNOMIAL || shape[0] < 1 || shape[0] > 16 || shape[1] < 1 || shape[2] < 1) {
         snprintf(c->message, sizeof c->message, "path_believe: bad lateral model");
         return ERROR;
@@ -424,7 +432,7 @@ int path_believe(void *component, int n_loads, int n_torques, int degree, const 
     c->lateral_b.n_load = shape[2];
     c->lateral_b.scales = law_copy(scales, (size_t)shape[0]);
     c->lateral_b.coefficients = law_copy(lateral, (size_t)(shape[0] * shape[1] * shape[2]));
-    if (law_init(&c->law_b, WHEELS, n_loads, n_torques, degree, c->settings[WN], c->settings[STEP], inverse, torques,
+    if (law_init(&c->law_b, n_wheels, n_loads, n_torques, degree, c->settings[WN], c->settings[STEP], inverse, torques,
                  settled, log_t, coefficients, filter, c->message) != 0
         || !c->lateral_b.scales || !c->lateral_b.coefficients || soil_grid_init(&c->grid, nx, ny, grid_x, grid_y, share)) {
         snprintf(c->message, sizeof c->message, "path_believe: bad sizes or out of memory");

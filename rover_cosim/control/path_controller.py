@@ -34,7 +34,6 @@ from pathlib import Path as FilePath
 
 import numpy as np
 
-from rover_cosim.common.paper import WHEELS  # the six limbs of the paper's rover, placed by x_limb and y_limb
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator import native as native_code
 from rover_cosim.orchestrator.native import doubles
@@ -58,18 +57,19 @@ def _clip(value: float, low: float, high: float) -> float:
     return high if value > high else value
 
 
-def _names(stem: str) -> list[str]:
-    return [f"{stem}[{i}]" for i in range(1, WHEELS + 1)]
+def _names(stem: str, wheels: int) -> list[str]:
+    return [f"{stem}[{i}]" for i in range(1, wheels + 1)]
 
 
 class PathFollowingController:
-    """Orchestrator block. Inputs: x, y, yaw, v, vy, yawRate (body), W[1..6], slipAngle[1..6]
-    (wheels). Outputs: tau[1..6], steer[1..6], Fx_des[1..6], Fy_des[1..6], s, s_ref,
-    cross_track, heading_error."""
+    """Orchestrator block. Inputs: x, y, yaw, v, vy, yawRate (body), W[1..N], slipAngle[1..N]
+    (wheels). Outputs: tau[1..N], steer[1..N], Fx_des[1..N], Fy_des[1..N], s, s_ref,
+    cross_track, heading_error. N = 2 len(x_limb): the hubs of the left side at (x_limb, y_limb)
+    [m] from front to rear, the right side mirrors them (six on the paper's rover)."""
 
     def __init__(self, name: str, model: ModelSet | str, path: str | Path = "turn", v_target: float = 0.5,
                  steering: str = "inverse", mass: float = 1570.0, yaw_inertia: float = 1980.0,
-                 x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5), y_limb: float = 1.5,
+                 x_limb: tuple[float, ...] = (1.5, 0.0, -1.5), y_limb: float = 1.5,
                  kv: float = 1.0, kp: float = 0.01, a_max: float = 0.1,
                  k_e: float = 0.25, k_de: float = 1.0, a_n_max: float = 0.3,
                  k_psi: float = 1.0, k_r: float = 2.0, alpha_max: float = 0.5,
@@ -88,24 +88,28 @@ class PathFollowingController:
         self.name, self.steering, self.step_size = name, steering, step
         self.path: Path = path if isinstance(path, Path) else PATHS[path]()
         self.lateral = models.lateral
-        self.inverse = LongitudinalInverse(longitudinal, WHEELS, wn, step, name)
+        if not 1 <= len(x_limb) <= 8:
+            raise ValueError(f"block {name!r}: x_limb = {x_limb!r}: expected 1 to 8 hub positions per side [m]")
+        self.wheels = wheels = 2 * len(x_limb)
+        self.inverse = LongitudinalInverse(longitudinal, wheels, wn, step, name)
         self.v_target, self.mass, self.yaw_inertia = v_target, mass, yaw_inertia
         self.gains = dict(kv=kv, kp=kp, a_max=a_max, k_e=k_e, k_de=k_de, a_n_max=a_n_max, k_psi=k_psi, k_r=k_r,
                           alpha_max=alpha_max)
         self.x_hub = np.array([*x_limb, *x_limb], float)
-        self.y_hub = np.array([y_limb] * 3 + [-y_limb] * 3, float)
+        self.y_hub = np.array([y_limb] * len(x_limb) + [-y_limb] * len(x_limb), float)
         self.matrix = allocation_matrix(self.x_hub, self.y_hub)
         self._rows = self.matrix.tolist()
-        self.steer = np.zeros(WHEELS)
+        self.steer = np.zeros(wheels)
         self.hint: int | None = None
-        self.inputs = ("x", "y", "yaw", "v", "vy", "yawRate", *_names("W"), *_names("slipAngle"))
-        self.outputs = (*_names("tau"), *_names("steer"), *_names("Fx_des"), *_names("Fy_des"),
+        self.inputs = ("x", "y", "yaw", "v", "vy", "yawRate", *_names("W", wheels), *_names("slipAngle", wheels))
+        self.outputs = (*_names("tau", wheels), *_names("steer", wheels), *_names("Fx_des", wheels),
+                        *_names("Fy_des", wheels),
                         "s", "s_ref", "cross_track", "heading_error")
         self.units = {"x": "m", "y": "m", "yaw": "rad", "v": "m/s", "vy": "m/s", "yawRate": "rad/s", "s": "m",
                       "s_ref": "m", "cross_track": "m", "heading_error": "rad",
-                      **{n: "N" for n in (*_names("W"), *_names("Fx_des"), *_names("Fy_des"))},
-                      **{n: "rad" for n in (*_names("slipAngle"), *_names("steer"))},
-                      **{n: "N.m" for n in _names("tau")}}
+                      **{n: "N" for n in (*_names("W", wheels), *_names("Fx_des", wheels), *_names("Fy_des", wheels))},
+                      **{n: "rad" for n in (*_names("slipAngle", wheels), *_names("steer", wheels))},
+                      **{n: "N.m" for n in _names("tau", wheels)}}
 
     # --- 1. tracking ----------------------------------------------------------------------------
     def _tracking(self, t: float, u: list[float]) -> tuple[list[float], float, list[float], tuple[float, float]]:
@@ -172,13 +176,14 @@ class PathFollowingController:
         total = 0.0
         for load in loads:
             total += load
-        return np.array(steer), np.array([force_t * load / total for load in loads]), np.zeros(WHEELS)
+        return np.array(steer), np.array([force_t * load / total for load in loads]), np.zeros(self.wheels)
 
     # --- the block interface ----------------------------------------------------------------------
     def _outputs(self, t: float, u: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
         values = np.asarray(u, float).tolist()
-        loads = [1.0 if 1.0 > w else w for w in values[6:6 + WHEELS]]  # np.clip(W, 1, None), NaN kept
-        slip_angles = values[6 + WHEELS:6 + 2 * WHEELS]
+        n = self.wheels
+        loads = [1.0 if 1.0 > w else w for w in values[6:6 + n]]  # np.clip(W, 1, None), NaN kept
+        slip_angles = values[6 + n:6 + 2 * n]
         demand, along, signals, (curvature, offset) = self._tracking(t, values)
         if self.steering == "kinematic":
             steer, fx_des, fy_des = self._kinematic_steering(along, curvature, offset, signals[2], loads, demand[0])
@@ -223,7 +228,7 @@ class PathFollowingController:
 
         library.path_new.restype = pointer
         library.path_new.argtypes = ([pointer] + [ctypes.c_int] * 3 + [pointer] * 6 + [ctypes.c_int, pointer]
-                                     + [ctypes.c_int] * 2 + [pointer] * 5)
+                                     + [ctypes.c_int] * 2 + [pointer] * 5 + [ctypes.c_int])
         g = self.gains
         settings = [self.mass, self.yaw_inertia, self.v_target, g["kv"], g["kp"], g["a_max"], g["k_e"], g["k_de"],
                     g["a_n_max"], g["k_psi"], g["k_r"], g["alpha_max"], self.step_size, self.inverse.wn,
@@ -239,7 +244,7 @@ class PathFollowingController:
             doubles([path.s, path.x, path.y, path.heading, path.curvature]), -1 if self.hint is None else self.hint,
             bases[self.lateral.form.basis], (ctypes.c_int * 3)(terms, slips, loads_),
             doubles(self.lateral.form.scales_rad), doubles(self.lateral.coefficients),
-            doubles([self.x_hub, self.y_hub]), doubles(self.steer))
+            doubles([self.x_hub, self.y_hub]), doubles(self.steer), self.wheels)
         if not component:
             raise MemoryError(f"block {self.name!r}: its C twin could not be made (tables of {len(table_loads)} loads "
                               f"x {len(torques)} torques: expected >= 2 each; or out of memory)")

@@ -40,7 +40,7 @@ import numpy as np
 from rover_cosim.orchestrator.native import doubles
 
 from .longitudinal import LongitudinalInverse, read_model
-from .path_controller import WHEELS, PathFollowingController
+from .path_controller import PathFollowingController
 
 
 class Ground(Protocol):
@@ -98,13 +98,13 @@ class TerrainPathController(PathFollowingController):
         if soil_map is not None and not hasattr(soil_map, "hub_shares"):
             raise TypeError(f"block {name!r}: soil_map = {soil_map!r}: expected a SoilMap or None")
         self.soil_map = soil_map
-        self.shares = [0.0] * WHEELS
+        self.shares = [0.0] * self.wheels
         if model_b is not None:
             models_b, longitudinal_b, _ = read_model(model_b, name)
             if models_b.lateral is None:
                 raise ValueError(f"block {name!r}: model_b {models_b.source} has no lateral model")
             self.lateral_b = models_b.lateral
-            self.inverse_b = LongitudinalInverse(longitudinal_b, WHEELS, self.inverse.wn, self.step_size, name)
+            self.inverse_b = LongitudinalInverse(longitudinal_b, self.wheels, self.inverse.wn, self.step_size, name)
         if not (isinstance(g, (int, float)) and math.isfinite(g) and g > 0):
             raise ValueError(f"block {name!r}: g = {g!r} m/s²: expected a gravity > 0")
         if terrain is not None and not (hasattr(terrain, "gravity") and hasattr(terrain, "level")):
@@ -137,7 +137,7 @@ class TerrainPathController(PathFollowingController):
             gx, gy = self.ground_map.gradient(x + cos * self.x_hub - sin * self.y_hub,
                                               y + sin * self.x_hub + cos * self.y_hub)
             sum_x = sum_y = 0.0
-            for w, slope_x, slope_y, x_hub, y_hub in zip(u[6:6 + WHEELS], np.asarray(gx).tolist(),
+            for w, slope_x, slope_y, x_hub, y_hub in zip(u[6:6 + self.wheels], np.asarray(gx).tolist(),
                                                          np.asarray(gy).tolist(), self.x_hub.tolist(),
                                                          self.y_hub.tolist()):
                 load = max(1.0, float(w))

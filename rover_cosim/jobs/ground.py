@@ -29,27 +29,30 @@ from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, hub_positions
 GROUND_C_SOURCE = Path(__file__).with_name("ground_block.c")
 SOIL_C_SOURCE = Path(__file__).with_name("soil_block.c")
 BODY = ("x", "y", "yaw", "v", "vy", "yawRate")
+#: The hubs the C twins (ground_block.c, soil_block.c) are made for.
+TWIN_HUBS = 6
 SIGNALS = ("groundHeight", "groundHeightRate", "groundGradientAlong", "groundGradientLateral")
 
 
 class _HubBlock:
     """What both blocks share: a map (of the class ``map_type``, given as ``map_argument``), the
-    hubs in the body frame (limbs 1-3 front, middle, rear on the left at ``y_limb`` [m], 4-6 on the
-    right; ``x_limb`` [m] ahead of the centre of gravity), and outputs that are a function of the
-    inputs now (``values``)."""
+    hubs in the body frame (the left side's limbs from front to rear at ``y_limb`` [m], 1-3 of six;
+    the right side mirrors them; ``x_limb`` [m] ahead of the centre of gravity), and outputs that
+    are a function of the inputs now (``values``). The C twins are made for six hubs: a rover with
+    another number of wheels steps these blocks in Python."""
 
     map_type: type = object
     map_argument = "map"
     outputs: tuple[str, ...] = ()
 
-    def __init__(self, name: str, the_map: object, x_limb: tuple[float, float, float], y_limb: float):
+    def __init__(self, name: str, the_map: object, x_limb: tuple[float, ...], y_limb: float):
         if not isinstance(the_map, self.map_type):
             raise TypeError(f"block {name!r}: {self.map_argument} = {the_map!r}: expected a {self.map_type.__name__}")
         if not y_limb > 0:
             raise ValueError(f"block {name!r}: y_limb = {y_limb!r} m: expected > 0")
         self.name, self.map = name, the_map
         self.x_hub = np.array([*x_limb, *x_limb], float)
-        self.y_hub = np.array([y_limb] * 3 + [-y_limb] * 3, float)
+        self.y_hub = np.array([y_limb] * len(x_limb) + [-y_limb] * len(x_limb), float)
 
     def values(self, u: np.ndarray) -> np.ndarray:
         raise NotImplementedError
@@ -58,6 +61,8 @@ class _HubBlock:
               *map_arguments: Any) -> native_code.NativeBlock | None:
         """The C twin ``<prefix>_new(map_arguments..., hubs, outputs now)`` of ``source``; None where
         it cannot be compiled."""
+        if len(self.x_hub) != TWIN_HUBS:
+            return None
         library = native_code.load_library(source)
         if isinstance(library, str):
             return None
@@ -86,7 +91,7 @@ class GroundBlock(_HubBlock):
 
     map_type, map_argument = HeightMap, "height_map"
 
-    def __init__(self, name: str, height_map: HeightMap, x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5),
+    def __init__(self, name: str, height_map: HeightMap, x_limb: tuple[float, ...] = (1.5, 0.0, -1.5),
                  y_limb: float = 1.5):
         super().__init__(name, height_map, x_limb, y_limb)
         self.map: HeightMap
@@ -126,7 +131,7 @@ class SoilBlock(_HubBlock):
 
     map_type, map_argument = SoilMap, "soil_map"
 
-    def __init__(self, name: str, soil_map: SoilMap, x_limb: tuple[float, float, float] = (1.5, 0.0, -1.5),
+    def __init__(self, name: str, soil_map: SoilMap, x_limb: tuple[float, ...] = (1.5, 0.0, -1.5),
                  y_limb: float = 1.5):
         super().__init__(name, soil_map, x_limb, y_limb)
         self.map: SoilMap

@@ -124,7 +124,7 @@ def _lateral_files(out: Path, sweep: SweepOutcome, table: pd.DataFrame, models: 
         out / "lateral_fit_detail.csv": detail.to_csv(index=False, float_format="%.6g").encode(),
         out / "lateral_forms.csv": forms.to_csv(index=False, float_format="%.4g").encode(),
         out / "lateral_trends.csv": ishigami_trends(table, torque_max).to_csv(index=False).encode(),
-        out / "fig_lateral_fy.png": lateral_figures.fy_against_beta_and_slip(table, recommended),
+        out / "fig_lateral_fy.png": lateral_figures.fy_against_beta_and_slip(table, recommended, torque_max),
         out / "fig_lateral_coefficients.png":
             lateral_figures.coefficient_curves(per_load_coefficients(table, recommended.form, torque_max),
                                                recommended),

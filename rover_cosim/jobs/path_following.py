@@ -47,7 +47,7 @@ from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice
 
 from .campaign import Campaign
-from .plants import add_plant_fmu, add_rover, hubs
+from .plants import add_plant_fmu, add_rover, hubs, rover_fmu
 from .simulate import RECORD_INTERVAL, adapter_for, checked_models, connect_telemetry, models_of, soil_and_wheel_of
 
 STEP = 1e-3  # s
@@ -84,10 +84,20 @@ def stop_time(scenario: str, straight: float = STRAIGHT) -> float:
     return float(np.floor(scenario_path(scenario, straight).length / SCENARIOS[scenario] / STEP) * STEP)
 
 
-def controller(models: ModelSet, scenario: str, steering: str, straight: float = STRAIGHT) -> PathFollowingController:
-    """The path-following controller block ``ctrl`` of ``scenario``."""
+def rover_geometry(choice: Choice | None) -> dict[str, Any]:
+    """What the path controllers know of the rover: mass [kg], yaw inertia [kg·m²] and where its
+    hubs are (x_limb, y_limb [m]); none without a choice (the paper's, the blocks' defaults)."""
+    if choice is None:
+        return {}
+    rover = choice.rover
+    return {"mass": rover.mass, "yaw_inertia": rover.Izz, "x_limb": rover.x_limb, "y_limb": rover.y_limb}
+
+
+def controller(models: ModelSet, scenario: str, steering: str, straight: float = STRAIGHT,
+               choice: Choice | None = None) -> PathFollowingController:
+    """The path-following controller block ``ctrl`` of ``scenario`` for the rover of ``choice``."""
     return PathFollowingController("ctrl", models, path=scenario_path(scenario, straight),
-                                   v_target=SCENARIOS[scenario], steering=steering)
+                                   v_target=SCENARIOS[scenario], steering=steering, **rover_geometry(choice))
 
 
 def connect_controller(builder: SystemBuilder, body: str, wheel: Any, wheels: range) -> None:
@@ -111,10 +121,11 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, stee
     """``scenario`` on SteerableRover.fmu, started rolling at its speed."""
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} ({steering})", scenario, straight)
-    wheels = hubs(Path(fmu_dir) / "SteerableRover.fmu")
+    plant = rover_fmu(fmu_dir, "SteerableRover", choice)
+    wheels = hubs(plant)
     start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in wheels}}
-    add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
-    builder.add_block("ctrl", controller(models_of(model), scenario, steering, straight))
+    add_plant_fmu(builder, "rover", plant, choice, start)
+    builder.add_block("ctrl", controller(models_of(model), scenario, steering, straight, choice))
     connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", wheels)
     for i in wheels:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
@@ -132,12 +143,14 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice
     wheel = soil_and_wheel_of(models)[1]
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} (adaptive)", scenario, straight)
-    wheels = hubs(Path(fmu_dir) / "SteerableRover.fmu")
+    plant = rover_fmu(fmu_dir, "SteerableRover", choice)
+    wheels = hubs(plant)
     start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in wheels}}
-    add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice, start)
+    add_plant_fmu(builder, "rover", plant, choice, start)
     block = AdaptivePathController("ctrl", models, adapter_for(models, fmu_dir, cache_dir, lateral=True),
                                    radius=wheel.r, inertia=wheel.J, calibration=calibration,
-                                   path=scenario_path(scenario, straight), v_target=speed)
+                                   path=scenario_path(scenario, straight), v_target=speed,
+                                   **rover_geometry(choice))
     builder.add_block("ctrl", block)
     connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", wheels)
     for i in wheels:
@@ -152,14 +165,15 @@ def _radius(choice: Choice | None) -> float:
 
 def cosim_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: Choice | None = None,
                  straight: float = STRAIGHT) -> System:
-    """``scenario`` on SteerableRoverBody + 6 Wheel (the hubs of the shipped
+    """``scenario`` on SteerableRoverBody + N Wheel (the hubs of the shipped
     steerable_rover_cosim.toml), started rolling at its speed, the controller first in the order."""
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} (cosim)", scenario, straight)
-    limbs = hubs(Path(fmu_dir) / "SteerableRoverBody.fmu")
-    wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", len(limbs),
+    body = rover_fmu(fmu_dir, "SteerableRoverBody", choice)
+    limbs = hubs(body)
+    wheels = add_rover(builder, body, Path(fmu_dir) / "Wheel.fmu", len(limbs),
                        choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": speed / _radius(choice)})
-    builder.add_block("ctrl", controller(models_of(model), scenario, "inverse", straight))
+    builder.add_block("ctrl", controller(models_of(model), scenario, "inverse", straight, choice))
     connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}", limbs)
     for i, wheel in zip(limbs, wheels):
         builder.connect(f"ctrl.tau[{i}]", f"{wheel}.tau").connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
@@ -238,7 +252,9 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
     record = campaign.record(
         {"scenarios": {s: {"target_speed_m_s": SCENARIOS[s], "stop_time_s": stop_time(s, straight)} for s in scenarios},
          "straight_m": straight, "model": str(model), "record_interval_s": record_interval},
-        fmu_dir=fmu_dir, fmus=FMUS, model=model, choice=choice, mismatch=mismatch,
+        fmu_dir=fmu_dir, fmus=(rover_fmu(fmu_dir, "SteerableRover", choice),
+                               rover_fmu(fmu_dir, "SteerableRoverBody", choice), "Wheel"),
+        model=model, choice=choice, mismatch=mismatch,
         metrics=metric_table.to_dict("records"), agreement=agreement_table.to_dict("records"))
     out = Path(out_dir)
     suffix = {"inverse": "", "cosim": "_cosim", "kinematic": "_kinematic"}

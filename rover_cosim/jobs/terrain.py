@@ -82,9 +82,9 @@ from rover_cosim.terramechanics.terrain import HeightMap, SoilMap, crater, soil_
 from . import terrain_figures
 from .campaign import Campaign
 from .ground import SIGNALS, GroundBlock, SoilBlock
-from .path_following import BODY, STEP, PathResult, agreement, connect_controller, trajectories
+from .path_following import BODY, STEP, PathResult, agreement, connect_controller, rover_geometry, trajectories
 from .path_following import metrics as path_metrics
-from .plants import add_plant_fmu, add_rover, hubs
+from .plants import add_plant_fmu, add_rover, hubs, rover_fmu
 from .simulate import RECORD_INTERVAL, checked_models, models_of
 
 SPEED = 0.3          # m/s, the traverse's target speed
@@ -324,11 +324,17 @@ def _radius(choice: Choice | None) -> float:
     return (choice.wheel if choice else Wheel()).r
 
 
-def _add_ground(builder: SystemBuilder, body: str, height_map: HeightMap | None, hubs: range) -> list[str]:
+def _hubs_of(choice: Choice | None) -> dict[str, Any]:
+    """Where the rover's hubs are (x_limb, y_limb [m]) for the ground and soil participants."""
+    return {"x_limb": choice.rover.x_limb, "y_limb": choice.rover.y_limb} if choice is not None else {}
+
+
+def _add_ground(builder: SystemBuilder, body: str, height_map: HeightMap | None, hubs: range,
+                choice: Choice | None = None) -> list[str]:
     """The ground participant on ``body``'s ``hubs`` (none without a map); its name in a list."""
     if height_map is None:
         return []
-    builder.add_block("ground", GroundBlock("ground", height_map))
+    builder.add_block("ground", GroundBlock("ground", height_map, **_hubs_of(choice)))
     for name in BODY:
         builder.connect(f"{body}.{name}", f"ground.{name}")
     for signal in SIGNALS:
@@ -338,12 +344,12 @@ def _add_ground(builder: SystemBuilder, body: str, height_map: HeightMap | None,
 
 
 def _add_soil(builder: SystemBuilder, body: str, soil_map: SoilMap | None, share_of: Callable[[int], str],
-              hubs: range) -> list[str]:
+              hubs: range, choice: Choice | None = None) -> list[str]:
     """The soil participant on ``body``'s ``hubs`` (none without a map) feeding ``share_of(i)``; its
     name in a list."""
     if soil_map is None:
         return []
-    builder.add_block("soil", SoilBlock("soil", soil_map))
+    builder.add_block("soil", SoilBlock("soil", soil_map, **_hubs_of(choice)))
     for name in BODY[:3]:
         builder.connect(f"{body}.{name}", f"soil.{name}")
     for i in hubs:
@@ -387,15 +393,18 @@ def traverse_system(fmu_dir: Path, model: ModelSet | Path, terrain: PlaneTerrain
     believes_soil = soil_map is not None and run_ in ("inverse", "cosim")
     block = TerrainPathController("ctrl", models_of(model), path=traverse_path(length), v_target=speed,
                                     steering="kinematic" if run_ == "kinematic" else "inverse",
-                                    terrain=None if run_ == "unaware" and soil_map is None else terrain, g=G,
-                                    mass=MASS, ground_map=height_map if run_ in ("inverse", "cosim") else None,
+                                    terrain=None if run_ == "unaware" and soil_map is None else terrain,
+                                    g=choice.soil.gravity if choice is not None else G,
+                                    **(rover_geometry(choice) if choice is not None else {"mass": MASS}),
+                                    ground_map=height_map if run_ in ("inverse", "cosim") else None,
                                     soil_map=soil_map if believes_soil else None,
                                     model_b=model_b if believes_soil else None)
     soil_b = soil_parameters(soil_map.soil_b, "soilB") if soil_map is not None else {}
     if run_ == "cosim":
-        limbs = hubs(Path(fmu_dir) / "SteerableRoverBody.fmu")
-        wheels = add_rover(builder, Path(fmu_dir) / "SteerableRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu",
-                           len(limbs), choice, lateral=True, body_start={"v": speed}, wheel_start={"omega": spin})
+        body = rover_fmu(fmu_dir, "SteerableRoverBody", choice)
+        limbs = hubs(body)
+        wheels = add_rover(builder, body, Path(fmu_dir) / "Wheel.fmu", len(limbs), choice, lateral=True,
+                           body_start={"v": speed}, wheel_start={"omega": spin})
         builder.set_parameters("body", terrain.fmu_parameters())
         builder.add_block("ctrl", block)
         connect_controller(builder, "body", lambda i, name: f"wheel{i}.{name}", limbs)
@@ -404,19 +413,20 @@ def traverse_system(fmu_dir: Path, model: ModelSet | Path, terrain: PlaneTerrain
             builder.connect(f"ctrl.steer[{i}]", f"body.steer[{i}]")
             if soil_b:
                 builder.set_parameters(wheel, soil_b)
-        ground = _add_ground(builder, "body", height_map, limbs)
-        soil = _add_soil(builder, "body", soil_map, lambda i: f"{wheels[i - 1]}.soilShare", limbs)
+        ground = _add_ground(builder, "body", height_map, limbs, choice)
+        soil = _add_soil(builder, "body", soil_map, lambda i: f"{wheels[i - 1]}.soilShare", limbs, choice)
         return builder.simulation(order=["ctrl", "body", *ground, *soil, *wheels]).build()
-    limbs = hubs(Path(fmu_dir) / "SteerableRover.fmu")
-    add_plant_fmu(builder, "rover", Path(fmu_dir) / "SteerableRover.fmu", choice,
+    plant = rover_fmu(fmu_dir, "SteerableRover", choice)
+    limbs = hubs(plant)
+    add_plant_fmu(builder, "rover", plant, choice,
                   {"v": speed, **{f"omega[{i}]": spin for i in limbs}})
     builder.set_parameters("rover", {**terrain.fmu_parameters(), **soil_b})
     builder.add_block("ctrl", block)
     connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", limbs)
     for i in limbs:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
-    ground = _add_ground(builder, "rover", height_map, limbs)
-    soil = _add_soil(builder, "rover", soil_map, lambda i: f"rover.soilShare[{i}]", limbs)
+    ground = _add_ground(builder, "rover", height_map, limbs, choice)
+    soil = _add_soil(builder, "rover", soil_map, lambda i: f"rover.soilShare[{i}]", limbs, choice)
     if ground or soil:
         builder.simulation(order=["ctrl", "rover", *ground, *soil])
     return builder.build()
@@ -499,7 +509,9 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
                                 "target_speed_m_s": s.speed, "length_m": s.length,
                                 "stop_time_s": stop_time(s.length, s.speed), **s.details()} for s in chosen},
          "model": str(model), "runs": list(runs), "record_interval_s": record_interval},
-        fmu_dir=fmu_dir, fmus=FMUS, model=model, choice=choice, mismatch=mismatch,
+        fmu_dir=fmu_dir, fmus=(rover_fmu(fmu_dir, "SteerableRover", choice),
+                               rover_fmu(fmu_dir, "SteerableRoverBody", choice), "Wheel"),
+        model=model, choice=choice, mismatch=mismatch,
         metrics=metric_table.to_dict("records"), agreement=agreement_table.to_dict("records"))
     for name, ready in prepared.items():
         if ready.model_b is not None:
