@@ -37,12 +37,14 @@ def cli_page() -> str:
 
 
 def library_page() -> str:
-    """The shipped soils and wheels: every value in SI, its title and source."""
-    lines = ["# Soils and wheels", "", "Generated from the library files "
-             "(`rover_cosim/terramechanics/library/*.toml`); `rover-cosim soils NAME` shows one with its notes.", ""]
+    """The shipped soils, wheels and rovers: every value in SI, its title and source."""
+    lines = ["# Soils, wheels and rovers", "", "Generated from the library files "
+             "(`rover_cosim/terramechanics/library/*.toml`); `rover-cosim soils NAME` and `rover-cosim rovers NAME` "
+             "show one with its notes.", ""]
     lines += format_section()
+    lines += rover_format_section()
     folder = resources.files("rover_cosim.terramechanics") / "library"
-    for kind in ("soils", "wheels"):
+    for kind in ("soils", "wheels", "rovers"):
         tables: dict[str, Any] = tomllib.loads((folder / f"{kind}.toml").read_text())
         lines += [f"## {kind.capitalize()}", ""]
         for name, table in tables.items():
@@ -81,6 +83,35 @@ def format_section() -> list[str]:
                          f"{accepted} |")
         lines.append("")
     return lines
+
+
+def rover_format_section() -> list[str]:
+    """The TOML format of a rover file: every key with its unit and the paper's value (from
+    terramechanics.Rover and its units)."""
+    from dataclasses import fields
+
+    from rover_cosim.terramechanics.parameters import ROVER_UNITS, Rover
+
+    doc = Rover.__doc__ or ""
+    meaning = {}
+    for line in doc.split("Attributes:")[-1].strip().splitlines():
+        key, _, text = line.strip().partition(": ")
+        if key.isidentifier() and text:
+            meaning[key] = text.split(" [")[0]
+    lines = ["### Rover keys", "", "A rover file is TOML as a soil's; the rover's wheels sit on two mirrored sides, "
+             "`len(x_limb)` per side (wheels 1..n on the left from front to rear, n+1..2n on the right); its "
+             "gravity is the soil's (where it drives). `wheel` names the rover's wheel (a name of the library or "
+             "a wheel file), used unless `--wheel` names another. Use it with `--rover FILE` on any command, "
+             "`--set rover.mass=740`, `--set rover.x_limb=1.2,-1.2`, or `make run ROVER=FILE`. The rover FMUs "
+             "are built for its number of wheels on first use (`fmus/wheels<N>/`).", "",
+             "| key | unit | default (paper) | meaning |", "|---|---|---|---|",
+             "| `wheel` | - | paper | the rover's wheel |"]
+    default = Rover()
+    for field in fields(Rover):
+        value = getattr(default, field.name)
+        shown = ", ".join(f"{v:g}" for v in value) if isinstance(value, tuple) else f"{value:.6g}"
+        lines.append(f"| `{field.name}` | {ROVER_UNITS[field.name]} | {shown} | {meaning.get(field.name, '')} |")
+    return [*lines, ""]
 
 
 REPOSITORY = Path(__file__).resolve().parent.parent

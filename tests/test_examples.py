@@ -23,7 +23,7 @@ from rover_cosim.terramechanics.library import choose
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 EXAMPLES = REPOSITORY / "examples"
-SCRIPTS = ("wheel_fmu_loop", "own_soil", "drawbar_pull", "monte_carlo")
+SCRIPTS = ("wheel_fmu_loop", "own_soil", "own_rover", "drawbar_pull", "monte_carlo")
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
@@ -141,6 +141,25 @@ def test_an_own_soil_goes_end_to_end(fmus, tmp_path):
     for plant in ("monolithic", "cosim"):
         assert max(simulation["rms_N"][plant]) < 1.0, simulation["rms_N"]   # measured 0.24-0.36 N
         assert simulation["checks"][plant]["final_v_m_s"] == pytest.approx(1.0, abs=0.02)
+
+
+def test_an_own_rover_goes_end_to_end_on_its_own_wheels(fmus, tmp_path):
+    """examples/two_axle.toml: a 60 kg four-wheeler on MER wheels, its plan around its 24 N wheel
+    load, its FMUs built for four wheels, the closed loop on both plants."""
+    out = tmp_path / "two_axle"
+    stdout = succeeded(run_example("own_rover", tmp_path, "--out", str(out), "--fmu-dir", str(fmus["Wheel"].parent),
+                                   "--quick", "--workers", "1"))
+    assert "rover two_axle: 60 kg on 4 wheels (mer wheel)" in stdout
+    model = json.loads((out / "identification" / "model.json").read_text())
+    plan = model["identification_plan"]
+    assert min(plan["loads"]) < 60.0 * 1.62 / 4 < max(plan["loads"]) and "scaled" in plan["basis"]
+    simulation = json.loads((out / "simulation" / "simulation.json").read_text())
+    assert simulation["rover"]["name"] == "two_axle" and simulation["rover"]["wheels"] == 4
+    assert set(simulation["fmus"]) == {"wheels4/Rover", "wheels4/RoverBody", "Wheel"}
+    for plant in ("monolithic", "cosim"):
+        assert len(simulation["rms_N"][plant]) == 4 and max(simulation["rms_N"][plant]) < 0.5   # measured 0.08-0.15 N
+        assert simulation["checks"][plant]["final_v_m_s"] == pytest.approx(1.0, abs=0.02)
+        assert simulation["checks"][plant]["Fz_at_start_N"] == pytest.approx(60.0 * 1.62 / 4, rel=1e-6)
 
 
 def test_an_own_monte_carlo_study_runs_and_resumes(fmus, tmp_path):
