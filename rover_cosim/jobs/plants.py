@@ -44,7 +44,11 @@ def rover_fmu(fmu_dir: str | Path, name: str, choice: Choice | None) -> Path:
     from rover_cosim.fmubuild.build import build_fmu
 
     folder = Path(fmu_dir) / f"wheels{wheels}"
-    return build_fmu(name, folder, axles=wheels // 2).path
+    try:
+        return build_fmu(name, folder, axles=wheels // 2).path
+    except Exception as error:  # noqa: BLE001 - a compiler, a file system, the exporter: said as one error
+        raise ValueError(f"the rover {choice.rover_name if choice else ''} has {wheels} wheels: {name}.fmu for them "
+                         f"could not be built into {folder} ({type(error).__name__}: {error})") from None
 
 
 def add_plant_fmu(builder: SystemBuilder, name: str, path: str | Path, choice: Choice | None,

@@ -63,12 +63,14 @@ def fig3_file(results: Path, suffix: str) -> Path:
 
 
 def on_paper_soil(results: Path) -> bool:
-    """Whether the results are on the paper's soil and wheel (Table 2, unchanged): only then are
-    the paper's numbers set beside ours."""
+    """Whether the results are on the paper's soil, wheel (Table 2, unchanged) and rover: only then
+    are the paper's numbers set beside ours."""
     record = soil_record(results)
     soil, wheel = record.get("soil", {}), record.get("wheel", {})
     paper_soil = soil.get("values", asdict(Soil())) == asdict(Soil())
-    return paper_soil and wheel.get("values", asdict(Wheel())) == asdict(Wheel()) and not record.get("set")
+    paper_rover = record.get("rover", {}).get("name", "paper") == "paper"
+    return (paper_soil and paper_rover and wheel.get("values", asdict(Wheel())) == asdict(Wheel())
+            and not record.get("set"))
 
 
 def soil_label(results: Path) -> str:
@@ -181,38 +183,45 @@ def closed_loop_section(simulation: Path, paper_soil: bool = True) -> list[str]:
     if not (rms_path.exists() and cosim_path.exists()):
         return [*sections, missing(rms_path)]
     ours, cosim = pd.read_csv(rms_path), pd.read_csv(cosim_path)
+    wheels = len(ours)
+    side = max(1, wheels // 2)
+    cosimulated = f"RoverBody + {wheels} Wheel"
     columns: dict[str, Any] = {"limb": [str(i) for i in ours["limb"]]}
     if paper_soil:
-        columns["paper RMS [N]"] = [f"{PAPER_RMS[i]:.1f}" if i in PAPER_RMS else f"— (mirror of limb {i - 3})"
+        columns["paper RMS [N]"] = [f"{PAPER_RMS[i]:.1f}" if i in PAPER_RMS else f"— (mirror of limb {i - side})"
                                     for i in ours["limb"]]
-    columns.update({"ours, Rover.fmu [N]": ours["rms_N"], "ours, RoverBody + 6 Wheel [N]": cosim["rms_N"]})
+    columns.update({"ours, Rover.fmu [N]": ours["rms_N"], f"ours, {cosimulated} [N]": cosim["rms_N"]})
     sections.append(table(pd.DataFrame(columns), default="{:.2f}"))
-    sections.append("<p>RMS(Fx - Fx_des) per limb; limbs 4-6 mirror 1-3"
+    sections.append(f"<p>RMS(Fx - Fx_des) per limb; limbs {side + 1}-{wheels} mirror 1-{side}"
                     + (" (the paper reports 1-3)." if paper_soil else "; the paper's Table 3 is for its own soil.")
                     + "</p>")
+    record_path = simulation / "simulation.json"
     ablation = simulation / "ablation_fixed_load.csv"
     if ablation.exists():
+        fixed = read_record(record_path).get("parameters", {}).get("fixed_load_ablation_N") \
+            if record_path.exists() else None
+        load = f"{fixed:.0f} N" if isinstance(fixed, (int, float)) else "the static wheel load"
         shown = pd.read_csv(ablation).rename(columns={"rms_lut_N": "RMS, per-load look-up tables [N]",
-                                                      "rms_fixed_load_N": "RMS, one model at 424 N [N]"})
+                                                      "rms_fixed_load_N": f"RMS, one model at {load} [N]"})
         shown["limb"] = shown["limb"].astype(str)
-        sections += ["<p>Ablation: the same controller with one model at a fixed 424 N instead of the per-load "
-                     "look-up tables:</p>", table(shown, default="{:.2f}")]
-    record_path = simulation / "simulation.json"
+        sections += [f"<p>Ablation: the same controller with one model at a fixed {load} (the rover's static "
+                     "wheel load) instead of the per-load look-up tables:</p>", table(shown, default="{:.2f}")]
     if record_path.exists() and read_record(record_path).get("model_mismatch"):
         why = html.escape(str(read_record(record_path)["model_mismatch"]))
         sections.insert(1, f"<p class='note'>Run with --allow-model-mismatch: {why}</p>")
     if record_path.exists():
         checks = read_record(record_path).get("checks", {})
-        rows = [{"plant": {"monolithic": "Rover.fmu", "cosim": "RoverBody + 6 Wheel"}.get(p, p),
+        rows = [{"plant": {"monolithic": "Rover.fmu", "cosim": cosimulated}.get(p, p),
                  **{CHECKS[k][0]: v for k, v in values.items() if k in CHECKS}} for p, values in checks.items()]
         formats = {label: fmt for label, fmt in CHECKS.values()}
         sections += ["<p>Velocity and loads (paper: the rover reaches 1.0 m/s, Fig. 10 g; limb 1 unloads and "
-                     "limb 3 loads while accelerating, Fig. 10 c):</p>", table(pd.DataFrame(rows), formats)]
+                     f"limb {side} (the rear of a side) loads while accelerating, Fig. 10 c):</p>",
+                     table(pd.DataFrame(rows), formats)]
     sections += [image(simulation / "fig10_closed_loop.png", "Fig. 10 (a)-(h), Rover.fmu; limbs drawn solid, "
                        "dashed and dotted, so that curves that coincide stay visible"),
                  image(simulation / "fig_tracking.png", "position x against x_t, the force error Fx - Fx_des, and "
                        "the co-simulated plant minus the monolithic one"),
-                 image(simulation / "fig10_closed_loop_cosim.png", "Fig. 10 (a)-(h), RoverBody + 6 Wheel")]
+                 image(simulation / "fig10_closed_loop_cosim.png", f"Fig. 10 (a)-(h), {cosimulated}")]
     return sections
 
 

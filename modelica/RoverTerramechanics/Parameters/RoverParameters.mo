@@ -16,6 +16,10 @@ record RoverParameters "ATHLETE-like rover body: mass, gravity, inertia, geometr
 rover parameter is chosen here, in one place:</p>
 <table border=\"1\" cellpadding=\"3\">
 <tr><th>parameter</th><th>value</th><th>source or reasoning</th></tr>
+<tr><td>nAxles</td><td>3</td><td>wheels per side, six in all (the paper's rover). Structural: it sizes
+the arrays of the rover models, so an FMU is built for one value; <code>rover-cosim</code> builds the
+rover FMUs for another rover's count on first use (<code>fmus/wheels&lt;N&gt;/</code>). Wheels 1..nAxles
+are the left side from front to rear, nAxles+1..2 nAxles mirror them on the right.</td></tr>
 <tr><td>xLimb</td><td>+1.5, 0, -1.5 m</td><td>ATHLETE's hexagonal frame is about 2.75 m across
 (JPL); with the legs splayed the wheels of a side sit about 1.5 m ahead of, under, and behind the
 centre. Limbs 1-3 are front, middle and rear of one side; limbs 4-6 mirror them at the same x.
