@@ -177,3 +177,22 @@ def test_study_values_are_escaped_and_a_linked_figure_is_not_embedded(tmp_path):
     assert "&lt;script&gt;1&lt;/script&gt;" in page and "&lt;iframe src=y&gt;" in page
     assert "is not a regular file (a link or a folder): not embedded" in page
     assert base64.b64encode(b"not for the page").decode() not in page
+
+
+def test_table_3_of_a_four_wheel_rover_names_its_wheels_and_its_static_load(tmp_path):
+    """A rover of four wheels (issue 46): the mirror, the co-simulated plant and the ablation's load
+    come from its results, not the paper's six wheels and 424 N; the paper's column stays out."""
+    from rover_cosim.report.sections import closed_loop_section
+
+    simulation = tmp_path / "simulation"
+    simulation.mkdir()
+    rms = "limb,rms_N\n1,0.10\n2,0.09\n3,0.10\n4,0.09\n"
+    (simulation / "rms.csv").write_text(rms)
+    (simulation / "rms_cosim.csv").write_text(rms)
+    (simulation / "ablation_fixed_load.csv").write_text("limb,rms_lut_N,rms_fixed_load_N\n" + "".join(
+        f"{i},0.1,0.7\n" for i in range(1, 5)))
+    (simulation / "simulation.json").write_text(json.dumps({"parameters": {"fixed_load_ablation_N": 174.15},
+                                                            "checks": {}}))
+    text = "\n".join(closed_loop_section(simulation, paper_soil=False))
+    assert "limbs 3-4 mirror 1-2" in text and "RoverBody + 4 Wheel" in text and "one model at 174 N" in text
+    assert "424" not in text and "6 Wheel" not in text and "paper RMS" not in text
