@@ -194,13 +194,18 @@ def test_the_path_controllers_c_twin_follows_any_number_of_wheels(model, x_limb)
     block = PathFollowingController("ctrl", str(model), path="turn", x_limb=x_limb, y_limb=0.61, mass=430.0,
                                     yaw_inertia=161.3)
     assert block.wheels == 2 * len(x_limb) and len(block.outputs) == 4 * block.wheels + 4
+    twin_follows_the_block(block, rng, 400, f"{block.wheels} wheels")
+
+
+def twin_follows_the_block(block: PathFollowingController, rng: np.random.Generator, steps: int, label: str) -> None:
+    """``steps`` steps of 1 ms near the block's path: its C twin's outputs equal the block's bit for bit."""
     block.start(0.0, near_the_path(block, 0.0, rng))
     twin = Twin(block, "path")
     t = 0.0
-    for k in range(1, 400):
+    for k in range(1, steps):
         u = near_the_path(block, 0.01 * k, rng)
         expected, got = block.step(t, 1e-3, u), twin.step(t, 1e-3, u)
-        assert np.array_equal(expected, got), f"step {k}: outputs {np.flatnonzero(expected != got)} differ"
+        assert np.array_equal(expected, got), f"{label}, step {k}: outputs {np.flatnonzero(expected != got)} differ"
         t += 1e-3
     twin.made.close()
 
@@ -324,15 +329,7 @@ def test_the_twin_takes_the_planes_pull_as_the_terrain_controller_does(model, st
     rng = np.random.default_rng(35)
     for terrain in (PlaneTerrain.side_slope(20.0), PlaneTerrain(0.3, 2.5)):
         block = TerrainPathController("ctrl", str(model), path="lane_change", steering=steering, terrain=terrain)
-        block.start(0.0, near_the_path(block, 0.0, rng))
-        twin = Twin(block, "path")
-        t = 0.0
-        for k in range(1, 1500):
-            u = near_the_path(block, 0.01 * k, rng)
-            expected, got = block.step(t, 1e-3, u), twin.step(t, 1e-3, u)
-            assert np.array_equal(expected, got), f"{terrain.label()}, step {k}: outputs differ"
-            t += 1e-3
-        twin.made.close()
+        twin_follows_the_block(block, rng, 1500, terrain.label())
 
     class Bowl:
         def gradient(self, x: Any, y: Any) -> tuple[Any, Any]:
