@@ -36,7 +36,8 @@ def test_tables_are_labelled_and_have_no_nan(page):
     for raw in ("rms_lut_N", "final_v_m_s", "fit_percent_quadratic", "time_to_98_percent_s"):
         assert raw not in text, raw
     assert "mirror of limb 1" in page and "final velocity [m/s]" in page
-    assert "Soil and wheel in use (Table 2)" in page and "friction angle φ" in page
+    assert "Soil, wheel and rover in use (Table 2)" in page and "friction angle φ" in page
+    assert "Rover <b>paper: ATHLETE-like" in page and "static wheel load 423.9 N" in page
 
 
 def test_every_table_scrolls_inside_its_box(page):

@@ -23,7 +23,7 @@ def build_report(results: Path) -> str:
                   "<code>make run</code>; the paper's values are quoted beside ours.</p>")]
     else:
         parts = [f"<h1>rover-cosim: the paper's pipeline on {label}</h1>",
-                 (f"<p>Every number below is read from the files under <code>{folder}</code>. The soil or wheel "
+                 (f"<p>Every number below is read from the files under <code>{folder}</code>. The soil, wheel or rover "
                   "is not the paper's, so the paper's numbers are not set beside these.</p>")]
     parts += sections.soil_section(results)
     parts += sections.fig3_section(results)

@@ -17,6 +17,7 @@ from rover_cosim.common.paper import TABLE_3_RMS as PAPER_RMS
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.jobs.simulate import CHECKS
 from rover_cosim.terramechanics import Soil, Wheel
+from rover_cosim.terramechanics.parameters import ROVER_UNITS, Rover
 
 from .page import image, missing, provenance, read_record, table
 
@@ -74,10 +75,12 @@ def on_paper_soil(results: Path) -> bool:
 
 
 def soil_label(results: Path) -> str:
-    """"soil NAME, wheel NAME" of the results (not escaped)."""
+    """"soil NAME, wheel NAME[, rover NAME]" of the results (not escaped; the rover where it is not
+    the paper's)."""
     record = soil_record(results)
+    rover = record.get("rover", {}).get("name", "paper")
     return (f"soil {record.get('soil', {}).get('name', 'paper')}, "
-            f"wheel {record.get('wheel', {}).get('name', 'paper')}")
+            f"wheel {record.get('wheel', {}).get('name', 'paper')}" + (f", rover {rover}" if rover != "paper" else ""))
 
 
 def soil_section(results: Path) -> list[str]:
@@ -95,10 +98,32 @@ def soil_section(results: Path) -> list[str]:
     wheel_name = html.escape(f"{wheel.get('name', 'paper')}: {wheel.get('title') or 'the paper’s wheel'}")
     changed = html.escape(", ".join(map(str, record.get("set") or [])))
     source = html.escape(str(soil.get("source") or "paper Table 2"))
-    return ["<h2>Soil and wheel in use (Table 2)</h2>",
+    return ["<h2>Soil, wheel and rover in use (Table 2)</h2>",
             f"<p>Soil <b>{name}</b>; wheel <b>{wheel_name}</b>" + (f"; changed with {changed}" if changed else "")
             + f". Source: {source}.</p>",
-            table(pd.DataFrame(rows), default="{:.4g}")]
+            table(pd.DataFrame(rows), default="{:.4g}"), *rover_rows(record)]
+
+
+def rover_rows(record: dict[str, Any]) -> list[str]:
+    """The rover in use (a record's ``rover``): its values beside the paper's, its wheel count and
+    static wheel load; nothing for a record without one."""
+    rover = record.get("rover")
+    if not rover:
+        return []
+    values, paper = rover.get("values", {}), asdict(Rover())
+    gravity = record.get("soil", {}).get("values", {}).get("gravity", Soil().gravity)
+
+    def shown(value: Any) -> str:
+        return ", ".join(f"{v:g}" for v in value) if isinstance(value, (list, tuple)) else f"{value:.4g}"
+
+    rows = [{"parameter": key, "unit": ROVER_UNITS.get(key, ""), "paper's rover": shown(paper[key]),
+             "in use": shown(values.get(key, paper[key]))} for key in paper]
+    mass, wheels = float(values.get("mass", paper["mass"])), int(rover.get("wheels", 6))
+    title = html.escape(f"{rover.get('name', 'paper')}: {rover.get('title') or 'the paper’s rover'}")
+    source = html.escape(str(rover.get("source") or "paper Sec. 4"))
+    return [f"<p>Rover <b>{title}</b>: {mass:g} kg on {wheels} wheels, static wheel load "
+            f"{mass * gravity / wheels:.1f} N (M g / N, the soil's gravity). Source: {source}.</p>",
+            table(pd.DataFrame(rows))]
 
 
 def fig3_section(results: Path) -> list[str]:
