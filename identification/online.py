@@ -33,8 +33,9 @@ from numpy.typing import NDArray
 
 from rover_cosim.terramechanics import Soil, Wheel
 
-from .fits import IdentifiedModel, identify, step_table
+from .fits import FIT_TORQUE_MAX, IdentifiedModel, identify, step_table
 from .lateral import LATERAL_SAMPLE_TIME, LATERAL_SLIP_ANGLES_DEG, LateralModel, identify_lateral, lateral_table
+from .plan import torques_for
 from .soil_estimation import SoilEstimate, estimate_soil
 from .sweep import SweepPlan, run_sweep
 from .testbed_data import TestBedData
@@ -92,29 +93,35 @@ def sweep_loads(loads: FloatArray) -> tuple[float, ...]:
 
 
 def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path, degree: int,
-                     plan: SweepPlan | None = None) -> tuple[IdentifiedModel, int]:
+                     plan: SweepPlan | None = None,
+                     torque_max: float = ADAPTED_FIT_TORQUE_MAX) -> tuple[IdentifiedModel, int]:
     """The paper's longitudinal model (LUTs and the Fx fit of ``degree``) identified by the sweep on
     ``fmu_path`` (SingleWheel.fmu) with ``soil`` and ``wheel`` as its parameters, in this process,
-    the Fx fit through the points up to ADAPTED_FIT_TORQUE_MAX; (the model, the runs computed)."""
+    the Fx fit through the points up to ``torque_max`` [N·m] (ADAPTED_FIT_TORQUE_MAX for the
+    paper's wheel; a plan scaled to another wheel scales it too); (the model, the runs computed)."""
     plan = replace(plan or SweepPlan(), soil=soil, wheel=wheel)
     sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=1)
     if not sweep.runs:
         raise RuntimeError(f"every run of the sweep on the estimated soil failed; first error: "
                            f"{next(iter(sweep.failures.values()))}")
-    return identify(step_table(sweep.at_slip_angle(0.0)), degree, ADAPTED_FIT_TORQUE_MAX), sweep.computed
+    return identify(step_table(sweep.at_slip_angle(0.0)), degree, torque_max), sweep.computed
 
 
 def identify_lateral_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path,
-                             loads: tuple[float, ...]) -> tuple[LateralModel, int]:
+                             loads: tuple[float, ...], torques: tuple[float, ...] | None = None,
+                             torque_max: float = FIT_TORQUE_MAX) -> tuple[LateralModel, int]:
     """The lateral model (the recommended form) identified by the lateral sweep on ``fmu_path``
-    with ``soil`` and ``wheel`` at ``loads`` [N]; (the model, the runs computed)."""
+    with ``soil`` and ``wheel`` at ``loads`` [N] and ``torques`` [N·m] (None: the paper's), fitted
+    up to ``torque_max`` [N·m]; (the model, the runs computed)."""
     plan = SweepPlan(loads=loads, slip_angles_deg=LATERAL_SLIP_ANGLES_DEG, sample_time=LATERAL_SAMPLE_TIME,
                      soil=soil, wheel=wheel)
+    if torques is not None:
+        plan = replace(plan, torques=tuple(torques))
     sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=1)
     if not sweep.runs:
         raise RuntimeError(f"every run of the lateral sweep on the estimated soil failed; first error: "
                            f"{next(iter(sweep.failures.values()))}")
-    return identify_lateral(lateral_table(sweep.runs)), sweep.computed
+    return identify_lateral(lateral_table(sweep.runs), torque_max=torque_max), sweep.computed
 
 
 def adapt_model(data: TestBedData, fmu_path: Path, wheel: Wheel, prior: Soil, cache_dir: Path,
@@ -127,10 +134,14 @@ def adapt_model(data: TestBedData, fmu_path: Path, wheel: Wheel, prior: Soil, ca
     estimate = estimate_soil(data, wheel, prior)
     estimated = time.perf_counter()
     loads = sweep_loads(data.load_N)
-    model, computed = identify_on_soil(fmu_path, estimate.soil, wheel, cache_dir, degree, SweepPlan(loads=loads))
+    torques, fit_max = torques_for(estimate.soil, wheel, loads)  # the paper's for the paper's wheel
+    model, computed = identify_on_soil(fmu_path, estimate.soil, wheel, cache_dir, degree,
+                                       SweepPlan(loads=loads, torques=torques),
+                                       ADAPTED_FIT_TORQUE_MAX / FIT_TORQUE_MAX * fit_max)
     lateral_model = None
     if lateral:
-        lateral_model, more = identify_lateral_on_soil(fmu_path, estimate.soil, wheel, cache_dir, loads)
+        lateral_model, more = identify_lateral_on_soil(fmu_path, estimate.soil, wheel, cache_dir, loads, torques,
+                                                       fit_max)
         computed += more
     return Adaptation(estimate, model, len(data.load_N), estimated - started, time.perf_counter() - estimated,
                       computed, lateral_model)

@@ -21,6 +21,7 @@ slip). A plan can also be given as a TOML file (:func:`read_plan`, ``identify --
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from dataclasses import asdict, dataclass, fields
@@ -31,7 +32,7 @@ import numpy as np
 
 from rover_cosim.common.paper import LOADS as PAPER_LOADS
 from rover_cosim.common.paper import STATIC_WHEEL_LOAD
-from rover_cosim.terramechanics import wheel_state
+from rover_cosim.terramechanics import Soil, Wheel, wheel_state
 from rover_cosim.terramechanics.library import Choice, choose
 
 from .fits import FIT_TORQUE_MAX, SLIP_FIT_RANGE
@@ -181,6 +182,41 @@ def _settled_slip_range(choice: Choice, load: float) -> tuple[float, float]:
     return float(state.Tx[0]), float(state.Tx[1])
 
 
+def _torque_levels(choice: Choice, scale: float, loads: list[float]) -> tuple[set[float], float, list[float]]:
+    """The paper's torque levels times ``scale`` and its fits' largest torque likewise, with the
+    levels added where a load of ``loads`` [N] has fewer than POINTS_NEEDED in the window;
+    (torques [N·m], fits' largest torque [N·m], the added ones)."""
+    torques = {_significant(t * scale) for t in PAPER_TORQUES}
+    fit_max = _significant(FIT_TORQUE_MAX * scale)
+    added = []
+    for w in loads:
+        low, high = _settled_slip_range(choice, w)
+        inside = [t for t in torques if low <= t <= min(high, fit_max)]
+        if len(inside) < POINTS_NEEDED:
+            extra = _state(choice, w, np.array(ADDED_SLIPS)).Tx
+            for t in extra:
+                if t > 0:
+                    torques.add(_significant(float(t)))
+                    added.append(_significant(float(t)))
+            fit_max = max(fit_max, max(_significant(float(t)) for t in extra))
+    return torques, fit_max, added
+
+
+def torques_for(soil: Soil, wheel: Wheel, loads: tuple[float, ...]) -> tuple[tuple[float, ...], float]:
+    """Torque levels [N·m] and the fits' largest torque [N·m] for a sweep of ``wheel`` on ``soil``
+    at ``loads`` [N] (a re-identification on an estimated soil): the paper's for the paper's wheel,
+    else the paper's scaled by the wheel's Tx at the loads' middle (as :func:`plan_for` scales)."""
+    paper = choose()
+    if wheel == paper.wheel:
+        return PAPER_TORQUES, FIT_TORQUE_MAX
+    choice = dataclasses.replace(paper, soil=soil, wheel=wheel, wheel_name="the rover's")
+    middle = float(np.median(loads))
+    scale = float(_state(choice, middle, np.array([SCALE_SLIP])).Tx[0]) / float(
+        _state(paper, STATIC_WHEEL_LOAD, np.array([SCALE_SLIP])).Tx[0])
+    torques, fit_max, _ = _torque_levels(choice, scale, list(loads))
+    return tuple(sorted(torques)), fit_max
+
+
 def plan_for(choice: Choice) -> IdentificationPlan:
     """The paper's plan for the paper's soil, wheel and rover; for any other choice the paper's
     plan scaled to it (module docstring). NotDrivable before any sweep where the choice cannot
@@ -198,19 +234,7 @@ def plan_for(choice: Choice) -> IdentificationPlan:
     if len(loads) < 2 or not validation:
         raise NotDrivable(f"{choice.wheel_name} wheel on {choice.soil_name}: it carries only {loads} of the plan's "
                           f"loads around the static load {load:.1f} N")
-    torques = {_significant(t * scale) for t in PAPER_TORQUES}
-    fit_max = _significant(FIT_TORQUE_MAX * scale)
-    added = []
-    for w in loads:
-        low, high = _settled_slip_range(choice, w)
-        inside = [t for t in torques if low <= t <= min(high, fit_max)]
-        if len(inside) < POINTS_NEEDED:
-            extra = _state(choice, w, np.array(ADDED_SLIPS)).Tx
-            for t in extra:
-                if t > 0:
-                    torques.add(_significant(float(t)))
-                    added.append(_significant(float(t)))
-            fit_max = max(fit_max, max(_significant(float(t)) for t in extra))
+    torques, fit_max, added = _torque_levels(choice, scale, loads)
     basis = (f"the paper's plan scaled to {choice.rover_name} rover on {choice.soil_name} with the {choice.wheel_name} "
              f"wheel: loads x {factor:.4g} (static wheel load {load:.1f} N against the paper's "
              f"{STATIC_WHEEL_LOAD:.1f} N), torques x {scale:.4g} (Tx at {SCALE_SLIP:g} slip against the paper's)"

@@ -55,6 +55,7 @@ results/simulation/
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 from collections.abc import Callable
@@ -66,12 +67,20 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import file_sha256, json_bytes
+from rover_cosim.common.paper import STATIC_WHEEL_LOAD
 from rover_cosim.common.rows import csv_bytes, every, indices, steps_between_rows
 from rover_cosim.control.path import Line
 from rover_cosim.control.path import Path as ReferencePath
 from rover_cosim.control.terrain_controller import TerrainPathController
+from rover_cosim.identification.fits import FIT_TORQUE_MAX
 from rover_cosim.identification.model_set import ModelSet
-from rover_cosim.identification.online import identify_lateral_on_soil, identify_on_soil, sweep_loads
+from rover_cosim.identification.online import (
+    ADAPTED_FIT_TORQUE_MAX,
+    identify_lateral_on_soil,
+    identify_on_soil,
+    sweep_loads,
+)
+from rover_cosim.identification.plan import plan_for, static_load
 from rover_cosim.identification.sweep import SweepPlan
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.model import System
@@ -215,7 +224,7 @@ class SoilCrossingScenario(TerrainScenario):
         soil_map = _read_back(files[path], lambda name: SoilMap.read(name, choice.soil, choose(soil=self.soil_b).soil))
         soil_map.source = f"{self.soil_b} beyond x = {self.boundary:g} m"
         model_b = identify_second_soil(fmu_dir / "SingleWheel.fmu", self.believed(), choice.wheel,
-                                       models.model().degree)
+                                       models.model().degree, choice)
         files[out / "terrain_soil_crossing_model_b.json"] = model_b.to_json()
         return Prepared(Ground(self.plane(), None, soil_map), files, model_b)
 
@@ -260,17 +269,29 @@ def soil_map_of(soil: Soil, crossing: SoilCrossingScenario = SOIL_CROSSING) -> S
     return soil_boundary(crossing.boundary, soil, soil_b, crossing.width, x_span=(-5.0, crossing.length + 5.0))
 
 
-def identify_second_soil(fmu_path: Path, soil: Soil, wheel: Wheel, degree: int) -> ModelSet:
+def identify_second_soil(fmu_path: Path, soil: Soil, wheel: Wheel, degree: int,
+                         choice: Choice | None = None) -> ModelSet:
     """The longitudinal (of ``degree``) and lateral models of ``soil`` (the second soil the controller
     believes in) and ``wheel``, identified by the sweeps on ``fmu_path`` (SingleWheel.fmu) around
     CROSSING_LOADS, as the adaptive controller identifies them on an estimated soil
-    (``identification.online``), in this process."""
+    (``identification.online``), in this process. For a rover or wheel other than the paper's
+    (``choice``), the loads scaled by its static wheel load and the torques and fit range of the
+    identification plan for it on ``soil`` (``identification.plan``)."""
     import tempfile
 
     loads = sweep_loads(np.array(CROSSING_LOADS))
+    plan, torque_max, torques, lateral_max = SweepPlan(loads=loads), ADAPTED_FIT_TORQUE_MAX, None, FIT_TORQUE_MAX
+    paper = choose()
+    if choice is not None and (wheel != paper.wheel or choice.rover != paper.rover):
+        scaled = plan_for(dataclasses.replace(choice, soil=soil, wheel=wheel))
+        loads = sweep_loads(np.array(CROSSING_LOADS) * static_load(choice) / STATIC_WHEEL_LOAD)
+        torques = scaled.torques
+        plan = SweepPlan(loads=loads, torques=torques)
+        torque_max = ADAPTED_FIT_TORQUE_MAX / FIT_TORQUE_MAX * scaled.fit_torque_max
+        lateral_max = scaled.fit_torque_max
     with tempfile.TemporaryDirectory(prefix="rover-cosim-soil-b-") as cache:
-        model, _ = identify_on_soil(fmu_path, soil, wheel, Path(cache), degree, SweepPlan(loads=loads))
-        lateral, _ = identify_lateral_on_soil(fmu_path, soil, wheel, Path(cache), loads)
+        model, _ = identify_on_soil(fmu_path, soil, wheel, Path(cache), degree, plan, torque_max)
+        lateral, _ = identify_lateral_on_soil(fmu_path, soil, wheel, Path(cache), loads, torques, lateral_max)
     label = f"degree {degree}"
     return ModelSet(label, {label: model}, lateral, {
         "identified_for": "the soil crossing's second soil (rover-cosim simulate, terrain)",
