@@ -49,7 +49,7 @@ positive), and per wheel <code>Fz[i]</code> [N] (= its load), <code>Fx[i]</code>
 <code>omega[i]</code>, and <code>body.z</code>, <code>body.w</code>, <code>body.q</code></li>
 <li>parameters: <code>soil</code>, <code>wheel</code>, <code>rover</code> (RoverParameters),
 <code>slope</code> [rad] = 0, <code>nNodes</code>, <code>nIterations</code>, <code>vEps</code>,
-<code>vHold</code>, <code>vStick</code></li>
+<code>vHold</code>, <code>vStick</code>, <code>nWheels</code> = 2 <code>rover.nAxles</code> (the number of wheels, six; structural: an FMU is built for one count, rover-cosim builds others on first use)</li>
 <li>experiment: 10 s</li>
 </ul>
 
@@ -65,7 +65,7 @@ wheels)</li>
 <code>x</code> [m], <code>v</code> [m/s], <code>z</code> [m] (heave from static equilibrium),
 <code>pitch</code> [rad]; internal states <code>w</code> [m/s] (heave rate), <code>q</code>
 [rad/s] (pitch rate)</li>
-<li>parameters: <code>rover</code> (RoverParameters), <code>slope</code> [rad] = 0</li>
+<li>parameters: <code>rover</code> (RoverParameters), <code>slope</code> [rad] = 0, <code>nWheels</code> = 2 <code>rover.nAxles</code> (the number of wheels, six; structural: an FMU is built for one count, rover-cosim builds others on first use)</li>
 </ul>
 <p>The drive torques are inputs of the body as well as of the wheels: without them the body would
 miss the motors' reaction torque and the cut rover would not be the monolithic one.</p>
@@ -111,7 +111,7 @@ plane itself); <code>soilShare[1..6]</code> [1]: the share of the second soil un
 <li>parameters: <code>soil</code>, <code>soilB</code> (the second soil), <code>wheel</code>, <code>rover</code> (RoverParameters, with
 <code>yLimb</code>, <code>Ixx</code>, <code>Izz</code>), <code>terrain</code> (TerrainParameters:
 <code>slope</code>, <code>downhill</code> [rad]; level by default), <code>nNodes</code>,
-<code>nIterations</code>, <code>vEps</code>, <code>vHold</code>, <code>vStick</code></li>
+<code>nIterations</code>, <code>vEps</code>, <code>vHold</code>, <code>vStick</code>, <code>nWheels</code> = 2 <code>rover.nAxles</code> (the number of wheels, six; structural: an FMU is built for one count, rover-cosim builds others on first use)</li>
 <li>limbs 1-3 front, middle, rear on the left (y = +yLimb), 4-6 on the right; the ground is the
 plane of <code>terrain</code> (x, y, yaw measured in it) with an optional height map over it</li>
 <li>with every <code>steer[i]</code> = 0 it is <code>Rover</code> on level ground (tests: equal to
@@ -138,7 +138,7 @@ to the wheels; the body's pose and rates <code>x</code>, <code>y</code> [m], <co
 <code>w</code> [m/s] (heave rate), <code>q</code> [rad/s] (pitch rate), <code>p</code> [rad/s]
 (roll rate)</li>
 <li>parameters: <code>rover</code> (RoverParameters), <code>terrain</code>
-(TerrainParameters)</li>
+(TerrainParameters), <code>nWheels</code> = 2 <code>rover.nAxles</code> (the number of wheels, six; structural: an FMU is built for one count, rover-cosim builds others on first use)</li>
 </ul>
 
 <h4>RoverReconnected</h4>
