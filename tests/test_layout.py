@@ -23,10 +23,11 @@ PACKAGE = REPOSITORY / "rover_cosim"
 ALLOWED = {
     "common": set(),
     "terramechanics": {"common"},
+    "limbs": {"common"},
     "fmubuild": {"common"},
     "orchestrator": {"common"},
     "identification": {"common", "terramechanics", "orchestrator"},
-    "control": {"common", "orchestrator", "identification"},
+    "control": {"common", "orchestrator", "identification", "limbs"},
 }
 
 

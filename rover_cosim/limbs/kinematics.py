@@ -1,0 +1,224 @@
+"""Forward and inverse kinematics of a limb of the leg-wheel rover (``geometry``), and of its whole
+stance: pure numpy, independent of the Modelica model it cross-checks.
+
+Conventions: the body frame has x forward, y left, z up, origin at the centre of gravity; a
+limb's joint vector is ``q = (q1 .. q6)`` [rad] in the order of ``geometry.JOINT_NAMES``. The
+driving posture hangs the ankle link along the world's vertical (down) with the wheel's axle
+horizontal; the wheel rolls along ``axle x up`` (its heading).
+
+- :func:`forward`: the joint frames and the hub (position, link and axle directions), 4x4 transforms.
+- :func:`jacobian`: d(hub position)/dq and the joints' axes (geometric Jacobian, 6 x 6).
+- :func:`inverse`: the joints that put the hub at a point with the ankle link vertical and the
+  wheel rolling along a heading: closed form on a level body (the hip yaw from the plane of the
+  limb, hip and knee pitch by the law of cosines, the ankle pitch that hangs the link, the steer
+  that turns the axle), Newton on the six conditions for a tilted one.
+- :func:`stance_forward`, :func:`stance_inverse`: the six limbs under a body pose (x, y, z, roll,
+  pitch, yaw; roll about x, then pitch about y, then yaw about z, intrinsic z-y-x).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .geometry import JOINTS, LimbGeometry
+
+FloatArray = NDArray[np.float64]
+#: Newton's tolerance on the conditions of :func:`inverse` [m, and 1 for the directions].
+TOLERANCE = 1e-13
+NEWTON_STEPS = 30
+
+
+class Unreachable(ValueError):
+    """The hub target is out of the limb's reach (the message says by how much)."""
+
+
+def rot_x(angle: float) -> FloatArray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rot_y(angle: float) -> FloatArray:
+    """Rotation about y; a positive angle tips the x axis down (towards -z)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rot_z(angle: float) -> FloatArray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def attitude(roll: float, pitch: float, yaw: float) -> FloatArray:
+    """The body's rotation into the world: R = Rz(yaw) Ry(-pitch) Rx(roll), so that a positive pitch
+    lifts the nose (as the rovers' ``pitch``) and a positive roll lifts the left side."""
+    return rot_z(yaw) @ rot_y(-pitch) @ rot_x(roll)
+
+
+@dataclass(frozen=True)
+class LimbPose:
+    """A limb's frames for joints ``q`` in the body frame (SI): ``origins[k]``, ``axes[k]`` of joint
+    k (k = 0..5), the hub's position, the ankle link's direction (from the ankle towards the hub) and
+    the wheel's axle (unit vectors)."""
+
+    origins: FloatArray   # (6, 3) [m]
+    axes: FloatArray      # (6, 3) [1]
+    hub: FloatArray       # (3,) [m]
+    link: FloatArray      # (3,) [1]
+    axle: FloatArray      # (3,) [1]
+
+    def heading(self, up: ArrayLike = (0.0, 0.0, 1.0)) -> FloatArray:
+        """The unit direction the wheel rolls along: axle x up, normalised [1]."""
+        direction = np.cross(self.axle, np.asarray(up, float))
+        return direction / np.linalg.norm(direction)
+
+
+def _checked(q: ArrayLike) -> FloatArray:
+    joints = np.asarray(q, dtype=float)
+    if joints.shape != (JOINTS,) or not np.all(np.isfinite(joints)):
+        raise ValueError(f"q = {q!r}: expected {JOINTS} finite joint angles [rad]")
+    return joints
+
+
+def forward(geometry: LimbGeometry, q: ArrayLike) -> LimbPose:
+    """The limb's frames and hub for the joint angles ``q`` [rad] (body frame, SI)."""
+    q1, q2, q3, q4, q5, q6 = _checked(q)
+    position = np.array(geometry.mount)
+    rotation = rot_z(geometry.mount_yaw)
+    origins, axes = [], []
+    steps = ((rot_z, q1, 0.0, 2), (rot_y, q2, geometry.thigh, 1), (rot_y, q3, geometry.shank, 1),
+             (rot_y, q4, geometry.ankle, 1), (rot_x, q5, 0.0, 0), (rot_z, q6, geometry.hub_offset, 2))
+    for turn, angle, length, axis in steps:
+        origins.append(position.copy())
+        axes.append(rotation[:, axis].copy())
+        rotation = rotation @ turn(angle)
+        position = position + length * rotation[:, 0]
+    return LimbPose(np.array(origins), np.array(axes), position, rotation[:, 0].copy(), rotation[:, 1].copy())
+
+
+def jacobian(geometry: LimbGeometry, q: ArrayLike) -> FloatArray:
+    """The geometric Jacobian (6 x 6): rows 0-2 d(hub)/dq [m/rad], rows 3-5 the joints' axes (the
+    hub frame's angular velocity per joint rate); column k for joint k."""
+    pose = forward(geometry, q)
+    linear = np.cross(pose.axes, pose.hub - pose.origins)
+    return np.vstack([linear.T, pose.axes.T])
+
+
+def joint_torques(geometry: LimbGeometry, q: ArrayLike, force: ArrayLike,
+                  moment: ArrayLike = (0.0, 0.0, 0.0)) -> FloatArray:
+    """The joint torques [N·m] that hold a force [N] (and moment [N·m]) applied by the ground to the
+    hub, by virtual work: tau = -J^T (F, M) (the joints push back on what the ground pushes)."""
+    wrench = np.concatenate([np.asarray(force, float), np.asarray(moment, float)])
+    return -jacobian(geometry, q).T @ wrench
+
+
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def _level_inverse(geometry: LimbGeometry, hub: FloatArray, heading: float) -> FloatArray:
+    """The closed form on a level body: the ankle link straight down, the wheel rolling along
+    ``heading`` [rad] (body frame), knee up."""
+    ankle = hub + np.array([0.0, 0.0, geometry.drop])
+    mount = np.array(geometry.mount)
+    dx, dy = ankle[0] - mount[0], ankle[1] - mount[1]
+    reach, depth = math.hypot(dx, dy), mount[2] - ankle[2]
+    q1 = _wrap(math.atan2(dy, dx) - geometry.mount_yaw) if reach > 1e-12 else 0.0
+    l1, l2 = geometry.thigh, geometry.shank
+    distance = math.hypot(reach, depth)
+    cosine = (distance ** 2 - l1 ** 2 - l2 ** 2) / (2 * l1 * l2)
+    if not -1.0 <= cosine <= 1.0:
+        limit = l1 + l2 if cosine > 1 else abs(l1 - l2)
+        raise Unreachable(f"hub at {hub.tolist()} m: the ankle is {distance:.4g} m from the hip pitch joint, the "
+                          f"limb reaches {abs(l1 - l2):.4g} to {l1 + l2:.4g} m (off by {abs(distance - limit):.3g} m)")
+    q3 = math.acos(cosine)  # knee up: the shank bends down from the thigh
+    q2 = math.atan2(depth, reach) - math.atan2(l2 * math.sin(q3), l1 + l2 * math.cos(q3))
+    q4 = math.pi / 2 - q2 - q3
+    partial = forward(geometry, [q1, q2, q3, q4, 0.0, 0.0])
+    frame_y = np.cross(partial.link, partial.axle)  # the ankle frame's z axis: link x axle
+    wanted = np.cross([0.0, 0.0, 1.0], [math.cos(heading), math.sin(heading), 0.0])  # the axle: up x heading
+    q5 = math.atan2(float(wanted @ frame_y), float(wanted @ partial.axle))
+    return np.array([q1, q2, q3, q4, q5, 0.0])
+
+
+def _conditions(geometry: LimbGeometry, q: FloatArray, hub: FloatArray, up: FloatArray,
+                forward_dir: FloatArray, across: FloatArray) -> FloatArray:
+    """The six conditions of :func:`inverse`: hub at the target (3), the link along -up (2: its
+    components along ``forward_dir`` and ``across``, both normal to up), the axle normal to the heading (1)."""
+    pose = forward(geometry, q)
+    return np.concatenate([pose.hub - hub, [pose.link @ forward_dir, pose.link @ across, pose.axle @ forward_dir]])
+
+
+def inverse(geometry: LimbGeometry, hub: ArrayLike, heading: float = 0.0,
+            up: ArrayLike = (0.0, 0.0, 1.0)) -> FloatArray:
+    """The joints [rad] that put the hub at ``hub`` [m] (body frame) with the ankle link hanging
+    along -``up`` (the world's up in body coordinates; (0, 0, 1) on a level body) and the wheel
+    rolling along ``heading`` [rad] (in the plane normal to ``up``, from the body's x axis
+    projected on it). Knee up, camber 0 on a level body. Unreachable for a target out of reach."""
+    target = np.asarray(hub, float)
+    vertical = np.asarray(up, float)
+    if target.shape != (3,) or not np.all(np.isfinite(target)):
+        raise ValueError(f"hub = {hub!r}: expected (x, y, z) [m], finite")
+    if vertical.shape != (3,) or not np.linalg.norm(vertical) > 0:
+        raise ValueError(f"up = {up!r}: expected a direction (x, y, z)")
+    vertical = vertical / np.linalg.norm(vertical)
+    x_on_plane = np.array([1.0, 0.0, 0.0]) - vertical[0] * vertical
+    if np.linalg.norm(x_on_plane) < 1e-9:
+        raise ValueError(f"up = {up!r}: the body's x axis is vertical; no heading can be measured from it")
+    x_on_plane /= np.linalg.norm(x_on_plane)
+    y_on_plane = np.cross(vertical, x_on_plane)
+    forward_dir = math.cos(heading) * x_on_plane + math.sin(heading) * y_on_plane
+    across = np.cross(vertical, forward_dir)
+    level = float(np.linalg.norm(vertical - np.array([0.0, 0.0, 1.0])))
+    q = _level_inverse(geometry, target if level < 1e-15 else _level_target(geometry, target, vertical), heading)
+    if level < 1e-15:
+        return q
+    for _ in range(NEWTON_STEPS):
+        residual = _conditions(geometry, q, target, vertical, forward_dir, across)
+        if np.max(np.abs(residual)) < TOLERANCE:
+            return q
+        step = 1e-7
+        slopes = np.column_stack([(_conditions(geometry, q + step * e, target, vertical, forward_dir, across)
+                                   - _conditions(geometry, q - step * e, target, vertical, forward_dir, across))
+                                  / (2 * step) for e in np.eye(JOINTS)])
+        q = q - np.linalg.solve(slopes, residual)
+    residual = _conditions(geometry, q, target, vertical, forward_dir, across)
+    if np.max(np.abs(residual)) > 1e-9:
+        ankle = float(np.linalg.norm(target + geometry.drop * vertical - np.array(geometry.mount)))
+        raise Unreachable(f"hub at {target.tolist()} m with up {vertical.tolist()}: no joint angles found "
+                          f"(largest condition {np.max(np.abs(residual)):.3g}; the hanging ankle would be "
+                          f"{ankle:.4g} m from the hip, the limb reaches {geometry.thigh + geometry.shank:.4g} m)")
+    return q
+
+
+def _level_target(geometry: LimbGeometry, hub: FloatArray, up: FloatArray) -> FloatArray:
+    """A start for Newton on a tilted body: the hub moved so that the level closed form hangs its
+    ankle where the tilted one would."""
+    return hub + geometry.drop * (up - np.array([0.0, 0.0, 1.0]))
+
+
+def stance_forward(limbs: Sequence[LimbGeometry], joints: ArrayLike, pose: ArrayLike) -> FloatArray:
+    """The hubs in the world [m], one row per limb, for ``joints`` (one row of six per limb) and the
+    body ``pose`` (x, y, z [m], roll, pitch, yaw [rad])."""
+    angles = np.asarray(joints, float).reshape(len(limbs), JOINTS)
+    x, y, z, roll, pitch, yaw = (float(v) for v in np.asarray(pose, float))
+    rotation = attitude(roll, pitch, yaw)
+    return np.array([rotation @ forward(limb, q).hub + np.array([x, y, z]) for limb, q in zip(limbs, angles)])
+
+
+def stance_inverse(limbs: Sequence[LimbGeometry], hubs: ArrayLike, pose: ArrayLike,
+                   headings: ArrayLike | float = 0.0) -> FloatArray:
+    """The joints (a row of six per limb) that put each hub at ``hubs`` [m] (world) under the body
+    ``pose`` (x, y, z [m], roll, pitch, yaw [rad]), each ankle link vertical in the world and each
+    wheel rolling along ``headings`` [rad] (from the body's heading, in the ground plane)."""
+    targets = np.asarray(hubs, float).reshape(len(limbs), 3)
+    x, y, z, roll, pitch, yaw = (float(v) for v in np.asarray(pose, float))
+    rotation = attitude(roll, pitch, yaw)
+    up = rotation.T @ np.array([0.0, 0.0, 1.0])
+    turns = np.broadcast_to(np.asarray(headings, float), (len(limbs),))
+    return np.array([inverse(limb, rotation.T @ (target - np.array([x, y, z])), float(turn), up)
+                     for limb, target, turn in zip(limbs, targets, turns)])

@@ -1,0 +1,118 @@
+"""The leg-wheel rover's limb kinematics (rover_cosim.limbs, issue 47 item 3): the inverse
+kinematics puts the hub where it was asked to within 1e-9 m with the ankle link vertical and the
+wheel rolling along its heading, on a level and a tilted body; the Jacobian is the forward
+kinematics' derivative; the joint torques that hold a hub force do the same virtual work; the
+stance mirrors left and right; a target out of reach is named."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rover_cosim.limbs import (
+    JOINTS,
+    LimbGeometry,
+    Unreachable,
+    athlete_limbs,
+    attitude,
+    forward,
+    inverse,
+    jacobian,
+    joint_torques,
+    stance_forward,
+    stance_inverse,
+)
+
+LIMBS = athlete_limbs()
+#: The paper's posture: hubs at x = 1.5, 0, -1.5 m, y = +-1.5 m, 1.0 m below the centre of gravity.
+PAPER_HUBS = np.array([[x, y, -1.0] for y in (1.5, -1.5) for x in (1.5, 0.0, -1.5)])
+
+
+def _targets(limb: LimbGeometry, rng: np.random.Generator, count: int, out_max: float = 1.6) -> list[np.ndarray]:
+    """Reachable hub targets around the limb's mount: out 0.6 m to ``out_max``, 0.7-1.4 m below it."""
+    targets = []
+    for _ in range(count):
+        angle = limb.mount_yaw + rng.uniform(-0.8, 0.8)
+        out, down = rng.uniform(0.6, out_max), rng.uniform(0.7, 1.4)
+        targets.append(np.array(limb.mount) + np.array([out * math.cos(angle), out * math.sin(angle), -down]))
+    return targets
+
+
+@pytest.mark.parametrize("limb", range(6))
+def test_inverse_then_forward_reaches_the_hub_on_a_level_body(limb):
+    rng = np.random.default_rng(47 + limb)
+    geometry = LIMBS[limb]
+    for target in _targets(geometry, rng, 40):
+        heading = rng.uniform(-1.0, 1.0)
+        pose = forward(geometry, inverse(geometry, target, heading))
+        assert np.max(np.abs(pose.hub - target)) < 1e-9
+        assert pose.link @ np.array([0.0, 0.0, -1.0]) == pytest.approx(1.0, abs=1e-12)   # the link hangs down
+        assert abs(pose.axle[2]) < 1e-12                                               # the axle is level
+        np.testing.assert_allclose(pose.heading(), [math.cos(heading), math.sin(heading), 0.0], atol=1e-12)
+
+
+def test_inverse_then_forward_reaches_the_hub_on_a_tilted_body():
+    rng = np.random.default_rng(471)
+    for limb in LIMBS:
+        for target in _targets(limb, rng, 10, out_max=1.2):  # within reach of a hanging ankle tilted 0.25 rad
+            roll, pitch = rng.uniform(-0.25, 0.25, 2)
+            up = attitude(roll, pitch, 0.0).T @ np.array([0.0, 0.0, 1.0])
+            heading = rng.uniform(-0.5, 0.5)
+            pose = forward(limb, inverse(limb, target, heading, up))
+            assert np.max(np.abs(pose.hub - target)) < 1e-9
+            assert pose.link @ up == pytest.approx(-1.0, abs=1e-9)     # vertical in the world
+            assert abs(pose.axle @ up) < 1e-9                          # the axle level in the world
+
+
+def test_the_jacobian_is_the_forward_kinematics_derivative():
+    rng = np.random.default_rng(472)
+    for limb in LIMBS:
+        q = inverse(limb, _targets(limb, rng, 1)[0], 0.3) + rng.normal(0, 0.1, JOINTS)
+        step = 1e-6
+        numeric = np.column_stack([(forward(limb, q + step * e).hub - forward(limb, q - step * e).hub) / (2 * step)
+                                   for e in np.eye(JOINTS)])
+        np.testing.assert_allclose(jacobian(limb, q)[:3], numeric, atol=1e-8)
+        axes = jacobian(limb, q)[3:]
+        np.testing.assert_allclose(np.linalg.norm(axes, axis=0), 1.0, atol=1e-12)
+
+
+def test_joint_torques_do_the_virtual_work_of_the_hub_force():
+    """tau . dq = -F . dp for a small joint motion: the joints hold what the ground pushes."""
+    rng = np.random.default_rng(473)
+    for limb in LIMBS:
+        q = inverse(limb, _targets(limb, rng, 1)[0], 0.0)
+        force = np.array([rng.normal(0, 30), rng.normal(0, 30), 424.0])
+        torques = joint_torques(limb, q, force)
+        dq = rng.normal(0, 1e-7, JOINTS)
+        dp = forward(limb, q + dq).hub - forward(limb, q).hub
+        assert torques @ dq == pytest.approx(-force @ dp, rel=1e-5, abs=1e-12)
+
+
+def test_the_paper_posture_is_reached_and_mirrored_left_to_right():
+    joints = stance_inverse(LIMBS, PAPER_HUBS, np.zeros(6))
+    np.testing.assert_allclose(stance_forward(LIMBS, joints, np.zeros(6)), PAPER_HUBS, atol=1e-9)
+    left, right = joints[:3], joints[3:]
+    np.testing.assert_allclose(right[:, [1, 2, 3, 5]], left[:, [1, 2, 3, 5]], atol=1e-12)  # pitches equal
+    np.testing.assert_allclose(right[:, [0, 4]], -left[:, [0, 4]], atol=1e-12)              # yaws mirrored
+    np.testing.assert_allclose(joints[0, 1:4], joints[2, 1:4], atol=1e-12)                  # front as rear
+
+
+def test_a_stance_under_a_tilted_and_moved_body_round_trips():
+    rng = np.random.default_rng(474)
+    pose = np.array([2.0, -1.0, 0.3, 0.12, -0.08, 0.6])
+    rotation = attitude(*pose[3:])
+    hubs = np.array([pose[:3] + rotation @ hub for hub in PAPER_HUBS]) + rng.normal(0, 0.05, (6, 3))
+    joints = stance_inverse(LIMBS, hubs, pose, headings=rng.uniform(-0.3, 0.3, 6))
+    np.testing.assert_allclose(stance_forward(LIMBS, joints, pose), hubs, atol=1e-9)
+
+
+def test_a_target_out_of_reach_and_bad_geometry_are_named():
+    limb = LIMBS[0]
+    with pytest.raises(Unreachable, match=r"the limb reaches 0 to 2 m \(off by"):
+        inverse(limb, np.array(limb.mount) + np.array([3.0, 3.0, -1.0]))
+    with pytest.raises(ValueError, match=r"thigh=-1.0: expected a length > 0 m"):
+        LimbGeometry((0.0, 0.0, 0.0), 0.0, thigh=-1.0)
+    with pytest.raises(ValueError, match=r"expected 6 finite joint angles"):
+        forward(limb, [0.0] * 5)
