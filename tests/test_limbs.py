@@ -116,3 +116,29 @@ def test_a_target_out_of_reach_and_bad_geometry_are_named():
         LimbGeometry((0.0, 0.0, 0.0), 0.0, thigh=-1.0)
     with pytest.raises(ValueError, match=r"expected 6 finite joint angles"):
         forward(limb, [0.0] * 5)
+
+
+def test_the_modelica_limb_forward_kinematics_is_the_numpy_one():
+    """Functions.limbForward (through Examples.LimbKinematics with this limb and these angles as
+    modifiers, run by rumoca) against rover_cosim.limbs.forward: hub, link and axle to 1e-9 for
+    every limb of the frame."""
+    import rumoca
+
+    from rover_cosim.fmubuild import catalog
+
+    def values(numbers) -> str:  # noqa: ANN001 - a sequence of floats
+        return "{" + ", ".join(repr(float(v)) for v in numbers) + "}"
+
+    rng = np.random.default_rng(475)
+    for number, limb in enumerate(LIMBS, start=1):
+        q = inverse(limb, _targets(limb, rng, 1)[0], rng.uniform(-0.5, 0.5)) + rng.normal(0, 0.2, JOINTS)
+        text = (f"model Check extends RoverTerramechanics.Examples.LimbKinematics(q = {values(q)}, limb(mount = "
+                f"{values(limb.mount)}, mountYaw = {limb.mount_yaw!r}, thigh = {limb.thigh!r}, shank = {limb.shank!r}, "
+                f"ankle = {limb.ankle!r}, hubOffset = {limb.hub_offset!r})); end Check;")
+        session = rumoca.Session(roots=[str(catalog.MODELICA_ROOT)])
+        row = session.loads(text, model="Check", filename="Check.mo").simulate(t=(0.0, 0.01), dt=0.01).to_dataframe()
+        row = row.iloc[-1]
+        pose = forward(limb, q)
+        for name, expected in (("hub", pose.hub), ("link", pose.link), ("axle", pose.axle)):
+            got = np.array([row[f"{name}[{k}]"] for k in (1, 2, 3)])
+            np.testing.assert_allclose(got, expected, atol=1e-9, err_msg=f"limb {number}: {name}")
