@@ -142,3 +142,42 @@ def test_the_modelica_limb_forward_kinematics_is_the_numpy_one():
         for name, expected in (("hub", pose.hub), ("link", pose.link), ("axle", pose.axle)):
             got = np.array([row[f"{name}[{k}]"] for k in (1, 2, 3)])
             np.testing.assert_allclose(got, expected, atol=1e-9, err_msg=f"limb {number}: {name}")
+
+
+# --- statics: the weight over six compliant limbs -------------------------------------------------
+
+def test_loads_at_rest_sum_to_the_weight_and_balance_its_moments():
+    from rover_cosim.limbs import static_loads
+
+    joints = stance_inverse(LIMBS, PAPER_HUBS, np.zeros(6))
+    loads = static_loads(LIMBS, joints, 2.0e4, 1570.0, 1.62)
+    assert loads.sum() == pytest.approx(1570.0 * 1.62, rel=1e-12)
+    assert PAPER_HUBS[:, 0] @ loads == pytest.approx(0.0, abs=1e-9)
+    assert PAPER_HUBS[:, 1] @ loads == pytest.approx(0.0, abs=1e-9)
+    np.testing.assert_allclose(loads[:3], loads[3:], rtol=1e-9)    # left as right
+    assert loads[0] == pytest.approx(loads[2], rel=1e-9)             # front as rear
+    forward_shift = static_loads(LIMBS, joints, 2.0e4, 1570.0, 1.62, centre=(0.3, 0.0))
+    assert forward_shift[0] > loads[0] and forward_shift[2] < loads[2]  # the load follows the centre of gravity
+
+
+def test_identical_limbs_share_the_weight_equally():
+    """Six limbs of one geometry around the body, each reaching out alike: one sixth each."""
+    from rover_cosim.limbs import static_loads
+
+    hubs = np.array([np.array(limb.mount) + 1.2 * np.array([np.cos(limb.mount_yaw), np.sin(limb.mount_yaw), 0.0])
+                     + np.array([0.0, 0.0, -1.1]) for limb in LIMBS])
+    joints = stance_inverse(LIMBS, hubs, np.zeros(6), headings=0.0)
+    np.testing.assert_allclose(static_loads(LIMBS, joints, 3.0e4, 900.0, 3.71), 900.0 * 3.71 / 6, rtol=1e-9)
+
+
+def test_the_holding_torques_are_the_jacobians_transpose_and_a_pulling_stance_is_named():
+    from rover_cosim.limbs import holding_torques, static_loads
+
+    joints = stance_inverse(LIMBS, PAPER_HUBS, np.zeros(6))
+    loads = static_loads(LIMBS, joints, 2.0e4, 1570.0, 1.62)
+    torques = holding_torques(LIMBS, joints, loads)
+    for limb, q, w, tau in zip(LIMBS, joints, loads, torques):
+        np.testing.assert_allclose(tau, -jacobian(limb, q)[:3].T @ np.array([0.0, 0.0, w]), atol=1e-9)
+        assert abs(tau[0]) < 1e-9 and abs(tau[4]) < 1e-9    # a vertical load turns no yaw or steer joint
+    with pytest.raises(ValueError, match=r"limbs \[.*\] would pull on the ground"):
+        static_loads(LIMBS, joints, 2.0e4, 1570.0, 1.62, centre=(3.0, 0.0))
