@@ -67,4 +67,5 @@ def holding_torques(limbs: Sequence[LimbGeometry], joints: ArrayLike, loads: Arr
     """The joint torques [N·m] (a row of six per limb) that hold vertical wheel loads ``loads`` [N]
     pushing up on the hubs: -J^T (0, 0, W)."""
     angles = np.asarray(joints, float).reshape(len(limbs), JOINTS)
-    return np.array([joint_torques(limb, q, [0.0, 0.0, float(w)]) for limb, q, w in zip(limbs, angles, loads)])
+    weights = np.asarray(loads, float).reshape(len(limbs))
+    return np.array([joint_torques(limb, q, [0.0, 0.0, float(w)]) for limb, q, w in zip(limbs, angles, weights)])
