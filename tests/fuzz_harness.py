@@ -48,7 +48,8 @@ ODD: list[Any] = [-1, 0, 1, 1e300, -1e300, 1e-300, math.inf, -math.inf, math.nan
 VALUES = ["-1", "0", "nan", "inf", "-inf", "1e308", "1e-308", "1e23", "x", "", ",", "1,2,3", "-0.5,0.9", "0.5",
           "5000", "a" * 300, "/" + "b/" * 2100, "\x1b[2J", "1e22", "2147483648", "-0"]
 OPTIONS = [["fig3", "--loads"], ["fig3", "--slip-step"], ["fig3", "--slip-range"], ["fig3", "--set"],
-           ["fig3", "--soil"], ["fig3", "--wheel"], ["soils"], ["--dpi"], ["--figures"],
+           ["fig3", "--soil"], ["fig3", "--wheel"], ["fig3", "--rover"], ["soils"], ["rovers"], ["--dpi"],
+           ["--figures"], ["identify", "--plan"], ["identify", "--rover"],
            ["run", "MISBEHAVE", "--step"], ["run", "MISBEHAVE", "--stop-time"],
            ["run", "MISBEHAVE", "--output-interval"],
            ["run", "MISBEHAVE", "--relative-tolerance"], ["run", "MISBEHAVE", "--fmu-timeout"],
@@ -146,11 +147,14 @@ class Harness:
                 "--model", str(folder / "no-model.json")]
 
     def soil_case(self, rng: random.Random, folder: Path) -> list[str]:
-        keys = ["c", "phi_deg", "kc", "kphi", "n", "kx", "a0", "a1", "lam", "r", "b", "title", "source", "unknown"]
+        """A fuzzed soil or wheel file through `soils`, or a fuzzed rover file through `rovers`."""
+        rover = rng.random() < 0.3
+        keys = (["mass", "Iyy", "h_cog", "x_limb", "y_limb", "k_limb", "wheel", "title", "unknown"] if rover else
+                ["c", "phi_deg", "kc", "kphi", "n", "kx", "a0", "a1", "lam", "r", "b", "title", "source", "unknown"])
         table = {rng.choice(keys): rng.choice(ODD) for _ in range(rng.randint(1, 4))}
         path = folder / "library.toml"
         path.write_text(_toml({"fuzzed": table}))
-        return ["soils", f"{path}:fuzzed"]
+        return ["rovers" if rover else "soils", f"{path}:fuzzed"]
 
     def option_case(self, rng: random.Random, folder: Path) -> list[str]:
         command = [str(self.misbehave) if part == "MISBEHAVE" else part for part in rng.choice(OPTIONS)]
