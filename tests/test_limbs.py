@@ -142,6 +142,8 @@ def test_the_modelica_limb_forward_kinematics_is_the_numpy_one():
         for name, expected in (("hub", pose.hub), ("link", pose.link), ("axle", pose.axle)):
             got = np.array([row[f"{name}[{k}]"] for k in (1, 2, 3)])
             np.testing.assert_allclose(got, expected, atol=1e-9, err_msg=f"limb {number}: {name}")
+        got = np.array([[row[f"jacobian[{i},{k}]"] for k in range(1, 7)] for i in (1, 2, 3)])
+        np.testing.assert_allclose(got, jacobian(limb, q)[:3], atol=1e-9, err_msg=f"limb {number}: jacobian")
 
 
 # --- statics: the weight over six compliant limbs -------------------------------------------------
@@ -181,3 +183,23 @@ def test_the_holding_torques_are_the_jacobians_transpose_and_a_pulling_stance_is
         assert abs(tau[0]) < 1e-9 and abs(tau[4]) < 1e-9    # a vertical load turns no yaw or steer joint
     with pytest.raises(ValueError, match=r"limbs \[.*\] would pull on the ground"):
         static_loads(LIMBS, joints, 2.0e4, 1570.0, 1.62, centre=(3.0, 0.0))
+
+
+def test_the_modelica_leg_wheel_body_settles_on_the_loads_of_the_numpy_statics():
+    """Components.LegWheelChassis in the paper's posture (Examples.LegWheelStance, rumoca): after
+    5 s on its damped limbs the loads sum to the weight and equal rover_cosim.limbs.static_loads,
+    the body level; the posture's joint angles in the example are those stance_inverse gives."""
+    from rover_cosim.fmubuild import source
+    from rover_cosim.limbs import static_loads
+
+    joints = stance_inverse(LIMBS, PAPER_HUBS, np.zeros(6))
+    text = source.class_file("RoverTerramechanics.Examples.LegWheelStance").read_text()
+    for name, column in (("hipYaw", 0), ("hipPitch", 1), ("kneePitch", 2), ("anklePitch", 3), ("ankleSteer", 4)):
+        declared = text.split(f"parameter Real {name}[6](each unit=\"rad\") = {{")[1].split("}")[0]
+        np.testing.assert_allclose([float(v) for v in declared.split(",")], joints[:, column], atol=1e-12)
+    last = source.simulate("RoverTerramechanics.Examples.LegWheelStance").iloc[-1]
+    loads = np.array([last[f"body.W[{i}]"] for i in range(1, 7)])
+    assert loads.sum() == pytest.approx(1570.0 * 1.62, rel=1e-6)
+    np.testing.assert_allclose(loads, static_loads(LIMBS, joints, 2.0e4, 1570.0, 1.62), rtol=1e-5)
+    assert abs(last["body.pitch"]) < 1e-9 and abs(last["body.roll"]) < 1e-9
+    np.testing.assert_allclose([last[f"body.hubX[{i}]"] for i in range(1, 7)], PAPER_HUBS[:, 0], atol=1e-9)

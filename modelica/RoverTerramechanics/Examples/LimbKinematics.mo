@@ -5,10 +5,11 @@ model LimbKinematics "The hub of a leg-wheel limb for given joint angles (Functi
   output Real hub[3](each unit="m") "Wheel hub in the body frame";
   output Real link[3](each unit="1") "Direction of the last link";
   output Real axle[3](each unit="1") "The wheel's axle";
+  output Real jacobian[3, 6](each unit="m") "d hub / d q [m/rad]";
   Real t(unit="s", start=0, fixed=true) "Time, so that the model has a state";
 equation
   der(t) = 1;
-  (hub, link, axle) = RoverTerramechanics.Functions.limbForward(limb, q);
+  (hub, link, axle, jacobian) = RoverTerramechanics.Functions.limbForward(limb, q);
   annotation (
     experiment(StartTime=0, StopTime=0.01, Interval=0.01),
     Documentation(info="<html>
