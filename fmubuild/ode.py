@@ -441,7 +441,7 @@ def _fold_subscripts(node: Any, parameters: _Parameters, name: str) -> None:
     if not isinstance(node, dict):
         return
     ref = node.get("VarRef")
-    if isinstance(ref, dict) and isinstance(ref.get("subscripts"), list):
+    if isinstance(ref, dict) and any("Expr" in sub for sub in ref.get("subscripts") or []):
         where = f"{name}: subscript of {ref.get('name', {}).get('name', '?')}"
         evaluate = Evaluator(parameters, parameters.library.call, where)
         folded = []

@@ -37,9 +37,7 @@ def rover_fmu(fmu_dir: str | Path, name: str, choice: Choice | None) -> Path:
     from the Modelica source for N wheels and kept (rebuilt only when its inputs change)."""
     path = Path(fmu_dir) / f"{name}.fmu"
     wheels = choice.rover.wheels if choice is not None else PACKAGE_WHEELS
-    if wheels == PACKAGE_WHEELS and (not path.is_file() or len(hubs(path)) == wheels):
-        return path
-    if path.is_file() and len(hubs(path)) == wheels:
+    if (path.is_file() and len(hubs(path)) == wheels) or (wheels == PACKAGE_WHEELS and not path.is_file()):
         return path
     from rover_cosim.fmubuild.build import build_fmu
 
