@@ -288,10 +288,24 @@ def declared_bound(info: Mapping[str, Any], key: str) -> float | None:
     return None
 
 
-def declared_start(info: Mapping[str, Any], locate: _Locator) -> float | None:
-    """The start value the Modelica source declares for a variable (``start=0``), or None. rumoca
-    fills in 0.0 for an undeclared start; a declared one's source span is the literal itself."""
+def declared_start(info: Mapping[str, Any], locate: _Locator, indices: list[int] | None = None) -> float | None:
+    """The start value the Modelica source declares for a variable (``start=0``; for the element
+    ``indices`` of an array, its element of ``start={...}``), or None. rumoca fills in 0.0 for an
+    undeclared start; a declared one's source span is the literal itself (a negative number: a
+    minus before the literal)."""
     start = info.get("start")
+    for i in indices or []:
+        if not isinstance(start, dict) or "Array" not in start:
+            break
+        elements = start["Array"]["elements"]
+        if not 1 <= i <= len(elements):
+            return None
+        start = elements[i - 1]
+    sign = 1.0
+    if isinstance(start, dict) and "Unary" in start and "Literal" in start["Unary"].get("rhs", {}):
+        if "Minus" not in json.dumps(start["Unary"].get("op")):
+            return None
+        sign, start = -1.0, start["Unary"]["rhs"]
     if not isinstance(start, dict) or "Literal" not in start:
         return None
     span = start["Literal"].get("span") or {}
@@ -302,18 +316,18 @@ def declared_start(info: Mapping[str, Any], locate: _Locator) -> float | None:
         float(path_text[1][span["start"]:span["end"]])
     except (KeyError, ValueError):
         return None
-    return float(literal(start["Literal"]))
+    return sign * float(literal(start["Literal"]))
 
 
 def _variables(infos: dict[str, Info], types: Mapping[str, str], parameters: _Parameters, inputs: list[str],
                states: list[str], locate: _Locator) -> dict[str, Variable]:
     variables = {}
-    for s, (info, _, flat_name) in infos.items():
+    for s, (info, indices, flat_name) in infos.items():
         start = parameters.defaults.get(s)
         if start is None and isinstance(parameters.values.get(s), (int, float)):
             start = float(parameters.values[s])
         if start is None and s in inputs:
-            start = declared_start(info, locate)  # an input the source gives a default, or None
+            start = declared_start(info, locate, indices)  # an input the source gives a default, or None
         is_output = _role_names(info)[1] == "Output" and "." not in flat_name
         variables[s] = Variable(s, _role(s, info, flat_name, parameters, inputs, states), types.get(flat_name, "Real"),
                                 info["unit"], info["description"], start, is_output, declared_bound(info, "min"),

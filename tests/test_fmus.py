@@ -114,11 +114,14 @@ def test_model_description_interfaces_match_the_users_guide(fmus):
 
 @pytest.mark.parametrize("name", build.FMU_MODELS)
 def test_fmpy_simulates_each_fmu_as_cs_and_as_me_with_the_same_result(fmus, name: str):
+    torques, forces = {f"tau[{i}]": 40.0 for i in range(1, 7)}, {f"Fx[{i}]": 20.0 for i in range(1, 7)}
     inputs = {"SingleWheel": {"tau": 40.0}, "Wheel": {"tau": 40.0, "W": 424.0, "v_hub": 0.2},
               "RoverBody": {f"Fx[{i}]": 20.0 for i in range(1, 7)},
               "Rover": {f"tau[{i}]": 40.0 for i in range(1, 7)},
               "SteerableRover": {**{f"tau[{i}]": 40.0 for i in range(1, 7)}, "steer[1]": 0.05, "steer[4]": 0.05},
-              "SteerableRoverBody": {**{f"Fx[{i}]": 20.0 for i in range(1, 7)}, "Fy[1]": 15.0, "steer[3]": -0.05}}[name]
+              "SteerableRoverBody": {**{f"Fx[{i}]": 20.0 for i in range(1, 7)}, "Fy[1]": 15.0, "steer[3]": -0.05},
+              "LegWheelRover": {**torques, "ankleSteer[1]": 1.25, "kneePitch[2]": 2.5},
+              "LegWheelRoverBody": {**forces, "Fy[1]": 15.0, "hipPitch[3]": -0.4}}[name]
     runs = {kind: fmpy.simulate_fmu(str(fmus[name]), fmi_type=kind, stop_time=0.3,
                                     output_interval=0.01, start_values=inputs, relative_tolerance=1e-8)
             for kind in ("CoSimulation", "ModelExchange")}

@@ -119,7 +119,7 @@ def test_a_target_out_of_reach_and_bad_geometry_are_named():
 
 
 def test_the_modelica_limb_forward_kinematics_is_the_numpy_one():
-    """Functions.limbForward (through Examples.LimbKinematics with this limb and these angles as
+    """Components.Limb (through Examples.LimbKinematics with this limb and these angles as
     modifiers, run by rumoca) against rover_cosim.limbs.forward: hub, link and axle to 1e-9 for
     every limb of the frame."""
     import rumoca
@@ -140,10 +140,12 @@ def test_the_modelica_limb_forward_kinematics_is_the_numpy_one():
         row = row.iloc[-1]
         pose = forward(limb, q)
         for name, expected in (("hub", pose.hub), ("link", pose.link), ("axle", pose.axle)):
-            got = np.array([row[f"{name}[{k}]"] for k in (1, 2, 3)])
+            got = np.array([row[f"kinematics.{name}[{k}]"] for k in (1, 2, 3)])
             np.testing.assert_allclose(got, expected, atol=1e-9, err_msg=f"limb {number}: {name}")
-        got = np.array([[row[f"jacobian[{i},{k}]"] for k in range(1, 7)] for i in (1, 2, 3)])
+        got = np.array([[row[f"kinematics.jacobian[{i},{k}]"] for k in range(1, 7)] for i in (1, 2, 3)])
         np.testing.assert_allclose(got, jacobian(limb, q)[:3], atol=1e-9, err_msg=f"limb {number}: jacobian")
+        got = np.array([[row[f"kinematics.axes[{i},{k}]"] for k in range(1, 7)] for i in (1, 2, 3)])
+        np.testing.assert_allclose(got, jacobian(limb, q)[3:], atol=1e-9, err_msg=f"limb {number}: axes")
 
 
 # --- statics: the weight over six compliant limbs -------------------------------------------------
@@ -190,7 +192,7 @@ def test_the_modelica_leg_wheel_body_settles_on_the_loads_of_the_numpy_statics()
     5 s on its damped limbs the loads sum to the weight and equal rover_cosim.limbs.static_loads,
     the body level; the posture's joint angles in the example are those stance_inverse gives."""
     from rover_cosim.fmubuild import source
-    from rover_cosim.limbs import static_loads
+    from rover_cosim.limbs import holding_torques, static_loads
 
     joints = stance_inverse(LIMBS, PAPER_HUBS, np.zeros(6))
     text = source.class_file("RoverTerramechanics.Examples.LegWheelStance").read_text()
@@ -202,4 +204,15 @@ def test_the_modelica_leg_wheel_body_settles_on_the_loads_of_the_numpy_statics()
     assert loads.sum() == pytest.approx(1570.0 * 1.62, rel=1e-6)
     np.testing.assert_allclose(loads, static_loads(LIMBS, joints, 2.0e4, 1570.0, 1.62), rtol=1e-5)
     assert abs(last["body.pitch"]) < 1e-9 and abs(last["body.roll"]) < 1e-9
-    np.testing.assert_allclose([last[f"body.hubX[{i}]"] for i in range(1, 7)], PAPER_HUBS[:, 0], atol=1e-9)
+    names = ("hipYaw", "hipPitch", "kneePitch", "anklePitch", "ankleSteer", "ankleRoll")
+    angles = np.array([[last[f"body.{name}Angle[{i}]"] for name in names] for i in range(1, 7)])
+    torques = np.array([[last[f"body.{name}Torque[{i}]"] for name in names] for i in range(1, 7)])
+    # the servos hold the loads (virtual work, numpy) and deflect by torque / stiffness
+    np.testing.assert_allclose(torques, holding_torques(LIMBS, joints, loads), atol=1e-6)
+    np.testing.assert_allclose(angles, joints - torques / 2.0e4, atol=1e-12)
+    # the hubs the model reports are numpy's forward kinematics of the angles it reports
+    for number, (limb, q) in enumerate(zip(LIMBS, angles), start=1):
+        got = [last[f"body.hub{axis}[{number}]"] for axis in "XYZ"]
+        np.testing.assert_allclose(got, forward(limb, q).hub, atol=1e-9, err_msg=f"limb {number}")
+    # ... which sit on the ground (the normal spring's deflection) to the second order of the deflection
+    assert np.max(np.abs(np.array([last[f"body.hubZ[{i}]"] for i in range(1, 7)]) + last["body.z"])) < 2e-3

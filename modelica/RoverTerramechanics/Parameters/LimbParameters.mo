@@ -16,6 +16,6 @@ knee and ankle pitch, two at the ankle); the axes of the two ankle joints and ev
 are our stated reading: a hexagonal frame 2.75 m across (the mount of limb 1 at its front-left
 corner, the default), 1.0 m thigh and shank, an ankle link of 0.25 m and the hub 0.15 m beyond
 the roll joint. The same geometry in Python: <code>rover_cosim.limbs.LimbGeometry</code>
-(the cross-check of <code>Functions.limbForward</code>).</p>
+(the cross-check of <code>Components.Limb</code>).</p>
 </html>"));
 end LimbParameters;

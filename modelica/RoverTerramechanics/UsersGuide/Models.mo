@@ -141,6 +141,41 @@ to the wheels; the body's pose and rates <code>x</code>, <code>y</code> [m], <co
 (TerrainParameters), <code>nWheels</code> = 2 <code>rover.nAxles</code> (the number of wheels, six; structural: an FMU is built for one count, rover-cosim builds others on first use)</li>
 </ul>
 
+<h4>LegWheelRover</h4>
+<p><a href=\"modelica://RoverTerramechanics.FMUs.LegWheelRover\">FMUs.LegWheelRover</a>: the paper's
+plant (Sec. 2.1, Fig. 1), a leg-wheel robot with six joints per limb after NASA/JPL's ATHLETE:
+<code>Components.LegWheelChassis</code> (the body on six limbs of six position-servoed joints,
+<code>Components.Limb</code> the kinematics) with six <code>Components.RigidWheel</code>s. The
+limb's joints (Wilcox et al. 2007 give six rotary joints per limb; the two ankle axes are our
+reading): hip yaw about the body's z axis; hip, knee and ankle pitch about the limb's horizontal
+axis; ankle steer about the ankle link; ankle roll normal to the link and the axle. Each joint's
+servo has a stiffness, a damping and a torque limit; the limb's compliance along the ground's
+normal carries the wheel's load (the load comes out of the limb, the sinkage is not fed back).</p>
+<ul>
+<li>inputs: the 36 joint set-points <code>hipYaw</code>, <code>hipPitch</code>, <code>kneePitch</code>, <code>anklePitch</code>, <code>ankleSteer</code>, <code>ankleRoll</code> [rad], six each (limbs 1-3 front, middle, rear on the left, 4-6 on the right; start: the paper's posture, hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity); <code>tau[1..6]</code> [N&middot;m] the drive torques; <code>groundHeight[1..6]</code> [m], <code>groundHeightRate[1..6]</code> [m/s], <code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: the ground under each hub (<code>Interfaces.GroundContacts</code>; optional, start 0); <code>soilShare[1..6]</code>
+[1] the share of the second soil under each wheel (optional, start 0)</li>
+<li>outputs: joint angles <code>hipYawAngle</code>, <code>hipPitchAngle</code>, <code>kneePitchAngle</code>, <code>anklePitchAngle</code>, <code>ankleSteerAngle</code>, <code>ankleRollAngle</code> [rad] (the set-points deflected by the load), servo torques <code>hipYawTorque</code>, <code>hipPitchTorque</code>, <code>kneePitchTorque</code>, <code>anklePitchTorque</code>, <code>ankleSteerTorque</code>, <code>ankleRollTorque</code> [N&middot;m], hub positions <code>hubX</code>, <code>hubY</code>, <code>hubZ</code> [m] (body frame, from the joint angles), wheel headings <code>steer</code> [rad] (from the ankle steer joints); per wheel <code>Fz</code>, <code>Fx</code>, <code>Fy</code> [N],
+<code>Tx</code> [N&middot;m], <code>slip</code> [1], <code>slipAngle</code> [rad],
+<code>sinkage</code> [m], <code>omega</code> [rad/s]; the body's pose and velocity <code>x</code>, <code>y</code>, <code>z</code> [m] (z: the centre of gravity over the ground plane), <code>yaw</code>, <code>pitch</code>, <code>roll</code> [rad], <code>v</code>, <code>vy</code> [m/s], <code>yawRate</code> [rad/s], <code>heaveRate</code> [m/s], <code>pitchRate</code>, <code>rollRate</code> [rad/s]</li>
+<li>parameters: <code>rover</code> (RoverParameters: <code>M</code>, <code>g</code>, <code>Iyy</code>, <code>Ixx</code>, <code>Izz</code>; its limb fields unused), <code>legs</code> (LegWheelParameters: six <code>LimbParameters</code>, <code>kJoint</code> [N&middot;m/rad] 2e4, <code>dJoint</code> [N&middot;m&middot;s/rad] 2e3, <code>tauJointMax</code> [N&middot;m] 2e3), <code>terrain</code> (TerrainParameters), <code>height0</code> [m] 1.0 (start height of the centre of gravity), <code>nWheels</code> = 6 (fixed); <code>soil</code>, <code>soilB</code> (SoilParameters), <code>wheel</code> (WheelParameters),
+<code>nNodes</code>, <code>nIterations</code>, <code>vEps</code>, <code>vHold</code>, <code>vStick</code>
+as <code>SteerableRover</code></li>
+</ul>
+
+<h4>LegWheelRoverBody</h4>
+<p><a href=\"modelica://RoverTerramechanics.FMUs.LegWheelRoverBody\">FMUs.LegWheelRoverBody</a>:
+<code>Components.LegWheelChassis</code> alone, cut at the hubs as the steerable rover is, for
+co-simulation with six <code>Wheel</code>s (<code>W[i]</code>, <code>v_hub[i]</code>,
+<code>v_lat[i]</code> to wheel i; its <code>Fx</code>, <code>Fy</code> back). The wheels are
+steered by the ankle steer joints: a wheel has no steering input of its own.</p>
+<ul>
+<li>inputs: the 36 joint set-points <code>hipYaw</code>, <code>hipPitch</code>, <code>kneePitch</code>, <code>anklePitch</code>, <code>ankleSteer</code>, <code>ankleRoll</code> [rad], six each (limbs 1-3 front, middle, rear on the left, 4-6 on the right; start: the paper's posture, hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity); <code>Fx[1..6]</code>, <code>Fy[1..6]</code> [N] (wheel frames), <code>tau[1..6]</code>
+[N&middot;m]; <code>groundHeight[1..6]</code> [m], <code>groundHeightRate[1..6]</code> [m/s], <code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: the ground under each hub (<code>Interfaces.GroundContacts</code>; optional, start 0)</li>
+<li>outputs: <code>W[1..6]</code> [N], <code>v_hub[1..6]</code>, <code>v_lat[1..6]</code> [m/s] to
+the wheels; joint angles <code>hipYawAngle</code>, <code>hipPitchAngle</code>, <code>kneePitchAngle</code>, <code>anklePitchAngle</code>, <code>ankleSteerAngle</code>, <code>ankleRollAngle</code> [rad] (the set-points deflected by the load), servo torques <code>hipYawTorque</code>, <code>hipPitchTorque</code>, <code>kneePitchTorque</code>, <code>anklePitchTorque</code>, <code>ankleSteerTorque</code>, <code>ankleRollTorque</code> [N&middot;m], hub positions <code>hubX</code>, <code>hubY</code>, <code>hubZ</code> [m] (body frame, from the joint angles), wheel headings <code>steer</code> [rad] (from the ankle steer joints); the body's pose and velocity <code>x</code>, <code>y</code>, <code>z</code> [m] (z: the centre of gravity over the ground plane), <code>yaw</code>, <code>pitch</code>, <code>roll</code> [rad], <code>v</code>, <code>vy</code> [m/s], <code>yawRate</code> [rad/s], <code>heaveRate</code> [m/s], <code>pitchRate</code>, <code>rollRate</code> [rad/s]</li>
+<li>parameters: <code>rover</code> (RoverParameters: <code>M</code>, <code>g</code>, <code>Iyy</code>, <code>Ixx</code>, <code>Izz</code>; its limb fields unused), <code>legs</code> (LegWheelParameters: six <code>LimbParameters</code>, <code>kJoint</code> [N&middot;m/rad] 2e4, <code>dJoint</code> [N&middot;m&middot;s/rad] 2e3, <code>tauJointMax</code> [N&middot;m] 2e3), <code>terrain</code> (TerrainParameters), <code>height0</code> [m] 1.0 (start height of the centre of gravity), <code>nWheels</code> = 6 (fixed)</li>
+</ul>
+
 <h4>RoverReconnected</h4>
 <p><a href=\"modelica://RoverTerramechanics.Examples.RoverReconnected\">Examples.RoverReconnected</a>
 (not an FMU): <code>FMUs.RoverBody</code> and six <code>FMUs.Wheel</code> instances wired only
