@@ -21,7 +21,7 @@ from .builder import block_port_type
 from .execution import Execution, make_execution
 from .fmi_access import StringTable
 from .isolation import IsolatedFmu, isolated
-from .model import FmuEntry, Port, System
+from .model import FmuEntry, Port, System, declared_start
 from .model_exchange import make_fmu_participant
 from .native import unavailable_reason
 from .observers import (
@@ -47,10 +47,41 @@ INITIAL_PASSES = 2
 NATIVE_STRETCH = 500
 
 
+def input_starts(participant: Participant) -> list[float] | None:
+    """The start values of an FMU participant's connected inputs, as its system sets them (its
+    ``start``) or its model description declares them (0 where neither gives a number); None for a
+    block."""
+    entry = getattr(participant, "entry", None)
+    if not isinstance(entry, FmuEntry):
+        return None
+    variables = entry.variables()
+    starts = []
+    for name in participant.inputs:
+        value = entry.start[name] if name in entry.start else (
+            declared_start(variables[name]) if name in variables else None)
+        starts.append(float(value) if isinstance(value, (int, float)) else 0.0)
+    return starts
+
+
+def _hold_start_values(participants: list[Participant], slots: dict, values: np.ndarray) -> None:
+    """Each FMU input whose source is a block with inputs (started after the FMUs) at the input's
+    start value (``input_starts``)."""
+    later = {int(slot) for p in participants if not p.iterative_start and p.inputs
+             for slot in slots[p.name].output_slots}
+    for participant in participants:
+        starts = input_starts(participant) if participant.iterative_start else None
+        for slot, start in zip(slots[participant.name].input_slots, starts or []):
+            if int(slot) in later:
+                values[slot] = start
+
+
 def initialize(participants: list[Participant], wiring: Wiring, values: np.ndarray, t0: float,
                stop_time: float) -> None:
-    """FMI 2.0 initialization of every participant; ``values`` then holds the outputs at ``t0``."""
+    """FMI 2.0 initialization of every participant; ``values`` then holds the outputs at ``t0``.
+    An FMU input whose source is a block with inputs (started after the FMUs) holds the input's
+    start value until that block has started, as an unconnected input would."""
     slots = {p.name: wiring.participants[p.name] for p in participants}
+    _hold_start_values(participants, slots, values)
 
     def initial(participant: Participant) -> None:
         ports = slots[participant.name]

@@ -62,8 +62,37 @@ def test_inverse_then_forward_reaches_the_hub_on_a_tilted_body():
             heading = rng.uniform(-0.5, 0.5)
             pose = forward(limb, inverse(limb, target, heading, up))
             assert np.max(np.abs(pose.hub - target)) < 1e-9
-            assert pose.link @ up == pytest.approx(-1.0, abs=1e-9)     # vertical in the world
             assert abs(pose.axle @ up) < 1e-9                          # the axle level in the world
+            assert abs(pose.heading(up) @ np.cross(up, _heading_direction(up, heading))) < 1e-9  # along the heading
+            if abs(pose.axes[5] @ pose.axes[1]) < 0.85:                # the wrist well away from its singularity
+                assert pose.link @ up == pytest.approx(-1.0, abs=1e-9)  # the link vertical in the world
+
+
+def _heading_direction(up: np.ndarray, heading: float) -> np.ndarray:
+    """The direction ``heading`` [rad] from the body's x axis projected on the plane normal to ``up``."""
+    x_on_plane = np.array([1.0, 0.0, 0.0]) - up[0] * up
+    x_on_plane /= np.linalg.norm(x_on_plane)
+    return math.cos(heading) * x_on_plane + math.sin(heading) * np.cross(up, x_on_plane)
+
+
+def test_a_middle_limb_near_its_wrist_singularity_stands_its_wheel_upright_under_a_tilted_body():
+    """The middle limb steered 90 deg: its roll axis along the pitch axes, it cannot tilt its link
+    out of its plane. Under roll and pitch it still reaches the hub, heads its wheel along the
+    heading and keeps it upright (camber 0); over a sweep of small steps (a posture controller's)
+    no joint jumps."""
+    limb = LIMBS[1]
+    q = inverse(limb, PAPER_HUBS[1], 0.0)
+    for k in range(1, 41):
+        roll, pitch = -0.35 * k / 40, 0.02 * k / 40
+        up = attitude(roll, pitch, 0.0).T @ np.array([0.0, 0.0, 1.0])
+        rotation = attitude(roll, pitch, 0.0)
+        target = rotation.T @ (PAPER_HUBS[1] + np.array([0.0, -0.1 * k / 40, 0.0]))
+        moved = inverse(limb, target, 0.0, up, q)
+        assert np.max(np.abs(moved - q)) < 0.05, f"step {k}: a joint jumped by {np.max(np.abs(moved - q)):.3g} rad"
+        q = moved
+        pose = forward(limb, q)
+        assert np.max(np.abs(pose.hub - target)) < 1e-9 and abs(pose.axle @ up) < 1e-9
+        assert abs(pose.axle @ _heading_direction(up, 0.0)) < 1e-9
 
 
 def test_the_jacobian_is_the_forward_kinematics_derivative():

@@ -23,7 +23,7 @@ from .options import (
 )
 
 #: The parts of ``simulate`` (--only), in the order they run.
-PARTS = ("straight", "path", "terrain")
+PARTS = ("straight", "path", "terrain", "legwheel")
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -31,8 +31,11 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     add_fmu_dir(parser)
     add_model(parser, "identified model (from `rover-cosim identify`)")
     parser.add_argument("--only", choices=PARTS, default=None,
-                        help="only the paper's straight run, only the path following, or only the terrain "
-                             "scenarios (side-slope traverses; default: all three)")
+                        help="only the paper's straight run, only the path following, only the terrain "
+                             "scenarios (side-slope traverses) or only the leg-wheel rover's (LegWheelRover.fmu: "
+                             "the straight run and a 20 deg side slope with and without posture control; the "
+                             "paper's rover only); default: all four (the leg-wheel part only for the paper's "
+                             "rover)")
     parser.add_argument("--allow-model-mismatch", action="store_true",
                         help="use a model identified on another soil or wheel (refused otherwise; recorded)")
     parser.add_argument("--adapt", action="store_true",
@@ -106,6 +109,7 @@ def run(args: argparse.Namespace) -> int:
 def _runs(args: argparse.Namespace, choice: Any, calibration: Any) -> None:
     """The runs asked for (``--only``): the paper's straight run, the path following, the terrain
     scenarios, each writing its files."""
+    from rover_cosim.jobs.legwheel import run_legwheel
     from rover_cosim.jobs.path_following import run_path_following
     from rover_cosim.jobs.simulate import run_simulation
     from rover_cosim.jobs.terrain import SoilCrossingScenario, run_terrain
@@ -131,6 +135,12 @@ def _runs(args: argparse.Namespace, choice: Any, calibration: Any) -> None:
                               progress=bar, record_interval=args.record_interval, crossing=crossing)
         bar.close()
         _print_terrain(terrain)
+    if args.only == "legwheel" or (args.only is None and choice.rover_name == "paper"):
+        bar = ProgressBar("simulate: the leg-wheel rover", enabled=not args.quiet)
+        legwheel = run_legwheel(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                                progress=bar, record_interval=args.record_interval)
+        bar.close()
+        print_legwheel(legwheel)
 
 
 def _print_path(outcome: Any) -> None:
@@ -141,6 +151,23 @@ def _print_path(outcome: Any) -> None:
     table["largest RMS(Fx - Fx_des) [N]"] = rms.filter(like="rms_Fx").max(axis=1)
     table["largest RMS(Fy - Fy_des) [N]"] = rms.filter(like="rms_Fy").max(axis=1)
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    print_written(outcome.files)
+
+
+def print_legwheel(outcome: Any) -> None:
+    """What the leg-wheel scenarios measured (jobs.legwheel.LegWheelResult)."""
+    print("Leg-wheel rover, the paper's straight run (Table 3, limbs 4-6 mirror 1-3):")
+    print(outcome.rms.rename(columns={"rms_legwheel_N": "RMS(Fx - Fx_des), LegWheelRover.fmu [N]",
+                                      "rms_legwheel_cosim_N": "LegWheelRoverBody + 6 Wheel [N]",
+                                      "rms_spring_damper_N": "Rover.fmu [N]", "rms_paper_N": "paper [N]"})
+          .to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    columns = {"load_spread": "load max/min", "sinkage_spread_m": "sinkage spread [m]",
+               "cross_track_rms_m": "cross-track RMS [m]", "cross_track_max_m": "max [m]",
+               "energy_per_metre_J_m": "energy [J/m]", "roll_end_deg": "roll at the end [deg]"}
+    slope = outcome.record["parameters"]["slope_deg"]
+    print(f"Leg-wheel rover across a {slope:g} deg side slope:")
+    print(outcome.metrics[["run", *columns]].rename(columns=columns).to_string(index=False,
+                                                                             float_format=lambda v: f"{v:.3g}"))
     print_written(outcome.files)
 
 
@@ -184,7 +211,10 @@ def print_straight(outcome: Any) -> None:
 
 def result_sets(args: argparse.Namespace) -> int | None:
     """One result set per part run (each writes its files into the folder as one set)."""
-    return 1 if args.only else len(PARTS)
+    if args.only:
+        return 1
+    rover = getattr(args, "rover", None)
+    return len(PARTS) if rover in (None, "paper") else len(PARTS) - 1  # the leg-wheel part: the paper's rover
 
 
 COMMAND = Command(

@@ -17,8 +17,8 @@ from .kinematics import (
     stance_forward,
     stance_inverse,
 )
-from .statics import holding_torques, hub_compliance, static_loads
+from .statics import holding_torques, hub_compliance, static_heave, static_loads
 
 __all__ = ["JOINTS", "JOINT_NAMES", "LIMBS", "LimbGeometry", "LimbPose", "Unreachable", "athlete_limbs", "attitude",
            "forward", "holding_torques", "hub_compliance", "inverse", "jacobian", "joint_torques", "stance_forward",
-           "stance_inverse", "static_loads"]
+           "stance_inverse", "static_heave", "static_loads"]

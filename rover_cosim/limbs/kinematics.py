@@ -31,6 +31,9 @@ FloatArray = NDArray[np.float64]
 #: Newton's tolerance on the conditions of :func:`inverse` [m, and 1 for the directions].
 TOLERANCE = 1e-13
 NEWTON_STEPS = 30
+#: |cos| of the angle between the ankle roll axis and the pitch axes above which :func:`inverse`
+#: treats the wrist as singular (within 15 deg of it; see there).
+WRIST_SINGULAR = math.cos(math.radians(15.0))
 
 
 class Unreachable(ValueError):
@@ -145,20 +148,18 @@ def _level_inverse(geometry: LimbGeometry, hub: FloatArray, heading: float) -> F
     return np.array([q1, q2, q3, q4, q5, 0.0])
 
 
-def _conditions(geometry: LimbGeometry, q: FloatArray, hub: FloatArray, up: FloatArray,
-                forward_dir: FloatArray, across: FloatArray) -> FloatArray:
-    """The six conditions of :func:`inverse`: hub at the target (3), the link along -up (2: its
-    components along ``forward_dir`` and ``across``, both normal to up), the axle normal to the heading (1)."""
-    pose = forward(geometry, q)
-    return np.concatenate([pose.hub - hub, [pose.link @ forward_dir, pose.link @ across, pose.axle @ forward_dir]])
-
-
 def inverse(geometry: LimbGeometry, hub: ArrayLike, heading: float = 0.0,
-            up: ArrayLike = (0.0, 0.0, 1.0)) -> FloatArray:
+            up: ArrayLike = (0.0, 0.0, 1.0), start: ArrayLike | None = None) -> FloatArray:
     """The joints [rad] that put the hub at ``hub`` [m] (body frame) with the ankle link hanging
     along -``up`` (the world's up in body coordinates; (0, 0, 1) on a level body) and the wheel
     rolling along ``heading`` [rad] (in the plane normal to ``up``, from the body's x axis
-    projected on it). Knee up, camber 0 on a level body. Unreachable for a target out of reach."""
+    projected on it). Knee up, camber 0. A limb whose wrist is near its singularity (steered within
+    15 deg of 90 deg: the roll axis along the pitch axes, the middle limbs of the paper's posture)
+    cannot tilt its link out of its plane: on a tilted body it keeps its ankle roll and stands the
+    wheel upright (hub, heading, camber 0), its link as the rest leaves it. Unreachable for a
+    target out of reach.
+    ``start``: where Newton starts on a tilted body (e.g. the joints of a nearby pose, which a
+    controller that moves the posture step by step has; default: the level closed form's)."""
     target = np.asarray(hub, float)
     vertical = np.asarray(up, float)
     if target.shape != (3,) or not np.all(np.isfinite(target)):
@@ -174,25 +175,44 @@ def inverse(geometry: LimbGeometry, hub: ArrayLike, heading: float = 0.0,
     forward_dir = math.cos(heading) * x_on_plane + math.sin(heading) * y_on_plane
     across = np.cross(vertical, forward_dir)
     level = float(np.linalg.norm(vertical - np.array([0.0, 0.0, 1.0])))
-    q = _level_inverse(geometry, target if level < 1e-15 else _level_target(geometry, target, vertical), heading)
     if level < 1e-15:
-        return q
+        return _level_inverse(geometry, target, heading)
+    q = (_checked(start) if start is not None
+         else _level_inverse(geometry, _level_target(geometry, target, vertical), heading))
+    pose = forward(geometry, q)
+    # A wrist steered near 90 deg has its roll axis along the pitch axes: it cannot tilt its link out
+    # of the limb's plane, so the link cannot be held vertical under any tilt; such a limb keeps its
+    # ankle roll and stands its wheel upright instead (hub, heading, camber 0 on the other five).
+    singular = abs(float(pose.axes[5] @ pose.axes[1])) > WRIST_SINGULAR
+    rows, joints = ((0, 1, 2, 5, 6), slice(0, 5)) if singular else ((0, 1, 2, 3, 4, 5), slice(0, 6))
     for _ in range(NEWTON_STEPS):
-        residual = _conditions(geometry, q, target, vertical, forward_dir, across)
-        if np.max(np.abs(residual)) < TOLERANCE:
+        residual, slopes = _conditions_and_slopes(geometry, q, target, forward_dir, across, vertical)
+        if np.max(np.abs(residual[list(rows)])) < TOLERANCE:
             return q
-        step = 1e-7
-        slopes = np.column_stack([(_conditions(geometry, q + step * e, target, vertical, forward_dir, across)
-                                   - _conditions(geometry, q - step * e, target, vertical, forward_dir, across))
-                                  / (2 * step) for e in np.eye(JOINTS)])
-        q = q - np.linalg.solve(slopes, residual)
-    residual = _conditions(geometry, q, target, vertical, forward_dir, across)
-    if np.max(np.abs(residual)) > 1e-9:
+        q[joints] = q[joints] - np.linalg.lstsq(slopes[list(rows), joints], residual[list(rows)], rcond=None)[0]
+    residual, _ = _conditions_and_slopes(geometry, q, target, forward_dir, across, vertical)
+    if np.max(np.abs(residual[list(rows)])) > 1e-9:
         ankle = float(np.linalg.norm(target + geometry.drop * vertical - np.array(geometry.mount)))
         raise Unreachable(f"hub at {target.tolist()} m with up {vertical.tolist()}: no joint angles found "
                           f"(largest condition {np.max(np.abs(residual)):.3g}; the hanging ankle would be "
                           f"{ankle:.4g} m from the hip, the limb reaches {geometry.thigh + geometry.shank:.4g} m)")
     return q
+
+
+def _conditions_and_slopes(geometry: LimbGeometry, q: FloatArray, hub: FloatArray, forward_dir: FloatArray,
+                           across: FloatArray, up: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The conditions of :func:`inverse`: the hub at the target (3), the link along -up (2), the
+    axle normal to the heading (1), the axle level (1, camber 0); and their derivatives by the
+    joints (7 x 6): the hub's by the geometric Jacobian, a direction d's by a_k x d (every joint
+    turns the hub frame)."""
+    pose = forward(geometry, q)
+    linear = np.cross(pose.axes, pose.hub - pose.origins).T
+    link_turns, axle_turns = np.cross(pose.axes, pose.link), np.cross(pose.axes, pose.axle)
+    residual = np.concatenate([pose.hub - hub, [pose.link @ forward_dir, pose.link @ across,
+                                                pose.axle @ forward_dir, pose.axle @ up]])
+    slopes = np.vstack([linear, link_turns @ forward_dir, link_turns @ across, axle_turns @ forward_dir,
+                        axle_turns @ up])
+    return residual, slopes
 
 
 def _level_target(geometry: LimbGeometry, hub: FloatArray, up: FloatArray) -> FloatArray:
@@ -211,14 +231,16 @@ def stance_forward(limbs: Sequence[LimbGeometry], joints: ArrayLike, pose: Array
 
 
 def stance_inverse(limbs: Sequence[LimbGeometry], hubs: ArrayLike, pose: ArrayLike,
-                   headings: ArrayLike | float = 0.0) -> FloatArray:
+                   headings: ArrayLike | float = 0.0, start: ArrayLike | None = None) -> FloatArray:
     """The joints (a row of six per limb) that put each hub at ``hubs`` [m] (world) under the body
     ``pose`` (x, y, z [m], roll, pitch, yaw [rad]), each ankle link vertical in the world and each
-    wheel rolling along ``headings`` [rad] (from the body's heading, in the ground plane)."""
+    wheel rolling along ``headings`` [rad] (from the body's heading, in the ground plane);
+    ``start``: the joints Newton starts from on a tilted body (a row per limb; see :func:`inverse`)."""
     targets = np.asarray(hubs, float).reshape(len(limbs), 3)
     x, y, z, roll, pitch, yaw = (float(v) for v in np.asarray(pose, float))
     rotation = attitude(roll, pitch, yaw)
     up = rotation.T @ np.array([0.0, 0.0, 1.0])
     turns = np.broadcast_to(np.asarray(headings, float), (len(limbs),))
-    return np.array([inverse(limb, rotation.T @ (target - np.array([x, y, z])), float(turn), up)
-                     for limb, target, turn in zip(limbs, targets, turns)])
+    starts = [None] * len(limbs) if start is None else list(np.asarray(start, float).reshape(len(limbs), JOINTS))
+    return np.array([inverse(limb, rotation.T @ (target - np.array([x, y, z])), float(turn), up, first)
+                     for limb, target, turn, first in zip(limbs, targets, turns, starts)])

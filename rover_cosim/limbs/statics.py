@@ -11,6 +11,8 @@ posture).
 - :func:`static_loads`: the wheel loads [N] of a stance at rest on level ground, with the centre
   of gravity at a point of the body: heave, roll and pitch of the body on the six vertical
   springs 1/C_zz in equilibrium with the weight; they sum to M g and balance its moments.
+- :func:`static_heave`: how far the body sinks on its limbs at rest [m] (the same solution's heave):
+  the hubs' set-points sit that much below where the loaded hubs come to rest.
 - :func:`holding_torques`: the joint torques [N·m] that hold those loads (virtual work, J^T F).
 """
 
@@ -44,6 +46,25 @@ def static_loads(limbs: Sequence[LimbGeometry], joints: ArrayLike, joint_stiffne
     ``centre`` (x, y) [m] of the body frame: heave, roll and pitch in equilibrium on the limbs'
     vertical springs. A limb that would pull (a negative load) is an error naming it: the stance
     cannot carry the weight there."""
+    loads, _ = _equilibrium(limbs, joints, joint_stiffness, mass, gravity, centre)
+    if np.any(loads < 0):
+        lifted = [i + 1 for i in np.flatnonzero(loads < 0)]
+        raise ValueError(f"limbs {lifted} would pull on the ground (loads {np.round(loads, 1).tolist()} N): the "
+                         "stance cannot carry the weight at that centre of gravity")
+    return loads
+
+
+def static_heave(limbs: Sequence[LimbGeometry], joints: ArrayLike, joint_stiffness: ArrayLike, mass: float,
+                 gravity: float, centre: ArrayLike = (0.0, 0.0)) -> float:
+    """How far [m] the centre of gravity sinks at rest on the stance of :func:`static_loads` (same
+    arguments): the limbs' common compression at the centre."""
+    static_loads(limbs, joints, joint_stiffness, mass, gravity, centre)  # the same checks and errors
+    return float(_equilibrium(limbs, joints, joint_stiffness, mass, gravity, centre)[1][0])
+
+
+def _equilibrium(limbs: Sequence[LimbGeometry], joints: ArrayLike, joint_stiffness: ArrayLike, mass: float,
+                 gravity: float, centre: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """The loads [N] and the body's motion (heave [m], roll, pitch [rad]) at rest (see static_loads)."""
     if not (mass > 0 and gravity > 0):
         raise ValueError(f"mass = {mass!r} kg, gravity = {gravity!r} m/s²: expected both > 0")
     angles = np.asarray(joints, float).reshape(len(limbs), JOINTS)
@@ -55,12 +76,7 @@ def static_loads(limbs: Sequence[LimbGeometry], joints: ArrayLike, joint_stiffne
     system = basis.T @ np.diag(springs) @ basis                # sum of k s, of y k s, of -x k s
     weight = mass * gravity
     motion = np.linalg.solve(system, np.array([weight, 0.0, 0.0]))
-    loads = springs * (basis @ motion)
-    if np.any(loads < 0):
-        lifted = [i + 1 for i in np.flatnonzero(loads < 0)]
-        raise ValueError(f"limbs {lifted} would pull on the ground (loads {np.round(loads, 1).tolist()} N): the "
-                         "stance cannot carry the weight at that centre of gravity")
-    return loads
+    return springs * (basis @ motion), motion
 
 
 def holding_torques(limbs: Sequence[LimbGeometry], joints: ArrayLike, loads: ArrayLike) -> FloatArray:

@@ -32,6 +32,7 @@ def build_report(results: Path) -> str:
     parts += sections.closed_loop_section(simulation, paper_soil)
     parts += sections.path_section(simulation)
     parts += sections.terrain_section(simulation)
+    parts += sections.legwheel_section(simulation)
     parts += sections.coupling_section(results)
     parts += sections.montecarlo_section(results / "montecarlo")
     parts += sections.scope_section(results)

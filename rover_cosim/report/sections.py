@@ -499,10 +499,59 @@ def scope_section(results: Path) -> list[str]:
     return lines
 
 
+def legwheel_section(simulation: Path) -> list[str]:
+    """The paper's own plant, the leg-wheel rover (LegWheelRover.fmu): the straight run's Table 3
+    beside the spring-damper rover's and the paper's, and the side slope with and without posture
+    control (where the run made them: the paper's rover only)."""
+    sections = ["<h2>The leg-wheel rover: six joints per limb (paper Fig. 1)</h2>",
+                ("<p>The paper's plant is a leg-wheel robot after NASA/JPL's ATHLETE: six limbs of six rotary "
+                 "joints (hip yaw; hip, knee and ankle pitch; ankle steer and roll), each a position servo with "
+                 "stiffness, damping and a torque limit, a driven wheel at each end "
+                 "(<code>LegWheelRover.fmu</code>; the joints' compliance carries the load). "
+                 "<b>Straight run</b>: the paper's controller unchanged, the limbs held in the paper's symmetric "
+                 "posture (hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity), "
+                 "beside the same run on the spring-damper rover (Rover.fmu) and the paper's Table 3. "
+                 "<b>Side slope</b>: a 6 m traverse across a 20&deg; side slope at 0.3 m/s, the path follower "
+                 "steering through the ankle steer joints; <b>fixed</b>: the paper's posture, the body parallel "
+                 "to the slope; <b>posture control</b>: the body levelled (rolled against the slope), raised to "
+                 "1.2 m, its centre of gravity moved uphill until the weight's line passes through the "
+                 "footprint's centre, and each hub raised or lowered until the six wheels share the load.</p>")]
+    rms_path, metrics_path = simulation / "legwheel_rms.csv", simulation / "legwheel_metrics.csv"
+    if not rms_path.exists() or not metrics_path.exists():
+        return [*sections, "<p>Not run: the leg-wheel scenarios are the paper's rover's "
+                "(<code>rover-cosim simulate --only legwheel</code>).</p>"]
+    rms_table = pd.read_csv(rms_path).rename(columns={
+        "rms_legwheel_N": "leg-wheel rover [N]", "rms_legwheel_cosim_N": "leg-wheel, co-simulated [N]",
+        "rms_spring_damper_N": "spring-damper rover (Rover.fmu) [N]",
+        "rms_paper_N": "paper, Table 3 [N]"})
+    metrics = pd.read_csv(metrics_path)
+    shown = pd.DataFrame({
+        "run": metrics["run"].map({"fixed": "paper's posture (fixed)", "posture": "posture control"}),
+        "load max/min": metrics["load_spread"], "sinkage max - min [mm]": 1000 * metrics["sinkage_spread_m"],
+        "cross-track RMS [mm]": 1000 * metrics["cross_track_rms_m"],
+        "cross-track max [mm]": 1000 * metrics["cross_track_max_m"],
+        "energy [J/m]": metrics["energy_per_metre_J_m"], "roll at the end [°]": metrics["roll_end_deg"],
+        "CoG shift uphill [m]": metrics["shift_y_end_m"]})
+    sections += ["<h3>Straight run: RMS(F<sub>x</sub> - F<sub>x,des</sub>) per limb</h3>",
+                 table(rms_table, default="{:.3f}"),
+                 "<h3>20&deg; side slope</h3>",
+                 "<p>Load and sinkage spreads: over the six wheels' means in the run's second half.</p>",
+                 table(shown, default="{:.3g}"),
+                 image(simulation / "legwheel_stance.png", "the stances: the paper's posture and the posture "
+                       "control's on the slope (side, front and top views)"),
+                 image(simulation / "legwheel_limbs_slope.png", "side slope, per limb: joint torques, load, "
+                       "sinkage, slip (solid: fixed posture; dashed: posture control)"),
+                 image(simulation / "legwheel_limbs_straight.png", "straight run, per limb: joint torques, load, "
+                       "sinkage, slip")]
+    return sections
+
+
 def provenance_section(results: Path) -> list[str]:
     records = [fig3_file(results, "json"), results / "identification" / "identification.json",
                results / "simulation" / "simulation.json", results / "simulation" / "path_following.json",
                results / "simulation" / "terrain.json"]
+    if (results / "simulation" / "legwheel.json").exists():  # the paper's rover only
+        records.append(results / "simulation" / "legwheel.json")
     if (results / "montecarlo" / "summary.json").exists():  # an optional study: listed only when run
         records.append(results / "montecarlo" / "summary.json")
     return ["<h2>Provenance</h2>", *(provenance(path) for path in records)]

@@ -1,0 +1,255 @@
+"""The leg-wheel rover's posture controller (issue 47), an orchestrator block: the 36 joint
+set-points of LegWheelRover / LegWheelRoverBody from a posture of the body over its six hubs.
+
+The posture: the hubs' footprint on the ground (x_i, y_i in the heading frame, the paper's
+x = 1.5, 0, -1.5 m, y = ±1.5 m by default), the centre of gravity at ``height`` [m] above it and
+``shift`` [m] to the left of the footprint's centre, the body turned by roll and pitch against the
+ground plane; every ankle link along the ground's normal, each wheel rolling along its heading.
+The joints are :func:`rover_cosim.limbs.stance_inverse`'s for it (numpy), the steering the path
+follower asks for turns the ankle steer joints (about the ankle link: a heading change of ``δ``
+is ``-δ`` on the joint).
+
+With ``control`` the block closes three slow loops every ``period`` [s] (0.1 s; the inverse kinematics
+is Newton on a tilted body, warm-started from the last posture):
+
+1. height: ``height_cmd`` integrates the error of the measured height ``z`` (ground frame) so
+   that the body stands at ``height`` (default: the posture's) however much the limbs give under
+   the load (it starts at the posture's own: a run starts on the limbs as they are,
+   ``limbs.static_heave`` below it); a levelled body on a side slope stands higher than the
+   paper's posture so that the uphill middle limb does not fold shut (at 1.0 m and 20 deg its knee
+   is at 170 deg);
+2. attitude: the roll command integrates the error of the measured roll against the level roll
+   (the ground's slope seen from the body's heading: on a side slope of θ with the valley to the
+   right, roll = -θ levels the body), so that the body ends level however the limbs give;
+3. load balance: the lateral shift of the centre of gravity integrates the lateral offset of the
+   loads' centre from the footprint's centre (Σ y_i W_i / Σ W_i), so that the weight's line of
+   action passes through the footprint's centre;
+4. load sharing: six limbs carry the body with more contacts than it needs, so how the load
+   spreads among them is the limbs' to choose: each hub's ``lift`` integrates its load's excess
+   over the mean (over a nominal limb stiffness), the lifts kept at zero mean (the height loop
+   owns the mean), until every wheel carries the same load and, on one soil, sinks alike. Without
+   it a stiffer limb (the downhill middle one, stretched) carries most.
+
+Pitch and the longitudinal shift are held at the posture's: the middle limbs, steered 90 deg in
+the paper's posture, have their ankle roll axis along the pitch axes (a wrist singularity) and
+cannot tilt their links along the body; a slope along the heading is left to a later version
+(``limbs.inverse`` stands such a wheel upright, but its hip yaw and steer then trade places over
+small pitch changes).
+
+Every command moves at a bounded rate (``rate_*``), so a posture is reached smoothly from where
+the run starts. Without ``control`` the block holds the posture it was made with (the paper's by
+default) and only steers. The block runs every step in Python (its inverse kinematics only every
+``period``); it has no C twin: at 10 Hz its cost is the inverse kinematics (about 15 ms an
+update), not the step.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from rover_cosim.limbs import JOINTS, LimbGeometry, athlete_limbs, stance_inverse
+
+#: The joints' variable names in the leg-wheel FMUs, in a limb's joint order.
+JOINT_INPUTS = ("hipYaw", "hipPitch", "kneePitch", "anklePitch", "ankleSteer", "ankleRoll")
+#: The paper's footprint: hubs 1-3 front, middle, rear on the left, 4-6 on the right (x, y) [m].
+PAPER_FOOTPRINT = ((1.5, 1.5), (0.0, 1.5), (-1.5, 1.5), (1.5, -1.5), (0.0, -1.5), (-1.5, -1.5))
+PAPER_HEIGHT = 1.0  # m, the centre of gravity above the hubs (RoverParameters.hCoG)
+
+
+@dataclass(frozen=True)
+class Posture:
+    """The body over its hubs: ``height`` [m] of the centre of gravity above the hubs, its ``shift``
+    (x, y) [m] from the footprint's centre, ``roll`` and ``pitch`` [rad] against the ground plane,
+    and each hub's ``lift`` [m] above that plane (0: every hub on it; a hub set higher presses its
+    wheel less hard into the ground, the others harder)."""
+
+    height: float = PAPER_HEIGHT
+    shift: tuple[float, float] = (0.0, 0.0)
+    roll: float = 0.0
+    pitch: float = 0.0
+    lift: tuple[float, ...] = ()
+
+    def hubs(self, footprint: Sequence[tuple[float, float]]) -> np.ndarray:
+        """The hubs relative to the centre of gravity in the ground's heading frame [m]."""
+        lift = self.lift or (0.0,) * len(footprint)
+        return np.array([[x - self.shift[0], y - self.shift[1], -self.height + dz]
+                         for (x, y), dz in zip(footprint, lift)])
+
+
+@dataclass
+class PostureGains:
+    """The loops' integral gains and the commands' rate limits (SI)."""
+
+    height: float = 2.0          # 1/s: height command per metre of height error, per second
+    attitude: float = 2.0        # 1/s: roll command per radian of roll error, per second
+    balance: float = 1.0         # 1/s: shift per metre of the loads' offset, per second
+    sharing: float = 2.0         # 1/s: lift per metre of load excess (over sharing_stiffness), per second
+    sharing_stiffness: float = 2.6e4  # N/m: the nominal limb stiffness the load excess is divided by
+    rate_lift: float = 0.02      # m/s
+    rate_height: float = 0.05    # m/s
+    rate_attitude: float = math.radians(3.0)  # rad/s
+    rate_shift: float = 0.15     # m/s
+    max_shift: float = 0.6       # m
+
+    def __post_init__(self) -> None:
+        for name, value in vars(self).items():
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise ValueError(f"posture gains: {name} = {value!r}: expected a finite value >= 0")
+
+
+@dataclass
+class _Loops:
+    """The controller's state: the commanded posture and the joints that realise it."""
+
+    height: float
+    shift: np.ndarray
+    roll: float
+    pitch: float
+    lift: np.ndarray
+    joints: np.ndarray
+    next_update: float = 0.0
+    history: list[tuple[float, ...]] = field(default_factory=list)
+
+
+class PostureController:
+    """Orchestrator block: inputs z, roll, pitch, yaw [m, rad], the loads W[1..6] [N] and the
+    steering steer[1..6] [rad] the path follower asks for; outputs the 36 joint set-points
+    (``hipYaw[i]`` ... ``ankleRoll[i]``, [rad]) and the commanded posture (``height_cmd`` [m],
+    ``shift_y`` [m], ``roll_cmd``, ``pitch_cmd`` [rad]). See the module docstring."""
+
+    def __init__(self, name: str, *, posture: Posture = Posture(), control: bool = False,
+                 slope: float = 0.0, downhill: float = 0.0, height: float | None = None,
+                 limbs: Sequence[LimbGeometry] | None = None,
+                 footprint: Sequence[tuple[float, float]] = PAPER_FOOTPRINT, period: float = 0.1,
+                 gains: PostureGains | None = None):
+        self.name = name
+        self.limbs = tuple(limbs) if limbs is not None else athlete_limbs()
+        if len(footprint) != len(self.limbs):
+            raise ValueError(f"block {name!r}: footprint of {len(footprint)} hubs for {len(self.limbs)} limbs")
+        self.height = posture.height if height is None else height
+        for key, value in (("period", period), ("posture height", posture.height), ("height", self.height)):
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"block {name!r}: {key} = {value!r}: expected a finite value > 0")
+        if not (math.isfinite(slope) and 0 <= slope < math.pi / 2):
+            raise ValueError(f"block {name!r}: slope = {slope!r} rad: expected [0, pi/2)")
+        self.posture, self.control = posture, bool(control)
+        self.slope, self.downhill = float(slope), float(downhill)
+        self.footprint = tuple((float(x), float(y)) for x, y in footprint)
+        self.period = float(period)
+        self.gains = gains or PostureGains()
+        n = len(self.limbs)
+        self.inputs = ("z", "roll", "pitch", "yaw", *[f"W[{i}]" for i in range(1, n + 1)],
+                       *[f"steer[{i}]" for i in range(1, n + 1)])
+        self.outputs = (*[f"{joint}[{i}]" for joint in JOINT_INPUTS for i in range(1, n + 1)],
+                        "height_cmd", "shift_y", "roll_cmd", "pitch_cmd")
+        self.units = {"z": "m", "roll": "rad", "pitch": "rad", "yaw": "rad", "height_cmd": "m", "shift_y": "m",
+                      "roll_cmd": "rad", "pitch_cmd": "rad",
+                      **{f"W[{i}]": "N" for i in range(1, n + 1)}, **{f"steer[{i}]": "rad" for i in range(1, n + 1)},
+                      **{f"{joint}[{i}]": "rad" for joint in JOINT_INPUTS for i in range(1, n + 1)}}
+        self.feedthrough = True
+        self.loops = self._initial()
+
+    # --- the posture ----------------------------------------------------------------------------
+    def joints_of(self, posture: Posture, start: np.ndarray | None = None) -> np.ndarray:
+        """The joints (a row of six per limb) of ``posture``, the wheels straight ahead."""
+        pose = np.array([0.0, 0.0, 0.0, posture.roll, posture.pitch, 0.0])
+        return stance_inverse(self.limbs, posture.hubs(self.footprint), pose, 0.0, start)
+
+    def _initial(self) -> _Loops:
+        """The loops at the start: the posture the block was made with (a run starts from it)."""
+        lift = np.array(self.posture.lift or (0.0,) * len(self.limbs), float)
+        return _Loops(self.posture.height, np.array(self.posture.shift, float), self.posture.roll,
+                      self.posture.pitch, lift, self.joints_of(self.posture))
+
+    def level_attitude(self, yaw: float) -> tuple[float, float]:
+        """(roll, pitch) [rad] against the ground plane that level the body at heading ``yaw`` [rad]."""
+        slope_tan = math.tan(self.slope)
+        along, lateral = math.cos(self.downhill - yaw), math.sin(self.downhill - yaw)
+        return math.atan(slope_tan * lateral), math.atan(slope_tan * along)
+
+    def _update(self, t: float, u: np.ndarray) -> None:
+        """The slow loops, every ``period`` (see the module docstring)."""
+        loops, gains, dt = self.loops, self.gains, self.period
+        n = len(self.limbs)
+        z, roll, yaw = float(u[0]), float(u[1]), float(u[3])
+        loads = np.asarray(u[4:4 + n], float)
+        roll_level, pitch_level = self.level_attitude(yaw)
+        loops.height = _toward(loops.height, loops.height + gains.height * (self.height - z) * dt,
+                               gains.rate_height * dt)
+        loops.roll = _toward(loops.roll, loops.roll + gains.attitude * (roll_level - roll) * dt,
+                             gains.rate_attitude * dt)
+        del pitch_level  # held: see the module docstring
+        total = float(loads.sum())
+        if total > 0:
+            foot = np.array(self.footprint)
+            offset = (foot[:, 1] - foot[:, 1].mean()) @ loads / total  # the loads' centre from the footprint's
+            wanted = float(np.clip(loops.shift[1] - gains.balance * offset * dt, -gains.max_shift, gains.max_shift))
+            loops.shift[1] = _toward(float(loops.shift[1]), wanted, gains.rate_shift * dt)
+            excess = (loads - loads.mean()) / gains.sharing_stiffness
+            wanted_lift = loops.lift + gains.sharing * excess * dt
+            wanted_lift -= wanted_lift.mean()
+            loops.lift = loops.lift + np.clip(wanted_lift - loops.lift, -gains.rate_lift * dt, gains.rate_lift * dt)
+        posture = Posture(loops.height, (float(loops.shift[0]), float(loops.shift[1])), loops.roll, loops.pitch,
+                          tuple(float(v) for v in loops.lift))
+        loops.joints = self.joints_of(posture, loops.joints)
+        loops.history.append((t, loops.height, float(loops.shift[0]), float(loops.shift[1]), loops.roll,
+                              loops.pitch, *loops.lift.tolist()))
+
+    def _outputs(self, u: np.ndarray) -> np.ndarray:
+        n = len(self.limbs)
+        joints = self.loops.joints.copy()
+        joints[:, 4] -= np.asarray(u[4 + n:4 + 2 * n], float)  # a heading change of d is -d on the steer joint
+        return np.concatenate([joints.T.reshape(-1), [self.loops.height, self.loops.shift[1], self.loops.roll,
+                                                      self.loops.pitch]])
+
+    # --- the block interface --------------------------------------------------------------------
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
+        self.loops = self._initial()
+        self.loops.next_update = t0 + self.period
+        return self._outputs(u0)
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        now = t + h
+        if self.control and now >= self.loops.next_update - 1e-12:
+            self._update(now, u)
+            self.loops.next_update += self.period
+        return self._outputs(u)
+
+    def get_state(self) -> _Loops:
+        loops = self.loops
+        return _Loops(loops.height, loops.shift.copy(), loops.roll, loops.pitch, loops.lift.copy(),
+                      loops.joints.copy(), loops.next_update, list(loops.history))
+
+    def set_state(self, state: _Loops) -> None:
+        self.loops = _Loops(state.height, state.shift.copy(), state.roll, state.pitch, state.lift.copy(),
+                            state.joints.copy(), state.next_update, list(state.history))
+
+    def report(self) -> dict[str, Any]:
+        """The commanded posture at the end and how it got there (every ``period``)."""
+        loops = self.loops
+        return {"control": self.control, "period_s": self.period, "height_cmd_m": loops.height,
+                "shift_m": loops.shift.tolist(), "roll_cmd_rad": loops.roll, "pitch_cmd_rad": loops.pitch,
+                "lift_m": loops.lift.tolist(),
+                "updates": len(loops.history)}
+
+
+def _toward(value: float, target: float, limit: float) -> float:
+    """``target``, but at most ``limit`` from ``value``."""
+    return value + max(-limit, min(limit, target - value))
+
+
+def posture_joints(posture: Posture = Posture(), limbs: Sequence[LimbGeometry] | None = None,
+                   footprint: Sequence[tuple[float, float]] = PAPER_FOOTPRINT) -> dict[str, float]:
+    """The leg-wheel FMUs' 36 set-point inputs (``hipYaw[1]`` ... ``ankleRoll[6]``, rad) of ``posture``."""
+    block = PostureController("posture", posture=posture, limbs=limbs, footprint=footprint)
+    joints = block.loops.joints
+    return {f"{joint}[{i + 1}]": float(joints[i, k]) for k, joint in enumerate(JOINT_INPUTS)
+            for i in range(joints.shape[0])}
+
+
+assert JOINTS == len(JOINT_INPUTS)

@@ -1,0 +1,312 @@
+"""``make simulate`` (``--only legwheel``): the paper's own plant, the leg-wheel rover with six
+joints per limb (LegWheelRover.fmu, issue 47), on the paper's straight run and across a side slope.
+
+Scenario ``straight`` (paper Sec. 4, Table 3): 20 s at 1 ms, the paper's controller
+(``InverseModelController``: identified model, inverse law, filter) on LegWheelRover.fmu with its
+limbs held in the paper's symmetric posture (hubs at x = 1.5, 0, -1.5 m, y = ±1.5 m, 1.0 m below
+the centre of gravity), started at rest on its limbs (the centre of gravity at 1.0 m less the static
+heave of ``limbs.static_heave``); beside it the same run on Rover.fmu (the body on six vertical
+spring-dampers), the reference of the comparison.
+
+Scenario ``slope``: a 6 m traverse along +x across a 20 deg side slope (the valley to the right) at
+0.3 m/s, the path follower of the terrain scenarios (``TerrainPathController``: identified models,
+the downhill pull fed forward) steering through the ankle steer joints (``PostureController``),
+run ``fixed`` (the paper's posture, the body parallel to the slope) and ``posture`` (the posture
+controller levels the body and shifts the centre of gravity uphill until the wheels' loads
+balance).
+
+results/simulation/
+  legwheel_straight.csv     LegWheelRover.fmu: time, x, v, per limb tau, Tx, Fz, sinkage, slip, Fx,
+                            Fx_des and the six joint torques (hipYawTorque_i ...)
+  legwheel_rms.csv          limb, RMS(Fx - Fx_des) [N] on the leg-wheel rover, on Rover.fmu, the paper's
+  legwheel_slope_<run>.csv  the columns of path_*.csv, z, roll, pitch, the posture's commands and
+                            per limb the joint torques
+  legwheel_metrics.csv      per scenario and run: load spread (max/min of the mean loads over the
+                            second half), sinkage spread (max - min) [m], cross-track RMS and max [m],
+                            the motors' energy per metre [J/m], RMS(Fx - Fx_des) per limb [N]
+  legwheel_stance.png       side and top views of the stances (paper's posture, levelled on the slope)
+  legwheel_limbs_<scenario>.png  per limb: joint torques, load, sinkage, slip
+  legwheel.json             parameters, FMU hashes, versions, wall times, metrics, the posture's report
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rover_cosim.common.outputs import json_bytes, summary_repr
+from rover_cosim.common.paper import TABLE_3_RMS
+from rover_cosim.common.rows import csv_bytes, every, indices
+from rover_cosim.control.posture import JOINT_INPUTS, Posture, PostureController, posture_joints
+from rover_cosim.control.terrain_controller import TerrainPathController
+from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.limbs import athlete_limbs, static_heave
+from rover_cosim.orchestrator.builder import SystemBuilder
+from rover_cosim.orchestrator.model import System
+from rover_cosim.terramechanics import PlaneTerrain, Soil, Wheel
+from rover_cosim.terramechanics.library import Choice, as_choice
+
+from . import legwheel_figures
+from .campaign import Campaign
+from .path_following import connect_controller
+from .plants import add_rover
+from .simulate import RECORD_INTERVAL, STEP, STOP_TIME, checked_models, controller, models_of, rms
+from .simulate import monolithic_system as spring_damper_system
+from .simulate import trajectories as straight_trajectories
+from .terrain import metrics as traverse_metrics
+from .terrain import motor_energy, stop_time, traverse_path
+
+FMUS = ("LegWheelRover", "LegWheelRoverBody", "Wheel", "Rover")
+SLOPE_DEG = 20.0      # deg, the side slope (the valley to the right)
+SPEED = 0.3           # m/s
+TRAVERSE = 6.0        # m
+RUNS = ("fixed", "posture")
+LEVEL_HEIGHT = 1.2    # m, the centre of gravity over the hubs the posture controller holds (see control.posture)
+LABELS = {"fixed": "paper's posture, parallel to the slope", "posture": "posture control (level, load balanced)"}
+TORQUES = tuple(f"{joint}Torque" for joint in JOINT_INPUTS)
+
+
+@dataclass
+class LegWheelResult:
+    """What ``run_legwheel`` wrote and measured."""
+
+    files: list[Path]
+    tables: dict[str, pd.DataFrame]   # "straight", "straight_spring_damper", "slope_fixed", "slope_posture"
+    rms: pd.DataFrame                 # legwheel_rms.csv
+    metrics: pd.DataFrame             # legwheel_metrics.csv
+    record: dict[str, Any]
+
+    def __repr__(self) -> str:
+        return summary_repr(type(self).__name__, self.files, runs=len(self.tables))
+
+
+def leg_parameters(choice: Choice) -> dict[str, float]:
+    """The leg-wheel FMU's parameters of the choice: its soil and wheel, the rover's mass, inertias
+    and gravity (the soil's); the limbs are the FMU's own (ATHLETE-like, ``LegWheelParameters``)."""
+    from rover_cosim.terramechanics.library import fmu_parameters
+
+    rover = choice.rover
+    return {**fmu_parameters(choice.soil, choice.wheel), "rover.M": rover.mass, "rover.g": choice.soil.gravity,
+            "rover.Iyy": rover.Iyy, "rover.Ixx": rover.Ixx, "rover.Izz": rover.Izz}
+
+
+def settled_height(choice: Choice, height: float = 1.0) -> float:
+    """m: where the centre of gravity comes to rest in the paper's posture set ``height`` above the
+    hubs (the limbs' static heave below it)."""
+    limbs = athlete_limbs()
+    joints = PostureController("posture", posture=Posture(height)).loops.joints
+    return height - static_heave(limbs, joints, 2.0e4, choice.rover.mass, choice.soil.gravity)
+
+
+def _add_leg_wheel_rover(builder: SystemBuilder, fmu_dir: Path, choice: Choice, start: dict[str, float]) -> str:
+    path = Path(fmu_dir) / "LegWheelRover.fmu"
+    builder.add_fmu("rover", path, start=start)
+    builder.set_parameters("rover", leg_parameters(choice), only_known=True)
+    return "rover"
+
+
+def straight_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None,
+                    stop: float = STOP_TIME) -> System:
+    """The paper's straight run on LegWheelRover.fmu in the paper's posture (the set-points its inputs'
+    start values), started at rest on its limbs."""
+    choice = as_choice(choice)
+    builder = SystemBuilder("leg-wheel straight run").simulation(stop_time=stop, step=STEP, algorithm="gauss-seidel")
+    _add_leg_wheel_rover(builder, fmu_dir, choice, {"height0": settled_height(choice)})
+    builder.add_block("ctrl", controller(models_of(model), wheels=6, mass=choice.rover.mass))
+    builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
+    for i in range(1, 7):
+        builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
+    return builder.build()
+
+
+def straight_cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None,
+                          stop: float = STOP_TIME) -> System:
+    """:func:`straight_system` on LegWheelRoverBody + 6 Wheel, cut at the hubs as the steerable rover
+    is (W, v_hub, v_lat to each wheel; its Fx, Fy back), the controller first in the Gauss-Seidel order."""
+    choice = as_choice(choice)
+    builder = SystemBuilder("leg-wheel straight run (co-simulated)").simulation(stop_time=stop, step=STEP,
+                                                                                algorithm="gauss-seidel")
+    wheels = add_rover(builder, Path(fmu_dir) / "LegWheelRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", 6, None,
+                       lateral=True, body_start={"height0": settled_height(choice)})
+    builder.set_parameters("body", leg_parameters(choice), only_known=True)
+    for wheel in wheels:
+        builder.set_parameters(wheel, leg_parameters(choice), only_known=True)
+    builder.add_block("ctrl", controller(models_of(model), wheels=6, mass=choice.rover.mass))
+    builder.connect("body.x", "ctrl.x").connect("body.v", "ctrl.v")
+    for i, wheel in enumerate(wheels, start=1):
+        builder.connect(f"body.W[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"{wheel}.tau")
+        builder.connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
+    return builder.simulation(order=["ctrl", "body", *wheels]).build()
+
+
+def slope_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choice | None = None, *,
+                 slope_deg: float = SLOPE_DEG, length: float = TRAVERSE, speed: float = SPEED) -> System:
+    """The side-slope traverse on LegWheelRover.fmu, run ``run_`` "fixed" or "posture" (see the module)."""
+    if run_ not in RUNS:
+        raise ValueError(f"run {run_!r}: expected one of {', '.join(RUNS)}")
+    choice = as_choice(choice)
+    terrain = PlaneTerrain.side_slope(slope_deg, valley="right")
+    builder = SystemBuilder(f"leg-wheel traverse, {slope_deg:g} deg side slope ({run_})").simulation(
+        stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
+    radius = choice.wheel.r
+    start = {"v": speed, "height0": settled_height(choice), **{f"omega[{i}]": speed / radius for i in range(1, 7)}}
+    _add_leg_wheel_rover(builder, fmu_dir, choice, start)
+    builder.set_parameters("rover", terrain.fmu_parameters())
+    rover = choice.rover
+    builder.add_block("ctrl", TerrainPathController(
+        "ctrl", models_of(model), path=traverse_path(length), v_target=speed, steering="inverse", terrain=terrain,
+        g=choice.soil.gravity, mass=rover.mass, yaw_inertia=rover.Izz, x_limb=(1.5, 0.0, -1.5), y_limb=1.5))
+    builder.add_block("posture", PostureController("posture", control=run_ == "posture", slope=terrain.slope,
+                                                   downhill=terrain.downhill, height=LEVEL_HEIGHT))
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", range(1, 7))
+    for name in ("z", "roll", "pitch", "yaw"):
+        builder.connect(f"rover.{name}", f"posture.{name}")
+    for i in range(1, 7):
+        builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"posture.steer[{i}]")
+        builder.connect(f"rover.Fz[{i}]", f"posture.W[{i}]")
+        for joint in JOINT_INPUTS:
+            builder.connect(f"posture.{joint}[{i}]", f"rover.{joint}[{i}]")
+    return builder.simulation(order=["ctrl", "posture", "rover"]).build()
+
+
+def _joint_torques(data: pd.DataFrame, body: str = "rover") -> dict[str, Any]:
+    return {f"{name}_{i}": data[f"{body}.{name}[{i}]"] for i in range(1, 7) for name in TORQUES}
+
+
+def straight_table(data: pd.DataFrame, cosim: bool = False) -> pd.DataFrame:
+    """The straight run's columns (simulate's trajectories.csv) and the joint torques."""
+    table = straight_trajectories(data, "cosim" if cosim else "monolithic")
+    return pd.concat([table, pd.DataFrame(_joint_torques(data, "body" if cosim else "rover"))], axis=1)
+
+
+def slope_table(data: pd.DataFrame) -> pd.DataFrame:
+    """The traverse's columns (path_*.csv), the body's height and attitude, the posture's commands
+    and the joint torques."""
+    from .path_following import trajectories
+
+    table = trajectories(data, cosim=False)
+    extra = {name: data[f"rover.{name}"] for name in ("z", "roll", "pitch")}
+    extra.update({name: data[f"posture.{name}"] for name in ("height_cmd", "shift_y", "roll_cmd", "pitch_cmd")})
+    return pd.concat([table, pd.DataFrame({**extra, **_joint_torques(data)})], axis=1)
+
+
+def slope_metrics(table: pd.DataFrame, length: float = TRAVERSE, speed: float = SPEED) -> dict[str, float]:
+    """The traverse's metrics (``terrain.metrics``) and the spreads over the second half: the
+    largest over the least mean load [1], the largest less the least mean sinkage [m]."""
+    row = traverse_metrics(table, speed)
+    steady = table[table["time"] >= table["time"].iloc[-1] / 2]
+    loads = np.array([steady[f"Fz_{i}"].mean() for i in range(1, 7)])
+    sinkages = np.array([steady[f"sinkage_{i}"].mean() for i in range(1, 7)])
+    row["load_spread"] = float(loads.max() / loads.min()) if loads.min() > 0 else math.inf
+    row["sinkage_spread_m"] = float(sinkages.max() - sinkages.min())
+    row["energy_per_metre_J_m"] = motor_energy(table) / max(float(table["x"].iloc[-1] - table["x"].iloc[0]), 1e-9)
+    row["roll_end_deg"] = float(np.degrees(table["roll"].iloc[-1]))
+    row["shift_y_end_m"] = float(table["shift_y"].iloc[-1])
+    return row
+
+
+def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soil | Wheel | None = None, *,
+                 allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
+                 record_interval: float = RECORD_INTERVAL, stop: float = STOP_TIME, length: float = TRAVERSE,
+                 slope_deg: float = SLOPE_DEG) -> LegWheelResult:
+    """The leg-wheel scenarios (see the module); writes every file (all or none). The rover is the
+    paper's (the leg-wheel limbs are its); ``choice`` gives the soil and wheel (and the rover's mass
+    and inertias); ``stop`` [s] and ``length`` [m] shorten the runs (tests)."""
+    choice = as_choice(choice)
+    if choice.rover_name != "paper":
+        raise ValueError(f"rover {choice.rover_name!r}: the leg-wheel scenarios are the paper's rover's (its "
+                         "ATHLETE-like limbs); run them with --rover paper")
+    fmu_dir = Path(fmu_dir).resolve()
+    models, mismatch = checked_models(model, choice, allow_model_mismatch)
+    campaign = Campaign("rover-cosim simulate --only legwheel", 3 + len(RUNS), progress)
+    tables = {"straight": straight_table(campaign.run("straight", straight_system(fmu_dir, models, choice,
+                                                                                   stop)).data),
+              "straight_cosim": straight_table(campaign.run("straight_cosim", straight_cosim_system(
+                  fmu_dir, models, choice, stop)).data, cosim=True)}
+    spring = dataclasses.replace(spring_damper_system(fmu_dir, models, choice), stop_time=stop)
+    tables["straight_spring_damper"] = straight_trajectories(campaign.run("straight_spring_damper", spring).data,
+                                                             "monolithic")
+    reports = {}
+    for run_ in RUNS:
+        system = slope_system(fmu_dir, models, run_, choice, slope_deg=slope_deg, length=length)
+        tables[f"slope_{run_}"] = slope_table(campaign.run(f"slope_{run_}", system).data)
+        reports[run_] = next(b.block for b in system.blocks if b.name == "posture").report()  # type: ignore[attr-defined]
+    legs, spring_rms = rms(tables["straight"]), rms(tables["straight_spring_damper"])
+    rms_table = pd.DataFrame({"limb": legs["limb"], "rms_legwheel_N": legs["rms_N"],
+                              "rms_legwheel_cosim_N": rms(tables["straight_cosim"])["rms_N"],
+                              "rms_spring_damper_N": spring_rms["rms_N"],
+                              "rms_paper_N": [TABLE_3_RMS.get(int(i), TABLE_3_RMS.get(int(i) - 3, math.nan))
+                                              for i in legs["limb"]]})
+    rows = []
+    for run_ in RUNS:
+        rows.append({"scenario": "slope", "run": run_, **slope_metrics(tables[f"slope_{run_}"], length)})
+    metrics = pd.DataFrame(rows)
+    agreement = {"spring_damper": _straight_agreement(tables["straight"], tables["straight_spring_damper"]),
+                 "cosim": _straight_agreement(tables["straight"], tables["straight_cosim"])}
+    record = campaign.record({"stop_time_s": stop, "model": str(model), "record_interval_s": record_interval,
+                              "slope_deg": slope_deg, "traverse_m": length, "speed_m_s": SPEED,
+                              "posture": "paper's: hubs at x = 1.5, 0, -1.5 m, y = +-1.5 m, 1.0 m below the "
+                                         "centre of gravity"},
+                             fmu_dir=fmu_dir, fmus=FMUS, model=model, choice=choice, mismatch=mismatch,
+                             rms_N={"legwheel": legs["rms_N"].tolist(), "spring_damper": spring_rms["rms_N"].tolist()},
+                             straight_agreement=agreement, metrics=metrics.to_dict(orient="records"),
+                             posture=reports)
+    out = Path(out_dir)
+    last = tables["slope_posture"].iloc[-1]
+    stance = {"paper's posture, parallel to the slope": (posture_joints(), 0.0, 0.0),
+              "posture control (its end)": (_end_joints(tables["slope_posture"]),
+                                                         float(last["roll_cmd"]), float(last["pitch_cmd"]))}
+    files = {
+        out / "legwheel_straight.csv": csv_bytes(every(tables["straight"], record_interval, STEP), "%.8g"),
+        out / "legwheel_rms.csv": rms_table.to_csv(index=False, float_format="%.4f").encode(),
+        out / "legwheel_metrics.csv": metrics.to_csv(index=False, float_format="%.6g").encode(),
+        out / "legwheel_stance.png": legwheel_figures.stance(stance, slope_deg),
+        out / "legwheel_limbs_straight.png": legwheel_figures.limbs({"leg-wheel rover": tables["straight"]},
+                                                                    "straight run, paper's posture"),
+        out / "legwheel_limbs_slope.png": legwheel_figures.limbs(
+            {LABELS[r]: tables[f"slope_{r}"] for r in RUNS}, f"{slope_deg:g} deg side slope at {SPEED:g} m/s"),
+        out / "legwheel.json": json_bytes(record),
+    }
+    for run_ in RUNS:
+        files[out / f"legwheel_slope_{run_}.csv"] = csv_bytes(every(tables[f"slope_{run_}"], record_interval, STEP),
+                                                              "%.8g")
+    written = campaign.write(out, files, stale=("legwheel_*",))
+    return LegWheelResult(written, tables, rms_table, metrics, record)
+
+
+def _end_joints(table: pd.DataFrame) -> dict[str, float]:
+    """The set-points of the posture at the end of a traverse (its commanded posture, wheels straight)."""
+    last = table.iloc[-1]
+    posture = Posture(float(last["height_cmd"]), (0.0, float(last["shift_y"])), float(last["roll_cmd"]),
+                      float(last["pitch_cmd"]))
+    return posture_joints(posture)
+
+
+def _straight_agreement(legs: pd.DataFrame, other: pd.DataFrame) -> dict[str, float]:
+    """The leg-wheel rover against another plant on the straight run: the largest speed difference
+    [m/s] and [% of 1 m/s], the largest load difference [N] and [% of the static load] and the final
+    positions' difference [m]."""
+    wheels = indices(legs.columns, "Fz")
+    static = float(np.mean([legs[f"Fz_{i}"].iloc[0] for i in wheels]))
+    speed = float(np.abs(legs["v"] - other["v"]).max())
+    load = float(max(np.abs(legs[f"Fz_{i}"] - other[f"Fz_{i}"]).max() for i in wheels))
+    return {"speed_max_difference_m_s": speed, "speed_max_difference_percent": 100 * speed / 1.0,
+            "load_max_difference_N": load, "load_max_difference_percent": 100 * load / static,
+            "final_x_difference_m": float(legs["x"].iloc[-1] - other["x"].iloc[-1])}
+
+
+def stance_hubs(joints: dict[str, float]) -> np.ndarray:
+    """The hubs (body frame) [m] of the set-points ``joints`` (``posture_joints``' names)."""
+    from rover_cosim.limbs import forward
+
+    limbs = athlete_limbs()
+    return np.array([forward(limb, [joints[f"{name}[{i + 1}]"] for name in JOINT_INPUTS]).hub
+                     for i, limb in enumerate(limbs)])
+

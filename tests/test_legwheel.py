@@ -1,0 +1,264 @@
+"""The leg-wheel rover (issue 47): the posture controller against the numpy kinematics, the FMUs'
+physics (rest stays at rest and carries the weight, the joint torques are J^T F, the hubs are the
+forward kinematics of the reported joint angles, reverse mirrors forward, energy is not created,
+monolithic and co-simulated agree) and the scenarios' job and command on short runs."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import fmpy
+import numpy as np
+import pandas as pd
+import pytest
+
+from rover_cosim.control.posture import JOINT_INPUTS, Posture, PostureController, posture_joints
+from rover_cosim.limbs import athlete_limbs, attitude, forward, holding_torques, static_loads
+
+LIMBS = athlete_limbs()
+MASS, G = 1570.0, 1.62
+
+
+def joints_of(mapping: dict[str, float]) -> np.ndarray:
+    """The 6 x 6 joints (a row per limb) of the FMUs' set-point names."""
+    return np.array([[mapping[f"{name}[{i}]"] for name in JOINT_INPUTS] for i in range(1, 7)])
+
+
+# --- the posture controller ---------------------------------------------------------------------
+
+def test_the_paper_posture_is_the_fmus_default_and_puts_the_hubs_where_the_paper_has_them(fmus):
+    """The block's set-points of the paper's posture equal the leg-wheel FMUs' input start values
+    (the Modelica declaration and the Python controller agree), and their forward kinematics puts the
+    hubs at x = 1.5, 0, -1.5 m, y = +-1.5 m, 1.0 m below the centre of gravity, wheels straight."""
+    expected = posture_joints()
+    for name in ("LegWheelRover", "LegWheelRoverBody"):
+        starts = {v.name: float(v.start) for v in fmpy.read_model_description(str(fmus[name])).modelVariables
+                  if v.causality == "input" and v.name.split("[")[0] in JOINT_INPUTS}
+        assert starts.keys() == expected.keys()
+        np.testing.assert_allclose([starts[k] for k in expected], list(expected.values()), atol=1e-12)
+    hubs = np.array([forward(limb, q).hub for limb, q in zip(LIMBS, joints_of(expected))])
+    np.testing.assert_allclose(hubs, [[x, y, -1.0] for y in (1.5, -1.5) for x in (1.5, 0.0, -1.5)], atol=1e-12)
+
+
+def test_the_posture_block_steers_each_wheel_by_its_ankle_steer_joint():
+    """A steering input of d turns the wheel's heading by d (forward kinematics of the output)."""
+    block = PostureController("posture")
+    steer = np.array([0.1, -0.2, 0.05, 0.3, -0.1, 0.0])
+    u = np.concatenate([[1.0, 0.0, 0.0, 0.0], np.full(6, 424.0), steer])
+    outputs = dict(zip(block.outputs, block.start(0.0, u, 1e-3)))
+    for i, (limb, q) in enumerate(zip(LIMBS, joints_of(outputs))):
+        heading = forward(limb, q).heading()
+        assert math.atan2(heading[1], heading[0]) == pytest.approx(steer[i], abs=1e-12)
+
+
+def test_the_posture_block_levels_the_body_across_a_slope_and_shares_the_load():
+    """On a 20 deg side slope (the valley to the right), fed a body that follows its commands and
+    loads that favour the downhill limbs, the block rolls the body to -20 deg at its rate limit,
+    raises the downhill hubs' extension less than the uphill ones' where those carry more (lift),
+    moves the centre of gravity uphill, and keeps every wheel straight ahead and upright."""
+    slope = math.radians(20.0)
+    block = PostureController("posture", control=True, slope=slope, downhill=-math.pi / 2, height=1.2)
+    loads = np.array([300.0, 280.0, 300.0, 560.0, 600.0, 560.0])
+    u = np.concatenate([[1.0, 0.0, 0.0, 0.0], loads, np.zeros(6)])
+    block.start(0.0, u, 1e-3)
+    for k in range(1, 121):  # 12 s; the body at its commanded roll, the loads held
+        u[1] = block.loops.roll
+        block.step((k - 1) * 0.1, 0.1, u)
+    report = block.report()
+    assert report["roll_cmd_rad"] == pytest.approx(-slope, abs=1e-6)     # levelled
+    assert report["shift_m"][1] > 0.1                                      # the centre of gravity uphill
+    lift = np.array(report["lift_m"])
+    assert lift[3:].mean() > lift[:3].mean() and abs(lift.sum()) < 1e-12  # the loaded hubs raised, mean 0
+    rotation = attitude(block.loops.roll, 0.0, 0.0)
+    for limb, q in zip(LIMBS, block.loops.joints):
+        pose = forward(limb, q)
+        axle = rotation @ pose.axle
+        assert abs(axle[2]) < 1e-9 and abs(axle[0]) < 1e-9             # upright, rolling along x
+
+
+def test_posture_settings_out_of_range_are_refused_with_their_value():
+    with pytest.raises(ValueError, match=r"slope = 2.0 rad: expected \[0, pi/2\)"):
+        PostureController("p", slope=2.0)
+    with pytest.raises(ValueError, match=r"period = 0.0: expected a finite value > 0"):
+        PostureController("p", period=0.0)
+    with pytest.raises(ValueError, match=r"footprint of 2 hubs for 6 limbs"):
+        PostureController("p", footprint=((1.0, 1.0), (1.0, -1.0)))
+
+
+# --- the FMUs' physics --------------------------------------------------------------------------
+
+def _names(prefix: str, name: str) -> list[str]:
+    return [f"{prefix}{name}[{i}]" for i in range(1, 7)]
+
+
+def _rest(fmu: Path, stop: float = 3.0, **start: float) -> np.ndarray:
+    from rover_cosim.jobs.legwheel import settled_height
+    from rover_cosim.terramechanics.library import choose
+
+    outputs = ["x", "v", "z", "pitch", "roll", *_names("", "Fz"), *_names("", "hubX"), *_names("", "hubY"),
+               *_names("", "hubZ"), *[n for j in JOINT_INPUTS for n in _names("", f"{j}Angle")],
+               *[n for j in JOINT_INPUTS for n in _names("", f"{j}Torque")]]
+    return fmpy.simulate_fmu(str(fmu), stop_time=stop, output_interval=0.01, output=outputs,
+                             start_values={"height0": settled_height(choose()), **start})
+
+
+def test_at_rest_the_leg_wheel_rover_stays_put_carries_its_weight_and_holds_it_by_j_transpose_f(fmus):
+    """LegWheelRover started at rest on its limbs in the paper's posture: it does not move, its
+    loads sum to M g and equal the numpy statics, the joint torques are -J^T (0, 0, W) of the numpy
+    Jacobian (virtual work) to 1e-6 N·m, and the hubs are numpy's forward kinematics of the joint
+    angles it reports to 1e-9 m."""
+    result = _rest(fmus["LegWheelRover"])
+    last = result[-1]
+    assert np.abs(result["x"]).max() < 1e-6 and np.abs(result["v"]).max() < 1e-6   # a micron, a micron per second
+    loads = np.array([last[n] for n in _names("", "Fz")])
+    assert loads.sum() == pytest.approx(MASS * G, rel=1e-6)
+    set_points = joints_of(posture_joints())
+    np.testing.assert_allclose(loads, static_loads(LIMBS, set_points, 2.0e4, MASS, G), rtol=1e-5)
+    torques = np.array([[last[f"{name}Torque[{i}]"] for name in JOINT_INPUTS] for i in range(1, 7)])
+    np.testing.assert_allclose(torques, holding_torques(LIMBS, set_points, loads), atol=1e-6)
+    angles = np.array([[last[f"{name}Angle[{i}]"] for name in JOINT_INPUTS] for i in range(1, 7)])
+    for i, (limb, q) in enumerate(zip(LIMBS, angles), start=1):
+        np.testing.assert_allclose([last[f"hub{a}[{i}]"] for a in "XYZ"], forward(limb, q).hub, atol=1e-9)
+
+
+def _drive(fmu: Path, torque: float, stop: float = 2.0, **start: float) -> np.ndarray:
+    from rover_cosim.jobs.legwheel import settled_height
+    from rover_cosim.terramechanics.library import choose
+
+    inputs = {f"tau[{i}]": torque for i in range(1, 7)}
+    return fmpy.simulate_fmu(str(fmu), stop_time=stop, output_interval=0.01,
+                             start_values={"height0": settled_height(choose()), **inputs, **start},
+                             output=["x", "v", "pitch", *_names("", "Fz"), *_names("", "omega"),
+                                     *_names("", "hipPitchTorque")])
+
+
+def test_reverse_mirrors_forward_on_the_leg_wheel_rover(fmus):
+    """Torques -T give the trajectory of +T mirrored front to back (the posture is front-back
+    symmetric): x, v and pitch change sign; the front and rear limbs swap their loads, their hip
+    torques and (with the sign changed) their wheels' spins; the middle limbs keep theirs."""
+    ahead, back = _drive(fmus["LegWheelRover"], 40.0), _drive(fmus["LegWheelRover"], -40.0)
+    assert ahead["v"][-1] > 0.05
+    for name in ("x", "v", "pitch", "omega[2]"):
+        np.testing.assert_allclose(back[name], -ahead[name], rtol=1e-6, atol=1e-9, err_msg=name)
+    for front, rear in ((1, 3), (4, 6), (3, 1)):
+        for name, sign in (("Fz", 1.0), ("hipPitchTorque", 1.0), ("omega", -1.0)):
+            np.testing.assert_allclose(back[f"{name}[{front}]"], sign * ahead[f"{name}[{rear}]"], rtol=1e-6,
+                                       atol=1e-9, err_msg=f"{name}[{front}]")
+    np.testing.assert_allclose(back["Fz[2]"], ahead["Fz[2]"], rtol=1e-6)
+
+
+def test_energy_is_not_created_rolling_out_without_torque(fmus):
+    """Started at 0.5 m/s with its wheels rolling and no motor torque on level ground, the rover's
+    kinetic energy (body and wheels) never grows: the soil and the joint servos only take energy."""
+    fmu = fmus["LegWheelRover"]
+    radius = 0.355
+    result = fmpy.simulate_fmu(str(fmu), stop_time=3.0, output_interval=0.01, output=["v", "vy", *_names("", "omega")],
+                               start_values={"height0": _rest(fmu, 0.01)["z"][0], "v": 0.5,
+                                             **{f"omega[{i}]": 0.5 / radius for i in range(1, 7)}})
+    spins = np.column_stack([result[f"omega[{i}]"] for i in range(1, 7)])
+    energy = 0.5 * MASS * (result["v"] ** 2 + result["vy"] ** 2) + 0.5 * 0.5 * (spins ** 2).sum(axis=1)
+    assert energy[-1] < energy[0]
+    assert np.all(np.diff(energy) <= 1e-9 * energy[0]), f"grows by {np.diff(energy).max():.3g} J"
+
+
+def test_the_monolithic_and_co_simulated_leg_wheel_rovers_agree(fmus, identified, results_root):
+    """The paper's straight run, 4 s, on LegWheelRover.fmu and on LegWheelRoverBody + 6 Wheel:
+    speed within 1 % of 1 m/s, loads within 2 % of the static load."""
+    from rover_cosim.jobs import legwheel
+    from rover_cosim.orchestrator.master import run
+
+    model = results_root / "identification" / "model.json"
+    fmu_dir = fmus["LegWheelRover"].parent
+    mono = legwheel.straight_table(run(legwheel.straight_system(fmu_dir, model, stop=4.0)).data)
+    cosim = legwheel.straight_table(run(legwheel.straight_cosim_system(fmu_dir, model, stop=4.0)).data, cosim=True)
+    agreement = legwheel._straight_agreement(mono, cosim)
+    assert mono["v"].iloc[-1] > 0.3
+    assert agreement["speed_max_difference_percent"] < 1.0
+    assert agreement["load_max_difference_percent"] < 2.0
+
+
+# --- the job and the command --------------------------------------------------------------------
+
+def test_the_leg_wheel_scenarios_write_their_files_and_posture_control_spreads_the_load_less(
+        fmus, identified, results_root, tmp_path):
+    """``run_legwheel`` on short runs (2 s straight, 0.9 m of the 20 deg slope): every file, a record
+    naming the FMUs and the posture's report; with posture control the uphill-downhill spread of
+    the loads is smaller than with the paper's posture (already while the body levels)."""
+    from rover_cosim.jobs.legwheel import run_legwheel
+
+    result = run_legwheel(fmus["LegWheelRover"].parent, results_root / "identification" / "model.json", tmp_path,
+                          stop=2.0, length=0.9)
+    names = {p.name for p in result.files}
+    assert {"legwheel_straight.csv", "legwheel_rms.csv", "legwheel_metrics.csv", "legwheel_stance.png",
+            "legwheel_limbs_slope.png", "legwheel.json", "legwheel_slope_fixed.csv",
+            "legwheel_slope_posture.csv"} <= names
+    assert set(result.record["fmus"]) >= {"LegWheelRover", "LegWheelRoverBody", "Wheel", "Rover"}
+    assert result.record["posture"]["posture"]["control"] and result.record["posture"]["posture"]["updates"] > 0
+    metrics = result.metrics.set_index("run")
+    assert metrics.loc["posture", "load_spread"] < metrics.loc["fixed", "load_spread"]
+    rms = pd.read_csv(tmp_path / "legwheel_rms.csv")
+    assert list(rms.columns) == ["limb", "rms_legwheel_N", "rms_legwheel_cosim_N", "rms_spring_damper_N",
+                                 "rms_paper_N"]
+
+
+def test_simulate_only_legwheel_refuses_another_rover_with_its_name(tmp_path, fmus, identified, results_root):
+    completed = subprocess.run([sys.executable, "-P", "-m", "rover_cosim", "simulate", "--only", "legwheel", "--rover",
+                                "mer", "--allow-model-mismatch", "--quiet", "--out", str(tmp_path / "out"),
+                                "--fmu-dir", str(fmus["LegWheelRover"].parent), "--model",
+                                str(results_root / "identification" / "model.json")],
+                               capture_output=True, text=True, timeout=600)
+    assert completed.returncode != 0
+    assert "rover 'mer': the leg-wheel scenarios are the paper's rover's" in completed.stderr
+    assert "Traceback" not in completed.stderr
+    assert not (tmp_path / "out" / "legwheel.json").exists()
+
+
+def test_the_stance_figure_draws_both_stances():
+    from rover_cosim.jobs import legwheel_figures
+
+    png = legwheel_figures.stance({"paper's posture": (posture_joints(), 0.0, 0.0),
+                                   "levelled": (posture_joints(Posture(1.2, (0.0, 0.3), -0.3)), -0.3, 0.0)}, 20.0)
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+
+
+
+class _Recorder:
+    """A block that reads a hub position and sets a joint: what it saw at its start is kept."""
+
+    inputs: tuple[str, ...] = ("hub",)
+    outputs: tuple[str, ...] = ("q",)
+    units: dict[str, str] = {}
+
+    def __init__(self, value: float):
+        self.name, self.value = "holder", value
+        self.seen: float | None = None
+
+    def start(self, t0: float, u0: np.ndarray, h: float) -> np.ndarray:
+        self.seen = float(u0[0])
+        return np.array([self.value])
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        return np.array([self.value])
+
+
+def test_an_fmu_input_fed_by_a_block_holds_its_start_value_until_the_block_starts(fmus):
+    """The engine's initialization: LegWheelRoverBody's hip yaw set-point of limb 1 comes from a
+    block started after the FMUs; until then the input keeps its declared start (the paper's
+    posture), so the hub the block reads at its start is the posture's (x = 1.5 m), not that of a
+    hip yaw of 0; after the start the block's value holds."""
+    from rover_cosim.orchestrator.builder import SystemBuilder
+    from rover_cosim.orchestrator.master import run
+
+    posture = posture_joints()
+    block = _Recorder(posture["hipYaw[1]"] + 0.1)
+    builder = SystemBuilder("start values").simulation(stop_time=0.01, step=1e-3, allow_algebraic_loops=True)
+    unloaded = {f"{name}[{i}]": 0.0 for name in ("Fx", "Fy", "tau") for i in range(1, 7)}
+    builder.add_fmu("body", fmus["LegWheelRoverBody"], start=unloaded).add_block("holder", block)
+    builder.connect("body.hubX[1]", "holder.hub").connect("holder.q", "body.hipYaw[1]")
+    data = run(builder.build()).data
+    assert block.seen == pytest.approx(forward(LIMBS[0], joints_of(posture)[0]).hub[0], abs=1e-3)
+    turned = joints_of(posture)[0] + np.array([0.1, 0, 0, 0, 0, 0])
+    assert data["body.hubX[1]"].iloc[-1] == pytest.approx(forward(LIMBS[0], turned).hub[0], abs=1e-3)
