@@ -66,7 +66,7 @@ identify: fmus
 	$(VENV)/bin/rover-cosim identify --out $(RESULTS)/identification --fmu fmus/SingleWheel.fmu $(SOIL_OPTIONS)
 
 ## simulate: paper Sec. 4, closed loop on Rover.fmu and RoverBody + 6 Wheel, then the steerable rover's paths
-## and side-slope traverses (issue 35) -> results/simulation/
+## and side-slope traverses (issue 35), then the leg-wheel rover (issue 47; the paper's rover only) -> results/simulation/
 simulate: identify
 	$(VENV)/bin/rover-cosim simulate --out $(RESULTS)/simulation --fmu-dir fmus --model $(RESULTS)/identification/model.json $(SOIL_OPTIONS)
 

@@ -117,10 +117,10 @@ class _Loops:
 
 
 class PostureController:
-    """Orchestrator block: inputs z, roll, pitch, yaw [m, rad], the loads W[1..6] [N] and the
-    steering steer[1..6] [rad] the path follower asks for; outputs the 36 joint set-points
-    (``hipYaw[i]`` ... ``ankleRoll[i]``, [rad]) and the commanded posture (``height_cmd`` [m],
-    ``shift_y`` [m], ``roll_cmd``, ``pitch_cmd`` [rad]). See the module docstring."""
+    """Orchestrator block: inputs ``z``, ``roll``, ``pitch``, ``yaw`` (m, rad), the loads
+    ``W[1..6]`` (N) and the steering ``steer[1..6]`` (rad) the path follower asks for; outputs the 36
+    joint set-points (``hipYaw[i]`` ... ``ankleRoll[i]``, rad) and the commanded posture
+    (``height_cmd``, ``shift_y`` in m, ``roll_cmd``, ``pitch_cmd`` in rad). See the module docstring."""
 
     def __init__(self, name: str, *, posture: Posture = Posture(), control: bool = False,
                  slope: float = 0.0, downhill: float = 0.0, height: float | None = None,

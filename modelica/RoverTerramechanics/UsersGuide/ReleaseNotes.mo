@@ -7,6 +7,11 @@ its users. For a Modelica user:</p>
 
 <h4>Unreleased</h4>
 <ul>
+<li>The leg-wheel rover (<code>UsersGuide.LegWheelRover</code>): <code>Components.Limb</code>,
+<code>Components.LegWheelChassis</code>, <code>Parameters.LimbParameters</code>,
+<code>Parameters.LegWheelParameters</code>, the FMUs <code>LegWheelRover</code> and
+<code>LegWheelRoverBody</code>, <code>Examples.LimbKinematics</code> and
+<code>Examples.LegWheelStance</code>. The other models are unchanged.</li>
 <li>The models exported as FMUs moved into the sub-package <code>FMUs</code>, and
 <code>RoverReconnected</code> (not an FMU) into <code>Examples</code>. A model of your own that
 uses them changes its class names; the FMUs keep their file names, model identifiers and every
