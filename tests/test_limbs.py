@@ -81,12 +81,13 @@ def test_a_middle_limb_near_its_wrist_singularity_stands_its_wheel_upright_under
     heading and keeps it upright (camber 0); over a sweep of small steps (a posture controller's)
     no joint jumps."""
     limb = LIMBS[1]
-    q = inverse(limb, PAPER_HUBS[1], 0.0)
+    hub = PAPER_HUBS[1] + np.array([0.0, 0.0, -0.2])  # the body raised to 1.2 m, as the posture controller does
+    q = inverse(limb, hub, 0.0)
     for k in range(1, 41):
         roll, pitch = -0.35 * k / 40, 0.02 * k / 40
         up = attitude(roll, pitch, 0.0).T @ np.array([0.0, 0.0, 1.0])
         rotation = attitude(roll, pitch, 0.0)
-        target = rotation.T @ (PAPER_HUBS[1] + np.array([0.0, -0.1 * k / 40, 0.0]))
+        target = rotation.T @ (hub + np.array([0.0, -0.1 * k / 40, 0.0]))
         moved = inverse(limb, target, 0.0, up, q)
         assert np.max(np.abs(moved - q)) < 0.05, f"step {k}: a joint jumped by {np.max(np.abs(moved - q)):.3g} rad"
         q = moved
@@ -245,3 +246,15 @@ def test_the_modelica_leg_wheel_body_settles_on_the_loads_of_the_numpy_statics()
         np.testing.assert_allclose(got, forward(limb, q).hub, atol=1e-9, err_msg=f"limb {number}")
     # ... which sit on the ground (the normal spring's deflection) to the second order of the deflection
     assert np.max(np.abs(np.array([last[f"body.hubZ[{i}]"] for i in range(1, 7)]) + last["body.z"])) < 2e-3
+
+
+def test_inverse_leaves_its_start_as_it_was():
+    """Newton works on its own copy: the joints a caller passes as the start (a controller's last
+    posture) are not changed."""
+    limb = LIMBS[0]
+    start = inverse(limb, PAPER_HUBS[0], 0.0)
+    kept = start.copy()
+    up = attitude(0.2, 0.05, 0.0).T @ np.array([0.0, 0.0, 1.0])
+    moved = inverse(limb, PAPER_HUBS[0] + np.array([0.0, 0.05, 0.02]), 0.0, up, start)
+    np.testing.assert_array_equal(start, kept)
+    assert np.max(np.abs(moved - start)) > 1e-3

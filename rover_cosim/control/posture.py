@@ -37,7 +37,9 @@ cannot tilt their links along the body; a slope along the heading is left to a l
 small pitch changes).
 
 Every command moves at a bounded rate (``rate_*``), so a posture is reached smoothly from where
-the run starts. Without ``control`` the block holds the posture it was made with (the paper's by
+the run starts, and the set-points move linearly from one update's joints to the next over the
+period (a first-order hold: a step of a few millimetres at a hub would load a stiff limb with
+hundreds of newtons at once). Without ``control`` the block holds the posture it was made with (the paper's by
 default) and only steers. The block runs every step in Python (its inverse kinematics only every
 ``period``); it has no C twin: at 10 Hz its cost is the inverse kinematics (about 15 ms an
 update), not the step.
@@ -112,6 +114,7 @@ class _Loops:
     pitch: float
     lift: np.ndarray
     joints: np.ndarray
+    previous: np.ndarray  # the joints of the update before: the outputs move from these to ``joints``
     next_update: float = 0.0
     history: list[tuple[float, ...]] = field(default_factory=list)
 
@@ -163,8 +166,9 @@ class PostureController:
     def _initial(self) -> _Loops:
         """The loops at the start: the posture the block was made with (a run starts from it)."""
         lift = np.array(self.posture.lift or (0.0,) * len(self.limbs), float)
+        joints = self.joints_of(self.posture)
         return _Loops(self.posture.height, np.array(self.posture.shift, float), self.posture.roll,
-                      self.posture.pitch, lift, self.joints_of(self.posture))
+                      self.posture.pitch, lift, joints, joints.copy())
 
     def level_attitude(self, yaw: float) -> tuple[float, float]:
         """(roll, pitch) [rad] against the ground plane that level the body at heading ``yaw`` [rad]."""
@@ -196,13 +200,18 @@ class PostureController:
             loops.lift = loops.lift + np.clip(wanted_lift - loops.lift, -gains.rate_lift * dt, gains.rate_lift * dt)
         posture = Posture(loops.height, (float(loops.shift[0]), float(loops.shift[1])), loops.roll, loops.pitch,
                           tuple(float(v) for v in loops.lift))
+        loops.previous = loops.joints
         loops.joints = self.joints_of(posture, loops.joints)
         loops.history.append((t, loops.height, float(loops.shift[0]), float(loops.shift[1]), loops.roll,
                               loops.pitch, *loops.lift.tolist()))
 
-    def _outputs(self, u: np.ndarray) -> np.ndarray:
-        n = len(self.limbs)
-        joints = self.loops.joints.copy()
+    def _outputs(self, u: np.ndarray, now: float) -> np.ndarray:
+        """The set-points at ``now`` [s]: moving linearly from the last update's joints to the new
+        ones over a period (a step of a few millimetres at a hub would load a stiff limb with
+        hundreds of newtons at once), the steering added."""
+        n, loops = len(self.limbs), self.loops
+        fraction = min(max((now - (loops.next_update - self.period)) / self.period, 0.0), 1.0)
+        joints = loops.previous + fraction * (loops.joints - loops.previous)
         joints[:, 4] -= np.asarray(u[4 + n:4 + 2 * n], float)  # a heading change of d is -d on the steer joint
         return np.concatenate([joints.T.reshape(-1), [self.loops.height, self.loops.shift[1], self.loops.roll,
                                                       self.loops.pitch]])
@@ -211,23 +220,23 @@ class PostureController:
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
         self.loops = self._initial()
         self.loops.next_update = t0 + self.period
-        return self._outputs(u0)
+        return self._outputs(u0, t0)
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         now = t + h
         if self.control and now >= self.loops.next_update - 1e-12:
             self._update(now, u)
             self.loops.next_update += self.period
-        return self._outputs(u)
+        return self._outputs(u, now)
 
     def get_state(self) -> _Loops:
         loops = self.loops
         return _Loops(loops.height, loops.shift.copy(), loops.roll, loops.pitch, loops.lift.copy(),
-                      loops.joints.copy(), loops.next_update, list(loops.history))
+                      loops.joints.copy(), loops.previous.copy(), loops.next_update, list(loops.history))
 
     def set_state(self, state: _Loops) -> None:
         self.loops = _Loops(state.height, state.shift.copy(), state.roll, state.pitch, state.lift.copy(),
-                            state.joints.copy(), state.next_update, list(state.history))
+                            state.joints.copy(), state.previous.copy(), state.next_update, list(state.history))
 
     def report(self) -> dict[str, Any]:
         """The commanded posture at the end and how it got there (every ``period``)."""

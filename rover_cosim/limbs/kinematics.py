@@ -177,7 +177,7 @@ def inverse(geometry: LimbGeometry, hub: ArrayLike, heading: float = 0.0,
     level = float(np.linalg.norm(vertical - np.array([0.0, 0.0, 1.0])))
     if level < 1e-15:
         return _level_inverse(geometry, target, heading)
-    q = (_checked(start) if start is not None
+    q = (_checked(start).copy() if start is not None
          else _level_inverse(geometry, _level_target(geometry, target, vertical), heading))
     pose = forward(geometry, q)
     # A wrist steered near 90 deg has its roll axis along the pitch axes: it cannot tilt its link out

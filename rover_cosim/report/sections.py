@@ -533,7 +533,7 @@ def legwheel_section(simulation: Path) -> list[str]:
         "energy [J/m]": metrics["energy_per_metre_J_m"], "roll at the end [°]": metrics["roll_end_deg"],
         "CoG shift uphill [m]": metrics["shift_y_end_m"]})
     sections += ["<h3>Straight run: RMS(F<sub>x</sub> - F<sub>x,des</sub>) per limb</h3>",
-                 table(rms_table, default="{:.3f}"),
+                 table(rms_table, {"limb": "{:.0f}"}, default="{:.3f}"),
                  "<h3>20&deg; side slope</h3>",
                  "<p>Load and sinkage spreads: over the six wheels' means in the run's second half.</p>",
                  table(shown, default="{:.3g}"),
