@@ -149,6 +149,7 @@ bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_soil_estimation.py --out $(RESULTS)/bench/soil_estimation.json --markdown $(RESULTS)/bench/soil_estimation.md
 	$(PY) -P benchmarks/bench_closed_loop.py --out $(RESULTS)/bench/closed_loop.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_path_following.py --out $(RESULTS)/bench/path_following.json --model $(RESULTS)/identification/model.json
+	$(PY) -P benchmarks/bench_legwheel.py --out $(RESULTS)/bench/legwheel.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_pipeline.py --out $(RESULTS)/bench/pipeline.json
 
 clean:
