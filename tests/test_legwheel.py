@@ -79,6 +79,52 @@ def test_the_posture_block_levels_the_body_across_a_slope_and_shares_the_load():
         assert abs(axle[2]) < 1e-9 and abs(axle[0]) < 1e-9             # upright, rolling along x
 
 
+def test_the_posture_block_steps_a_sunk_wheel_out_and_holds_its_motor_meanwhile():
+    """With ``step_over``: a wheel past the trigger sinkage has its hub lifted, carried ``reach``
+    ahead and set down (the forward kinematics of the outputs), its torque output 0 while it is
+    in the air, the others' torques passed through; each limb steps once."""
+    from rover_cosim.control.posture import StepOver
+
+    plan = StepOver(trigger_sinkage=0.06, lift=0.25, reach=1.0, lift_time=0.5, swing_time=1.0, lower_time=0.5)
+    block = PostureController("posture", control=True, step_over=plan)
+    sinkage = np.array([0.11, 0.024, 0.024, 0.024, 0.024, 0.024])
+    torques = np.arange(1.0, 7.0)
+    u = np.concatenate([[1.0, 0.0, 0.0, 0.0], np.full(6, 420.0), np.zeros(6), sinkage, torques])
+    block.start(0.0, u, 1e-3)
+    outputs: dict[float, dict[str, float]] = {}
+    for k in range(1, 41):  # 4 s at the block's 0.1 s
+        y = block.step((k - 1) * 0.1, 0.1, u)
+        outputs[round(k * 0.1, 1)] = dict(zip(block.outputs, y))
+        if k == 3:
+            u[4 + 12] = 0.0  # out of the patch: the wheel no longer sinks (a second trigger would be ignored)
+    hub = {t: forward(LIMBS[0], joints_of(o)[0]).hub for t, o in outputs.items()}
+    start = forward(LIMBS[0], joints_of(posture_joints())[0]).hub
+    assert hub[1.0][2] - start[2] == pytest.approx(0.25, abs=1e-6)            # lifted (the set-points lag a period)
+    assert outputs[1.0]["tau[1]"] == 0.0 and outputs[1.0]["tau[2]"] == 2.0    # its motor held, the others' passed
+    assert hub[3.0][0] - start[0] == pytest.approx(1.0, abs=1e-6)             # carried 1 m ahead ...
+    assert hub[3.0][2] - start[2] == pytest.approx(0.0, abs=1e-3)             # ... and set down
+    assert outputs[3.0]["tau[1]"] == 1.0
+    steps = block.report()["steps"]
+    assert [s["limb"] for s in steps] == [1] and steps[0]["ended_s"] - steps[0]["began_s"] == pytest.approx(2.0)
+
+
+def test_the_limb_soil_block_puts_each_hub_where_the_rover_says_it_is():
+    from rover_cosim.jobs.ground import LimbSoilBlock
+    from rover_cosim.terramechanics import Soil
+    from rover_cosim.terramechanics.terrain import soil_patch
+
+    soil_map = soil_patch((2.5, 1.5), 0.5, Soil(), Soil(c=200.0))
+    block = LimbSoilBlock("soil", soil_map)
+    hub_x = np.array([1.5, 0.0, -1.5, 1.5, 0.0, -1.5])
+    hub_y = np.array([1.5, 1.5, 1.5, -1.5, -1.5, -1.5])
+    shares = block.start(0.0, np.concatenate([[0.0, 0.0, 0.0], hub_x, hub_y]))
+    assert shares.tolist() == [0.0] * 6
+    hub_x[0] = 2.5  # limb 1 stepped 1 m ahead: into the patch
+    assert block.step(0.0, 1e-3, np.concatenate([[0.0, 0.0, 0.0], hub_x, hub_y])).tolist() == [1.0] + [0.0] * 5
+    turned = block.step(0.0, 1e-3, np.concatenate([[1.0, 0.0, 0.5 * math.pi], hub_x, hub_y]))  # the body turned left
+    assert turned[0] == 0.0
+
+
 def test_posture_settings_out_of_range_are_refused_with_their_value():
     with pytest.raises(ValueError, match=r"slope = 2.0 rad: expected \[0, pi/2\)"):
         PostureController("p", slope=2.0)
@@ -190,7 +236,7 @@ def test_the_leg_wheel_scenarios_write_their_files_and_posture_control_spreads_t
     from rover_cosim.jobs.legwheel import run_legwheel
 
     result = run_legwheel(fmus["LegWheelRover"].parent, results_root / "identification" / "model.json", tmp_path,
-                          stop=2.0, length=0.9)
+                          stop=2.0, length=0.9, patch_stop=3.0)
     names = {p.name for p in result.files}
     assert {"legwheel_straight.csv", "legwheel_rms.csv", "legwheel_metrics.csv", "legwheel_stance.png",
             "legwheel_limbs_slope.png", "legwheel.json", "legwheel_slope_fixed.csv",
@@ -199,6 +245,17 @@ def test_the_leg_wheel_scenarios_write_their_files_and_posture_control_spreads_t
     assert result.record["posture"]["posture"]["control"] and result.record["posture"]["posture"]["updates"] > 0
     metrics = result.metrics.set_index("run")
     assert metrics.loc["posture", "load_spread"] < metrics.loc["fixed", "load_spread"]
+    # the soft patch: the sunk front-left wheel stepped out; in the air it carries no load and makes
+    # no force; set down on firm soil it sinks as the others do
+    assert [s["limb"] for s in result.record["posture"]["patch_step"]["steps"]] == [1]
+    step = result.tables["patch_step"]
+    began, ended = (result.record["posture"]["patch_step"]["steps"][0][k] for k in ("began_s", "ended_s"))
+    air = step[(step["time"] > began + 0.6) & (step["time"] < ended - 0.6)]
+    assert len(air) > 100 and air["Fz_1"].max() < 0.01 and air["Fx_1"].abs().max() < 0.05  # of 426 N on the ground
+    assert step["soilShare_1"].iloc[-1] == 0.0 and step["sinkage_1"].iloc[-1] < 0.04
+    assert result.tables["patch_roll"]["sinkage_1"].iloc[-1] > 0.09
+    assert not result.record["posture"]["patch_roll"]["steps"]
+    assert "legwheel_patch_step.csv" in names and "legwheel_limbs_patch.png" in names
     rms = pd.read_csv(tmp_path / "legwheel_rms.csv")
     assert list(rms.columns) == ["limb", "rms_legwheel_N", "rms_legwheel_cosim_N", "rms_spring_damper_N",
                                  "rms_paper_N"]

@@ -165,9 +165,15 @@ def print_legwheel(outcome: Any) -> None:
                "cross_track_rms_m": "cross-track RMS [m]", "cross_track_max_m": "max [m]",
                "energy_per_metre_J_m": "energy [J/m]", "roll_end_deg": "roll at the end [deg]"}
     slope = outcome.record["parameters"]["slope_deg"]
+    metrics = outcome.metrics
     print(f"Leg-wheel rover across a {slope:g} deg side slope:")
-    print(outcome.metrics[["run", *columns]].rename(columns=columns).to_string(index=False,
-                                                                             float_format=lambda v: f"{v:.3g}"))
+    print(metrics[metrics["scenario"] == "slope"][["run", *columns]].rename(columns=columns).to_string(
+        index=False, float_format=lambda v: f"{v:.3g}"))
+    patch = {"distance_m": "distance [m]", "mean_speed_m_s": "mean speed [m/s]", "energy_per_metre_J_m": "energy [J/m]",
+             "sinkage_1_max_m": "front-left sinkage max [m]", "in_patch_s": "in the patch [s]"}
+    print("Leg-wheel rover, the front-left wheel in a soft patch:")
+    print(metrics[metrics["scenario"] == "patch"][["run", *patch]].rename(columns=patch).to_string(
+        index=False, float_format=lambda v: f"{v:.3g}"))
     print_written(outcome.files)
 
 

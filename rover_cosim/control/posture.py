@@ -30,6 +30,11 @@ is Newton on a tilted body, warm-started from the last posture):
    owns the mean), until every wheel carries the same load and, on one soil, sinks alike. Without
    it a stiffer limb (the downhill middle one, stretched) carries most.
 
+With ``step_over`` (``StepOver``) it also steps a stuck wheel out: a wheel that sinks past the
+trigger has its hub lifted (the wheel leaves the ground: no load, no force; the block passes the
+path follower's torques through and holds that wheel's at 0), carried ahead and set down, the
+other five carrying the body; each limb once, one at a time.
+
 Pitch and the longitudinal shift are held at the posture's: the middle limbs, steered 90 deg in
 the paper's posture, have their ankle roll axis along the pitch axes (a wrist singularity) and
 cannot tilt their links along the body; a slope along the heading is left to a later version
@@ -47,6 +52,7 @@ update), not the step.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -104,6 +110,46 @@ class PostureGains:
                 raise ValueError(f"posture gains: {name} = {value!r}: expected a finite value >= 0")
 
 
+@dataclass(frozen=True)
+class StepOver:
+    """Step a stuck wheel out: when a wheel sinks deeper than ``trigger_sinkage`` [m], its hub is
+    raised by ``lift`` [m] over ``lift_time`` [s] (the wheel leaves the ground: no load, no force; its
+    motor's torque is held at 0), carried ``reach`` [m] ahead over ``swing_time`` [s] and set down
+    over ``lower_time`` [s]; each limb steps once."""
+
+    trigger_sinkage: float = 0.06
+    lift: float = 0.25
+    reach: float = 1.0
+    lift_time: float = 0.5
+    swing_time: float = 1.0
+    lower_time: float = 0.5
+
+    def __post_init__(self) -> None:
+        for name, value in vars(self).items():
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"step over: {name} = {value!r}: expected a finite value > 0")
+
+    def profile(self, elapsed: float) -> tuple[float, float, bool]:
+        """(lift [m], the share of ``reach`` covered [1], done) ``elapsed`` [s] into the step."""
+        up, across = self.lift_time, self.lift_time + self.swing_time
+        if elapsed < up:
+            return self.lift * elapsed / up, 0.0, False
+        if elapsed < across:
+            return self.lift, (elapsed - up) / self.swing_time, False
+        down = (elapsed - across) / self.lower_time
+        return self.lift * max(0.0, 1.0 - down), 1.0, down >= 1.0
+
+
+@dataclass
+class _Step:
+    """A step under way: the limb (0-based), when it began [s], its footprint x [m] and lift [m] then."""
+
+    limb: int
+    began: float
+    x0: float
+    lift0: float
+
+
 @dataclass
 class _Loops:
     """The controller's state: the commanded posture and the joints that realise it."""
@@ -115,6 +161,9 @@ class _Loops:
     lift: np.ndarray
     joints: np.ndarray
     previous: np.ndarray  # the joints of the update before: the outputs move from these to ``joints``
+    footprint: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # the hubs' (x, y) [m], per limb
+    step: _Step | None = None
+    stepped: list[tuple[int, float, float]] = field(default_factory=list)  # (limb 1-based, began, ended) [s]
     next_update: float = 0.0
     history: list[tuple[float, ...]] = field(default_factory=list)
 
@@ -129,7 +178,7 @@ class PostureController:
                  slope: float = 0.0, downhill: float = 0.0, height: float | None = None,
                  limbs: Sequence[LimbGeometry] | None = None,
                  footprint: Sequence[tuple[float, float]] = PAPER_FOOTPRINT, period: float = 0.1,
-                 gains: PostureGains | None = None):
+                 gains: PostureGains | None = None, step_over: StepOver | None = None):
         self.name = name
         self.limbs = tuple(limbs) if limbs is not None else athlete_limbs()
         if len(footprint) != len(self.limbs):
@@ -145,30 +194,43 @@ class PostureController:
         self.footprint = tuple((float(x), float(y)) for x, y in footprint)
         self.period = float(period)
         self.gains = gains or PostureGains()
+        self.step_over = step_over
+        if step_over is not None and not self.control:
+            raise ValueError(f"block {name!r}: step_over needs control = True (the steps are made at its updates)")
         n = len(self.limbs)
+        stepping = step_over is not None  # the sinkages in, the torques through (a lifted wheel's held at 0)
         self.inputs = ("z", "roll", "pitch", "yaw", *[f"W[{i}]" for i in range(1, n + 1)],
-                       *[f"steer[{i}]" for i in range(1, n + 1)])
+                       *[f"steer[{i}]" for i in range(1, n + 1)],
+                       *([f"sinkage[{i}]" for i in range(1, n + 1)] + [f"tau_cmd[{i}]" for i in range(1, n + 1)]
+                         if stepping else []))
         self.outputs = (*[f"{joint}[{i}]" for joint in JOINT_INPUTS for i in range(1, n + 1)],
-                        "height_cmd", "shift_y", "roll_cmd", "pitch_cmd")
+                        "height_cmd", "shift_y", "roll_cmd", "pitch_cmd",
+                        *([f"tau[{i}]" for i in range(1, n + 1)] if stepping else []))
         self.units = {"z": "m", "roll": "rad", "pitch": "rad", "yaw": "rad", "height_cmd": "m", "shift_y": "m",
                       "roll_cmd": "rad", "pitch_cmd": "rad",
                       **{f"W[{i}]": "N" for i in range(1, n + 1)}, **{f"steer[{i}]": "rad" for i in range(1, n + 1)},
-                      **{f"{joint}[{i}]": "rad" for joint in JOINT_INPUTS for i in range(1, n + 1)}}
+                      **{f"{joint}[{i}]": "rad" for joint in JOINT_INPUTS for i in range(1, n + 1)},
+                      **{f"sinkage[{i}]": "m" for i in range(1, n + 1)},
+                      **{f"{name}[{i}]": "N.m" for name in ("tau_cmd", "tau") for i in range(1, n + 1)}}
+        self.units = {k: v for k, v in self.units.items() if k in self.inputs or k in self.outputs}
         self.feedthrough = True
         self.loops = self._initial()
 
     # --- the posture ----------------------------------------------------------------------------
-    def joints_of(self, posture: Posture, start: np.ndarray | None = None) -> np.ndarray:
-        """The joints (a row of six per limb) of ``posture``, the wheels straight ahead."""
+    def joints_of(self, posture: Posture, start: np.ndarray | None = None,
+                  footprint: np.ndarray | None = None) -> np.ndarray:
+        """The joints (a row of six per limb) of ``posture`` over ``footprint`` (default: the
+        block's), the wheels straight ahead."""
         pose = np.array([0.0, 0.0, 0.0, posture.roll, posture.pitch, 0.0])
-        return stance_inverse(self.limbs, posture.hubs(self.footprint), pose, 0.0, start)
+        feet = [tuple(row) for row in (footprint if footprint is not None else np.array(self.footprint))]
+        return stance_inverse(self.limbs, posture.hubs(feet), pose, 0.0, start)
 
     def _initial(self) -> _Loops:
         """The loops at the start: the posture the block was made with (a run starts from it)."""
         lift = np.array(self.posture.lift or (0.0,) * len(self.limbs), float)
         joints = self.joints_of(self.posture)
         return _Loops(self.posture.height, np.array(self.posture.shift, float), self.posture.roll,
-                      self.posture.pitch, lift, joints, joints.copy())
+                      self.posture.pitch, lift, joints, joints.copy(), np.array(self.footprint, float))
 
     def level_attitude(self, yaw: float) -> tuple[float, float]:
         """(roll, pitch) [rad] against the ground plane that level the body at heading ``yaw`` [rad]."""
@@ -194,16 +256,42 @@ class PostureController:
             offset = (foot[:, 1] - foot[:, 1].mean()) @ loads / total  # the loads' centre from the footprint's
             wanted = float(np.clip(loops.shift[1] - gains.balance * offset * dt, -gains.max_shift, gains.max_shift))
             loops.shift[1] = _toward(float(loops.shift[1]), wanted, gains.rate_shift * dt)
-            excess = (loads - loads.mean()) / gains.sharing_stiffness
+            carrying = np.ones(n, bool)
+            if loops.step is not None:
+                carrying[loops.step.limb] = False  # the stepping limb carries nothing and shares nothing
+            excess = np.where(carrying, loads - loads[carrying].mean(), 0.0) / gains.sharing_stiffness
             wanted_lift = loops.lift + gains.sharing * excess * dt
-            wanted_lift -= wanted_lift.mean()
-            loops.lift = loops.lift + np.clip(wanted_lift - loops.lift, -gains.rate_lift * dt, gains.rate_lift * dt)
+            wanted_lift[carrying] -= wanted_lift[carrying].mean() - loops.lift[carrying].mean()
+            change = np.clip(wanted_lift - loops.lift, -gains.rate_lift * dt, gains.rate_lift * dt)
+            loops.lift = loops.lift + np.where(carrying, change, 0.0)
+        if self.step_over is not None:
+            self._step(t, np.asarray(u[4 + 2 * n:4 + 3 * n], float))
         posture = Posture(loops.height, (float(loops.shift[0]), float(loops.shift[1])), loops.roll, loops.pitch,
                           tuple(float(v) for v in loops.lift))
         loops.previous = loops.joints
-        loops.joints = self.joints_of(posture, loops.joints)
+        loops.joints = self.joints_of(posture, loops.joints, loops.footprint)
         loops.history.append((t, loops.height, float(loops.shift[0]), float(loops.shift[1]), loops.roll,
                               loops.pitch, *loops.lift.tolist()))
+
+    def _step(self, t: float, sinkages: np.ndarray) -> None:
+        """The step-over manoeuvre (``StepOver``) at the update at ``t`` [s]: begin one for the
+        deepest wheel past the trigger (one limb at a time, each once), or move the one under way."""
+        loops, plan = self.loops, self.step_over
+        assert plan is not None
+        if loops.step is None:
+            done = {limb - 1 for limb, _, _ in loops.stepped}
+            deep = [i for i in np.argsort(-sinkages) if sinkages[i] > plan.trigger_sinkage and i not in done]
+            if not deep:
+                return
+            i = int(deep[0])
+            loops.step = _Step(i, t, float(loops.footprint[i, 0]), float(loops.lift[i]))
+        step = loops.step
+        lift, covered, finished = plan.profile(t - step.began)
+        loops.lift[step.limb] = step.lift0 + lift
+        loops.footprint[step.limb, 0] = step.x0 + plan.reach * covered
+        if finished:
+            loops.stepped.append((step.limb + 1, step.began, t))
+            loops.step = None
 
     def _outputs(self, u: np.ndarray, now: float) -> np.ndarray:
         """The set-points at ``now`` [s]: moving linearly from the last update's joints to the new
@@ -213,8 +301,13 @@ class PostureController:
         fraction = min(max((now - (loops.next_update - self.period)) / self.period, 0.0), 1.0)
         joints = loops.previous + fraction * (loops.joints - loops.previous)
         joints[:, 4] -= np.asarray(u[4 + n:4 + 2 * n], float)  # a heading change of d is -d on the steer joint
-        return np.concatenate([joints.T.reshape(-1), [self.loops.height, self.loops.shift[1], self.loops.roll,
-                                                      self.loops.pitch]])
+        commands = [loops.height, loops.shift[1], loops.roll, loops.pitch]
+        if self.step_over is None:
+            return np.concatenate([joints.T.reshape(-1), commands])
+        torques = np.asarray(u[4 + 3 * n:4 + 4 * n], float).copy()
+        if loops.step is not None:
+            torques[loops.step.limb] = 0.0  # a wheel in the air is not driven
+        return np.concatenate([joints.T.reshape(-1), commands, torques])
 
     # --- the block interface --------------------------------------------------------------------
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
@@ -232,18 +325,23 @@ class PostureController:
     def get_state(self) -> _Loops:
         loops = self.loops
         return _Loops(loops.height, loops.shift.copy(), loops.roll, loops.pitch, loops.lift.copy(),
-                      loops.joints.copy(), loops.previous.copy(), loops.next_update, list(loops.history))
+                      loops.joints.copy(), loops.previous.copy(), loops.footprint.copy(),
+                      dataclasses.replace(loops.step) if loops.step else None, list(loops.stepped),
+                      loops.next_update, list(loops.history))
 
     def set_state(self, state: _Loops) -> None:
         self.loops = _Loops(state.height, state.shift.copy(), state.roll, state.pitch, state.lift.copy(),
-                            state.joints.copy(), state.previous.copy(), state.next_update, list(state.history))
+                            state.joints.copy(), state.previous.copy(), state.footprint.copy(),
+                            dataclasses.replace(state.step) if state.step else None, list(state.stepped),
+                            state.next_update, list(state.history))
 
     def report(self) -> dict[str, Any]:
         """The commanded posture at the end and how it got there (every ``period``)."""
         loops = self.loops
         return {"control": self.control, "period_s": self.period, "height_cmd_m": loops.height,
                 "shift_m": loops.shift.tolist(), "roll_cmd_rad": loops.roll, "pitch_cmd_rad": loops.pitch,
-                "lift_m": loops.lift.tolist(),
+                "lift_m": loops.lift.tolist(), "footprint_m": loops.footprint.tolist(),
+                "steps": [{"limb": limb, "began_s": began, "ended_s": ended} for limb, began, ended in loops.stepped],
                 "updates": len(loops.history)}
 
 

@@ -151,3 +151,34 @@ class SoilBlock(_HubBlock):
         grid = self.map.grid
         return self._twin(SOIL_C_SOURCE, "soil", [ctypes.c_int] * 2 + [ctypes.c_void_p] * 3, grid.x.size,
                           grid.y.size, doubles(grid.x), doubles(grid.y), doubles(grid.heights))
+
+
+class LimbSoilBlock:
+    """Orchestrator block: the soil under each wheel of a rover whose hubs move on its body (the
+    leg-wheel rover): ``SoilBlock``'s shares, the hubs where the rover says they are. Inputs: x, y,
+    yaw of the body, hubX[i], hubY[i] [m] (body frame; pitch and roll neglected as ``SoilBlock``
+    does). Outputs: soilShare[i] [1]. Python only (no C twin)."""
+
+    def __init__(self, name: str, soil_map: SoilMap, hubs: int = 6):
+        if not isinstance(soil_map, SoilMap):
+            raise TypeError(f"block {name!r}: soil_map = {soil_map!r}: expected a SoilMap")
+        if isinstance(hubs, bool) or not isinstance(hubs, int) or hubs < 1:
+            raise ValueError(f"block {name!r}: hubs = {hubs!r}: expected a number of wheels >= 1")
+        self.name, self.map, self.hubs = name, soil_map, hubs
+        numbers = range(1, hubs + 1)
+        self.inputs: tuple[str, ...] = (*BODY[:3], *[f"hubX[{i}]" for i in numbers], *[f"hubY[{i}]" for i in numbers])
+        self.outputs: tuple[str, ...] = tuple(f"soilShare[{i}]" for i in numbers)
+        self.units = {"x": "m", "y": "m", "yaw": "rad", **{name: "m" for name in self.inputs[3:]},
+                      **{name: "1" for name in self.outputs}}
+
+    def shares(self, u: np.ndarray) -> np.ndarray:
+        """The outputs for the inputs ``u``."""
+        n = self.hubs
+        return self.map.hub_shares(float(u[0]), float(u[1]), float(u[2]), np.asarray(u[3:3 + n], float),
+                                   np.asarray(u[3 + n:3 + 2 * n], float))
+
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
+        return self.shares(u0)
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        return self.shares(u)

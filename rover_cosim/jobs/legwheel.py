@@ -15,17 +15,27 @@ run ``fixed`` (the paper's posture, the body parallel to the slope) and ``postur
 controller levels the body and shifts the centre of gravity uphill until the wheels' loads
 balance).
 
+Scenario ``patch``: the front-left wheel starts in a soft patch (``PATCH``, ``soft_soil``: it sinks
+about 115 mm against 24 mm), the soil under each wheel from its hub's place (``LimbSoilBlock``);
+the rover creeps 0.8 m at 0.1 m/s; run ``roll`` (posture control, the wheel rolls out) and ``step``
+(the posture controller lifts the wheel that sank past 60 mm, carries it 1.0 m ahead onto firm soil
+and sets it down, its motor held at 0 while it is in the air; ``control.posture.StepOver``).
+
 results/simulation/
   legwheel_straight.csv     LegWheelRover.fmu: time, x, v, per limb tau, Tx, Fz, sinkage, slip, Fx,
                             Fx_des and the six joint torques (hipYawTorque_i ...)
   legwheel_rms.csv          limb, RMS(Fx - Fx_des) [N] on the leg-wheel rover, on Rover.fmu, the paper's
   legwheel_slope_<run>.csv  the columns of path_*.csv, z, roll, pitch, the posture's commands and
                             per limb the joint torques
-  legwheel_metrics.csv      per scenario and run: load spread (max/min of the mean loads over the
+  legwheel_patch_<run>.csv  time, x, v; per wheel the applied torque, load, sinkage, slip, Fx, the
+                            soft soil's share, the hub's x, spin and the joint torques
+  legwheel_metrics.csv      per scenario and run: slope: load spread (max/min of the mean loads over the
                             second half), sinkage spread (max - min) [m], cross-track RMS and max [m],
-                            the motors' energy per metre [J/m], RMS(Fx - Fx_des) per limb [N]
+                            the motors' energy per metre [J/m], RMS(Fx - Fx_des) per limb [N]; patch:
+                            distance [m], mean speed [m/s], energy per metre [J/m], the front-left
+                            wheel's deepest sinkage [m] and time in the patch [s]
   legwheel_stance.png       side and top views of the stances (paper's posture, levelled on the slope)
-  legwheel_limbs_<scenario>.png  per limb: joint torques, load, sinkage, slip
+  legwheel_limbs_<scenario>.png  per limb: joint torques, load, sinkage, slip (straight, slope, patch)
   legwheel.json             parameters, FMU hashes, versions, wall times, metrics, the posture's report
 """
 
@@ -176,8 +186,94 @@ def slope_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choic
     return builder.simulation(order=["ctrl", "posture", "rover"]).build()
 
 
+#: The soft patch: a drift of loose dust ours (the paper's soil with its pressure-sinkage moduli a
+#: tenth, its cohesion a quarter and a 30 deg friction angle: the wheel sinks about 115 mm at
+#: 424 N against 24 mm), a patch of radius 0.5 m about the front-left wheel's start; the rover
+#: creeps 0.8 m at 0.1 m/s (the middle wheel stops short of the patch).
+PATCH = {"centre": (1.5, 1.5), "radius": 0.5, "speed": 0.1, "length": 0.8}
+PATCH_RUNS = ("roll", "step")
+PATCH_LABELS = {"roll": "rolls through (posture control)", "step": "steps the stuck wheel out"}
+
+
+def soft_soil(soil: Soil) -> Soil:
+    """The soft patch's soil (see PATCH): ``soil`` with kc, kphi a tenth, c a quarter, phi 30 deg."""
+    return dataclasses.replace(soil, kc=soil.kc / 10, kphi=soil.kphi / 10, c=soil.c / 4, phi=math.radians(30.0))
+
+
+def patch_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choice | None = None) -> System:
+    """The soft patch (PATCH) on LegWheelRover.fmu, the soil under each wheel from its hub's place
+    (``LimbSoilBlock``); run ``run_`` "roll" (posture control, the stuck wheel rolls on) or "step"
+    (the posture controller steps the wheel that sinks past 60 mm out of the patch)."""
+    from rover_cosim.control.posture import StepOver
+    from rover_cosim.terramechanics.library import soil_parameters
+    from rover_cosim.terramechanics.terrain import soil_patch
+
+    from .ground import LimbSoilBlock
+
+    if run_ not in PATCH_RUNS:
+        raise ValueError(f"run {run_!r}: expected one of {', '.join(PATCH_RUNS)}")
+    choice = as_choice(choice)
+    speed, length = float(PATCH["speed"]), float(PATCH["length"])  # type: ignore[arg-type]
+    soil_map = soil_patch(PATCH["centre"], float(PATCH["radius"]), choice.soil, soft_soil(choice.soil))  # type: ignore[arg-type]
+    builder = SystemBuilder(f"leg-wheel rover, a wheel in a soft patch ({run_})").simulation(
+        stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
+    _add_leg_wheel_rover(builder, fmu_dir, choice, {"height0": settled_height(choice)})
+    builder.set_parameters("rover", soil_parameters(soil_map.soil_b, "soilB"))
+    rover = choice.rover
+    builder.add_block("ctrl", TerrainPathController(
+        "ctrl", models_of(model), path=traverse_path(length), v_target=speed, steering="inverse",
+        g=choice.soil.gravity, mass=rover.mass, yaw_inertia=rover.Izz, x_limb=(1.5, 0.0, -1.5), y_limb=1.5))
+    stepping = run_ == "step"
+    builder.add_block("posture", PostureController("posture", control=True,
+                                                   step_over=StepOver() if stepping else None))
+    builder.add_block("soil", LimbSoilBlock("soil", soil_map))
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", range(1, 7))
+    for name in ("z", "roll", "pitch", "yaw"):
+        builder.connect(f"rover.{name}", f"posture.{name}")
+    for name in ("x", "y", "yaw"):
+        builder.connect(f"rover.{name}", f"soil.{name}")
+    for i in range(1, 7):
+        builder.connect(f"ctrl.steer[{i}]", f"posture.steer[{i}]").connect(f"rover.Fz[{i}]", f"posture.W[{i}]")
+        if stepping:
+            builder.connect(f"ctrl.tau[{i}]", f"posture.tau_cmd[{i}]").connect(f"posture.tau[{i}]", f"rover.tau[{i}]")
+            builder.connect(f"rover.sinkage[{i}]", f"posture.sinkage[{i}]")
+        else:
+            builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
+        for joint in JOINT_INPUTS:
+            builder.connect(f"posture.{joint}[{i}]", f"rover.{joint}[{i}]")
+        builder.connect(f"rover.hubX[{i}]", f"soil.hubX[{i}]").connect(f"rover.hubY[{i}]", f"soil.hubY[{i}]")
+        builder.connect(f"soil.soilShare[{i}]", f"rover.soilShare[{i}]")
+    return builder.simulation(order=["ctrl", "posture", "rover", "soil"]).build()
+
+
 def _joint_torques(data: pd.DataFrame, body: str = "rover") -> dict[str, Any]:
     return {f"{name}_{i}": data[f"{body}.{name}[{i}]"] for i in range(1, 7) for name in TORQUES}
+
+
+def patch_table(data: pd.DataFrame) -> pd.DataFrame:
+    """The soft patch's columns: time, x, v; per wheel the torque applied to it (``tau_i``: 0 while
+    its limb steps), load, sinkage, slip, drawbar pull, the soft soil's share under it, its hub's x
+    (body frame), spin and the joint torques."""
+    applied = "posture.tau" if "posture.tau[1]" in data.columns else "ctrl.tau"
+    table: dict[str, Any] = {"time": data["time"], "x": data["rover.x"], "v": data["rover.v"]}
+    for i in range(1, 7):
+        table.update({f"tau_{i}": data[f"{applied}[{i}]"], f"Fz_{i}": data[f"rover.Fz[{i}]"],
+                      f"sinkage_{i}": data[f"rover.sinkage[{i}]"], f"slip_{i}": data[f"rover.slip[{i}]"],
+                      f"Fx_{i}": data[f"rover.Fx[{i}]"], f"soilShare_{i}": data[f"soil.soilShare[{i}]"],
+                      f"hubX_{i}": data[f"rover.hubX[{i}]"], f"omega_{i}": data[f"rover.omega[{i}]"]})
+    return pd.concat([pd.DataFrame(table), pd.DataFrame(_joint_torques(data))], axis=1)
+
+
+def patch_metrics(table: pd.DataFrame) -> dict[str, float]:
+    """How far the rover got [m], its mean speed [m/s], the motors' energy per metre [J/m] and the
+    front-left wheel's deepest sinkage after the first half second [m] (its start in the patch
+    settled)."""
+    distance = float(table["x"].iloc[-1] - table["x"].iloc[0])
+    later = table[table["time"] >= 0.5]
+    return {"distance_m": distance, "mean_speed_m_s": distance / float(table["time"].iloc[-1]),
+            "energy_per_metre_J_m": motor_energy(table) / max(distance, 1e-9),
+            "sinkage_1_max_m": float(later["sinkage_1"].max()),
+            "in_patch_s": float((table["soilShare_1"] > 0.5).sum() * STEP)}
 
 
 def straight_table(data: pd.DataFrame, cosim: bool = False) -> pd.DataFrame:
@@ -215,17 +311,17 @@ def slope_metrics(table: pd.DataFrame, length: float = TRAVERSE, speed: float = 
 def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soil | Wheel | None = None, *,
                  allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
                  record_interval: float = RECORD_INTERVAL, stop: float = STOP_TIME, length: float = TRAVERSE,
-                 slope_deg: float = SLOPE_DEG) -> LegWheelResult:
+                 slope_deg: float = SLOPE_DEG, patch_stop: float = math.inf) -> LegWheelResult:
     """The leg-wheel scenarios (see the module); writes every file (all or none). The rover is the
     paper's (the leg-wheel limbs are its); ``choice`` gives the soil and wheel (and the rover's mass
-    and inertias); ``stop`` [s] and ``length`` [m] shorten the runs (tests)."""
+    and inertias); ``stop`` [s], ``length`` [m] and ``patch_stop`` [s] shorten the runs (tests)."""
     choice = as_choice(choice)
     if choice.rover_name != "paper":
         raise ValueError(f"rover {choice.rover_name!r}: the leg-wheel scenarios are the paper's rover's (its "
                          "ATHLETE-like limbs); run them with --rover paper")
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
-    campaign = Campaign("rover-cosim simulate --only legwheel", 3 + len(RUNS), progress)
+    campaign = Campaign("rover-cosim simulate --only legwheel", 3 + len(RUNS) + len(PATCH_RUNS), progress)
     tables = {"straight": straight_table(campaign.run("straight", straight_system(fmu_dir, models, choice,
                                                                                    stop)).data),
               "straight_cosim": straight_table(campaign.run("straight_cosim", straight_cosim_system(
@@ -238,6 +334,12 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
         system = slope_system(fmu_dir, models, run_, choice, slope_deg=slope_deg, length=length)
         tables[f"slope_{run_}"] = slope_table(campaign.run(f"slope_{run_}", system).data)
         reports[run_] = next(b.block for b in system.blocks if b.name == "posture").report()  # type: ignore[attr-defined]
+    for run_ in PATCH_RUNS:
+        system = dataclasses.replace(patch_system(fmu_dir, models, run_, choice),
+                                     stop_time=min(stop_time(float(PATCH["length"]), float(PATCH["speed"])),  # type: ignore[arg-type]
+                                                   patch_stop))
+        tables[f"patch_{run_}"] = patch_table(campaign.run(f"patch_{run_}", system).data)
+        reports[f"patch_{run_}"] = next(b.block for b in system.blocks if b.name == "posture").report()  # type: ignore[attr-defined]
     legs, spring_rms = rms(tables["straight"]), rms(tables["straight_spring_damper"])
     rms_table = pd.DataFrame({"limb": legs["limb"], "rms_legwheel_N": legs["rms_N"],
                               "rms_legwheel_cosim_N": rms(tables["straight_cosim"])["rms_N"],
@@ -247,6 +349,8 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     rows = []
     for run_ in RUNS:
         rows.append({"scenario": "slope", "run": run_, **slope_metrics(tables[f"slope_{run_}"], length)})
+    for run_ in PATCH_RUNS:
+        rows.append({"scenario": "patch", "run": run_, **patch_metrics(tables[f"patch_{run_}"])})
     metrics = pd.DataFrame(rows)
     agreement = {"spring_damper": _straight_agreement(tables["straight"], tables["straight_spring_damper"]),
                  "cosim": _straight_agreement(tables["straight"], tables["straight_cosim"])}
@@ -277,6 +381,12 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     for run_ in RUNS:
         files[out / f"legwheel_slope_{run_}.csv"] = csv_bytes(every(tables[f"slope_{run_}"], record_interval, STEP),
                                                               "%.8g")
+    for run_ in PATCH_RUNS:
+        files[out / f"legwheel_patch_{run_}.csv"] = csv_bytes(every(tables[f"patch_{run_}"], record_interval, STEP),
+                                                              "%.8g")
+    files[out / "legwheel_limbs_patch.png"] = legwheel_figures.limbs(
+        {PATCH_LABELS[r]: tables[f"patch_{r}"] for r in PATCH_RUNS},
+        f"front-left wheel in a soft patch, {float(PATCH['speed']):g} m/s")  # type: ignore[arg-type]
     written = campaign.write(out, files, stale=("legwheel_*",))
     return LegWheelResult(written, tables, rms_table, metrics, record)
 

@@ -525,6 +525,8 @@ def legwheel_section(simulation: Path) -> list[str]:
         "rms_spring_damper_N": "spring-damper rover (Rover.fmu) [N]",
         "rms_paper_N": "paper, Table 3 [N]"})
     metrics = pd.read_csv(metrics_path)
+    patch = metrics[metrics["scenario"] == "patch"]
+    metrics = metrics[metrics["scenario"] == "slope"]
     shown = pd.DataFrame({
         "run": metrics["run"].map({"fixed": "paper's posture (fixed)", "posture": "posture control"}),
         "load max/min": metrics["load_spread"], "sinkage max - min [mm]": 1000 * metrics["sinkage_spread_m"],
@@ -537,10 +539,25 @@ def legwheel_section(simulation: Path) -> list[str]:
                  "<h3>20&deg; side slope</h3>",
                  "<p>Load and sinkage spreads: over the six wheels' means in the run's second half.</p>",
                  table(shown, default="{:.3g}"),
+                 "<h3>A wheel in a soft patch</h3>",
+                 ("<p>The front-left wheel starts in a patch of loose dust (ours: the paper's soil with a tenth of "
+                  "its pressure-sinkage moduli, a quarter of its cohesion, 30&deg; friction: it sinks about 115 mm "
+                  "against 24 mm) and the rover creeps 0.8 m at 0.1 m/s. <b>Rolls through</b>: posture control, "
+                  "the wheel drags out of the patch. <b>Steps out</b>: the posture controller lifts the wheel that "
+                  "sank past 60 mm (in the air it carries no load, makes no force, its motor held at 0), carries "
+                  "it 1.0 m ahead onto firm soil and sets it down, the five others holding the body.</p>"),
+                 table(pd.DataFrame({
+                     "run": patch["run"].map({"roll": "rolls through", "step": "steps the wheel out"}),
+                     "distance [m]": patch["distance_m"], "mean speed [m/s]": patch["mean_speed_m_s"],
+                     "energy [J/m]": patch["energy_per_metre_J_m"],
+                     "front-left sinkage max [mm]": 1000 * patch["sinkage_1_max_m"],
+                     "in the patch [s]": patch["in_patch_s"]}), default="{:.3g}"),
                  image(simulation / "legwheel_stance.png", "the stances: the paper's posture and the posture "
                        "control's on the slope (side, front and top views)"),
                  image(simulation / "legwheel_limbs_slope.png", "side slope, per limb: joint torques, load, "
                        "sinkage, slip (solid: fixed posture; dashed: posture control)"),
+                 image(simulation / "legwheel_limbs_patch.png", "soft patch, per limb: joint torques, load, "
+                       "sinkage, slip (solid: rolls through; dashed: steps the wheel out)"),
                  image(simulation / "legwheel_limbs_straight.png", "straight run, per limb: joint torques, load, "
                        "sinkage, slip")]
     return sections
