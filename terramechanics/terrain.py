@@ -408,3 +408,20 @@ def soil_boundary(x_boundary: float, soil: Soil, soil_b: Soil, width: float = 0.
     t = np.clip((x - x_boundary) / width + 0.5, 0.0, 1.0)
     ramp = t * t * (3.0 - 2.0 * t)
     return SoilMap(x, y, np.tile(ramp, (y.size, 1)), soil, soil_b, source=f"soil boundary at x = {x_boundary:g} m")
+
+
+def soil_patch(centre: tuple[float, float], radius: float, soil: Soil, soil_b: Soil, width: float = 0.2,
+               x_span: tuple[float, float] = (-5.0, 15.0), y_span: tuple[float, float] = (-5.0, 5.0),
+               spacing: float = 0.05) -> SoilMap:
+    """``soil_b`` in a round patch of ``radius`` [m] about ``centre`` (x, y) [m] in ``soil``, the share
+    falling from 1 to 0 over ``width`` [m] across the patch's edge (centred on it) as 3t² - 2t³,
+    sampled every ``spacing`` [m] over ``x_span`` x ``y_span`` [m]."""
+    for name, value in (("radius", radius), ("width", width), ("spacing", spacing)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"soil patch {name} = {value!r} m: expected > 0")
+    x = np.arange(x_span[0], x_span[1] + spacing / 2, spacing)
+    y = np.arange(y_span[0], y_span[1] + spacing / 2, spacing)
+    distance = np.hypot(*np.meshgrid(x - centre[0], y - centre[1]))
+    t = np.clip((radius - distance) / width + 0.5, 0.0, 1.0)
+    return SoilMap(x, y, t * t * (3.0 - 2.0 * t), soil, soil_b,
+                   source=f"soil patch of radius {radius:g} m at ({centre[0]:g}, {centre[1]:g}) m")
