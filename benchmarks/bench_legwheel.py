@@ -14,6 +14,7 @@ missing).
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import statistics
 import subprocess
 import sys
@@ -31,6 +32,20 @@ from rover_cosim.orchestrator.master import run
 GOAL_REAL_TIME = 20.0
 
 
+def _path_following_benchmark() -> Any:
+    """benchmarks/bench_path_following.py, whose per-run summary this one shares (loaded from its
+    file: ``python -P`` keeps this folder off the import path)."""
+    spec = importlib.util.spec_from_file_location("bench_path_following",
+                                                  Path(__file__).with_name("bench_path_following.py"))
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+summary = _path_following_benchmark().summary
+
+
 def systems(fmu_dir: Path, model: Path) -> dict[str, Any]:
     return {"straight/LegWheelRover": legwheel.straight_system(fmu_dir, model),
             "straight/LegWheelRoverBody + 6 Wheel": legwheel.straight_cosim_system(fmu_dir, model),
@@ -43,15 +58,6 @@ def one_run(made: Any) -> dict[str, Any]:
     result = run(made)
     return {"wall_seconds": result.wall_seconds, "steps": result.steps, "simulated_seconds": made.stop_time,
             "participant_seconds": dict(result.step_seconds)}
-
-
-def summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
-    wall = statistics.median(r["wall_seconds"] for r in runs)
-    steps, simulated = runs[0]["steps"], runs[0]["simulated_seconds"]
-    return {"wall_seconds": [r["wall_seconds"] for r in runs], "wall_seconds_median": wall,
-            "simulated_seconds": simulated, "real_time_factor": simulated / wall,
-            "per_step_us_inside": {name: 1e6 * statistics.median(r["participant_seconds"][name] for r in runs) / steps
-                                   for name in runs[0]["participant_seconds"]}}
 
 
 def whole_command(fmu_dir: Path, model: Path) -> float:
