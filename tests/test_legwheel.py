@@ -273,6 +273,22 @@ def test_simulate_only_legwheel_refuses_another_rover_with_its_name(tmp_path, fm
     assert not (tmp_path / "out" / "legwheel.json").exists()
 
 
+def test_a_rover_too_heavy_for_its_joints_is_refused_before_any_run_with_the_numbers(fmus):
+    """The job's joint limit and stiffness are the FMU's defaults; a rover whose limbs cannot hold
+    it at rest (the FMU would yield and fall through) is refused naming its mass, the torque it
+    needs and the limit; the paper's rover passes."""
+    from rover_cosim.jobs.legwheel import K_JOINT, TAU_JOINT_MAX, check_carryable
+    from rover_cosim.terramechanics.library import choose
+
+    starts = {v.name: float(v.start) for v in fmpy.read_model_description(str(fmus["LegWheelRover"])).modelVariables
+              if v.name in ("legs.tauJointMax", "legs.kJoint")}
+    assert starts == {"legs.tauJointMax": TAU_JOINT_MAX, "legs.kJoint": K_JOINT}
+    check_carryable(choose())
+    with pytest.raises(ValueError, match=r"rover mass = 20000 kg under 1.62 m/s²: its limbs would need \d+ N·m at a "
+                                         r"joint .* hold 2000 N·m .*up to about \d+ kg"):
+        check_carryable(choose(assignments=["rover.mass=20000"]))
+
+
 def test_the_stance_figure_draws_both_stances():
     from rover_cosim.jobs import legwheel_figures
 

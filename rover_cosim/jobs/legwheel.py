@@ -57,7 +57,7 @@ from rover_cosim.common.rows import csv_bytes, every, indices
 from rover_cosim.control.posture import JOINT_INPUTS, Posture, PostureController, posture_joints
 from rover_cosim.control.terrain_controller import TerrainPathController
 from rover_cosim.identification.model_set import ModelSet
-from rover_cosim.limbs import athlete_limbs, static_heave
+from rover_cosim.limbs import athlete_limbs, holding_torques, static_heave, static_loads
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.orchestrator.model import System
 from rover_cosim.terramechanics import PlaneTerrain, Soil, Wheel
@@ -97,6 +97,28 @@ class LegWheelResult:
         return summary_repr(type(self).__name__, self.files, runs=len(self.tables))
 
 
+#: N·m, the joint servos' torque limit of the leg-wheel FMUs (``LegWheelParameters.tauJointMax``).
+TAU_JOINT_MAX = 2.0e3
+#: N·m/rad, their stiffness (``LegWheelParameters.kJoint``).
+K_JOINT = 2.0e4
+
+
+def check_carryable(choice: Choice) -> None:
+    """ValueError naming the rover's mass, the largest joint torque it needs at rest in the paper's
+    posture and the servos' limit, where its limbs cannot hold it (they would yield and the body
+    fall through the ground: no run can say anything of such a rover)."""
+    limbs = athlete_limbs()
+    joints = PostureController("posture").loops.joints
+    mass, gravity = choice.rover.mass, choice.soil.gravity
+    loads = static_loads(limbs, joints, K_JOINT, mass, gravity)
+    largest = float(np.abs(holding_torques(limbs, joints, loads)).max())
+    if largest > TAU_JOINT_MAX:
+        raise ValueError(f"rover mass = {mass:g} kg under {gravity:g} m/s²: its limbs would need {largest:.0f} N·m "
+                         f"at a joint to stand in the paper's posture; the joint servos hold {TAU_JOINT_MAX:.0f} N·m "
+                         f"(LegWheelParameters.tauJointMax): expected a rover the limbs can carry (up to about "
+                         f"{mass * TAU_JOINT_MAX / largest:.0f} kg)")
+
+
 def leg_parameters(choice: Choice) -> dict[str, float]:
     """The leg-wheel FMU's parameters of the choice: its soil and wheel, the rover's mass, inertias
     and gravity (the soil's); the limbs are the FMU's own (ATHLETE-like, ``LegWheelParameters``)."""
@@ -112,7 +134,7 @@ def settled_height(choice: Choice, height: float = 1.0) -> float:
     hubs (the limbs' static heave below it)."""
     limbs = athlete_limbs()
     joints = PostureController("posture", posture=Posture(height)).loops.joints
-    return height - static_heave(limbs, joints, 2.0e4, choice.rover.mass, choice.soil.gravity)
+    return height - static_heave(limbs, joints, K_JOINT, choice.rover.mass, choice.soil.gravity)
 
 
 def _add_leg_wheel_rover(builder: SystemBuilder, fmu_dir: Path, choice: Choice, start: dict[str, float]) -> str:
@@ -319,6 +341,7 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     if choice.rover_name != "paper":
         raise ValueError(f"rover {choice.rover_name!r}: the leg-wheel scenarios are the paper's rover's (its "
                          "ATHLETE-like limbs); run them with --rover paper")
+    check_carryable(choice)
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     campaign = Campaign("rover-cosim simulate --only legwheel", 3 + len(RUNS) + len(PATCH_RUNS), progress)
