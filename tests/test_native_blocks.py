@@ -84,6 +84,28 @@ def test_the_c_twin_gives_the_python_blocks_outputs_bit_for_bit(model, options):
     twin.made.close()
 
 
+def test_a_wheel_off_the_ground_gets_no_torque_and_the_twin_agrees(model):
+    """A wheel under 1 N or less (a leg-wheel rover's lifted wheel; the FMUs' floor is 1 mN) gets
+    no torque and its filter rests, in Python and in C alike, bit for bit; the other wheels are
+    driven as ever, and set down again the wheel is driven from rest."""
+    from rover_cosim.control.longitudinal import NO_LOAD
+
+    block = InverseModelController("ctrl", str(model))
+    u = np.array([0.0, 0.5, *[424.0] * 6])
+    block.start(0.0, u)
+    twin = Twin(block)
+    t = 0.0
+    for k in range(600):
+        u[2] = 0.001 if 100 <= k < 400 else 424.0  # wheel 1 in the air from step 100 to 399
+        expected, got = block.step(t, 1e-3, u), twin.step(t, 1e-3, u)
+        assert np.array_equal(expected, got), f"step {k}: {expected - got}"
+        if 100 <= k < 400:
+            assert expected[0] == 0.0 and expected[1] == expected[2] != 0.0
+        t += 1e-3
+    assert 0.0 < expected[0] < 2 * expected[1] and NO_LOAD == 1.0
+    twin.made.close()
+
+
 def test_the_c_twin_refuses_what_the_python_block_refuses(model):
     block = InverseModelController("ctrl", str(model))
     u = np.array([0.0, 0.0, *[424.0] * 6])

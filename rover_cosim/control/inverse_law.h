@@ -111,12 +111,22 @@ static double time_constant(const Law *c, double torque) {
     return low + (torque - torques[j - 1]) * (high - low) / (torques[j] - torques[j - 1]);
 }
 
+/* A wheel under this load [N] or less is off the ground: no torque, its filter at rest
+ * (LongitudinalInverse.NO_LOAD). */
+#define LAW_NO_LOAD 1.0
+
 /* The torque of wheel ``i`` for ``force`` at ``load``; ``advance``: the filter moves on by a
  * step whose discretisation is ad, bd (else it starts settled at the target slip). As
  * LongitudinalInverse.torques for one wheel. */
 static int law_torque(Law *c, int i, double load, double force, int advance, const double *ad, const double *bd,
                       double *torque) {
     double target, slip, rate;
+    if (load > 0 && load <= LAW_NO_LOAD) {
+        c->filter[2 * i] = 0.0;
+        c->filter[2 * i + 1] = 0.0;
+        *torque = 0.0;
+        return OK;
+    }
     if (slip_for_force(c, load, force, &target) != OK) return ERROR;
     if (advance) {
         double slip_f = c->filter[2 * i], rate_f = c->filter[2 * i + 1];

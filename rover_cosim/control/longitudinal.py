@@ -22,6 +22,10 @@ import numpy as np
 from rover_cosim.identification.fits import IdentifiedModel
 from rover_cosim.identification.model_set import ModelFileError, ModelSet
 
+#: N: a wheel under this load or less is off the ground (a leg-wheel rover's lifted wheel; the
+#: wheel FMUs' own floor is 1 mN): the law gives it no torque and holds its filter at rest (the
+#: inverse model there would ask for any torque at all). The C twins' LAW_NO_LOAD (inverse_law.h).
+NO_LOAD = 1.0
 
 def read_model(model: ModelSet | str | Path, name: str,
                label: str | None = None) -> tuple[ModelSet, IdentifiedModel, str]:
@@ -122,6 +126,9 @@ class LongitudinalInverse:
         state = self.filter_state
         result = np.empty(len(loads))
         for i, (load, force) in enumerate(zip(loads.tolist(), forces.tolist())):
+            if 0 < load <= NO_LOAD:  # off the ground (a leg-wheel rover's lifted wheel): no torque, the filter at rest
+                state[i, 0], state[i, 1], result[i] = 0.0, 0.0, 0.0
+                continue
             target = self._slip_for_force(load, force)
             if advance:
                 slip_f, rate_f = float(state[i, 0]), float(state[i, 1])
