@@ -178,6 +178,32 @@ def straight_cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice 
     return builder.simulation(order=["ctrl", "body", *wheels]).build()
 
 
+def _add_path_and_posture(builder: SystemBuilder, model: ModelSet | Path, choice: Choice, length: float,
+                          speed: float, posture: PostureController, terrain: PlaneTerrain | None = None) -> None:
+    """The terrain path follower ``ctrl`` (a straight of ``length`` [m] at ``speed`` [m/s], the pull
+    of ``terrain`` fed forward) and the posture block on the rover: the path follower's steering
+    through the ankle steer joints, the body's height and attitude and the loads to the posture
+    block; the torques straight to the motors, or through the posture block where it steps wheels
+    out (it holds a lifted wheel's at 0)."""
+    rover = choice.rover
+    builder.add_block("ctrl", TerrainPathController(
+        "ctrl", models_of(model), path=traverse_path(length), v_target=speed, steering="inverse", terrain=terrain,
+        g=choice.soil.gravity, mass=rover.mass, yaw_inertia=rover.Izz, x_limb=(1.5, 0.0, -1.5), y_limb=1.5))
+    builder.add_block("posture", posture)
+    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", range(1, 7))
+    for name in ("z", "roll", "pitch", "yaw"):
+        builder.connect(f"rover.{name}", f"posture.{name}")
+    for i in range(1, 7):
+        builder.connect(f"ctrl.steer[{i}]", f"posture.steer[{i}]").connect(f"rover.Fz[{i}]", f"posture.W[{i}]")
+        if posture.step_over is not None:
+            builder.connect(f"ctrl.tau[{i}]", f"posture.tau_cmd[{i}]").connect(f"posture.tau[{i}]", f"rover.tau[{i}]")
+            builder.connect(f"rover.sinkage[{i}]", f"posture.sinkage[{i}]")
+        else:
+            builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
+        for joint in JOINT_INPUTS:
+            builder.connect(f"posture.{joint}[{i}]", f"rover.{joint}[{i}]")
+
+
 def slope_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choice | None = None, *,
                  slope_deg: float = SLOPE_DEG, length: float = TRAVERSE, speed: float = SPEED) -> System:
     """The side-slope traverse on LegWheelRover.fmu, run ``run_`` "fixed" or "posture" (see the module)."""
@@ -191,20 +217,9 @@ def slope_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choic
     start = {"v": speed, "height0": settled_height(choice), **{f"omega[{i}]": speed / radius for i in range(1, 7)}}
     _add_leg_wheel_rover(builder, fmu_dir, choice, start)
     builder.set_parameters("rover", terrain.fmu_parameters())
-    rover = choice.rover
-    builder.add_block("ctrl", TerrainPathController(
-        "ctrl", models_of(model), path=traverse_path(length), v_target=speed, steering="inverse", terrain=terrain,
-        g=choice.soil.gravity, mass=rover.mass, yaw_inertia=rover.Izz, x_limb=(1.5, 0.0, -1.5), y_limb=1.5))
-    builder.add_block("posture", PostureController("posture", control=run_ == "posture", slope=terrain.slope,
-                                                   downhill=terrain.downhill, height=LEVEL_HEIGHT))
-    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", range(1, 7))
-    for name in ("z", "roll", "pitch", "yaw"):
-        builder.connect(f"rover.{name}", f"posture.{name}")
-    for i in range(1, 7):
-        builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"posture.steer[{i}]")
-        builder.connect(f"rover.Fz[{i}]", f"posture.W[{i}]")
-        for joint in JOINT_INPUTS:
-            builder.connect(f"posture.{joint}[{i}]", f"rover.{joint}[{i}]")
+    posture = PostureController("posture", control=run_ == "posture", slope=terrain.slope, downhill=terrain.downhill,
+                                height=LEVEL_HEIGHT)
+    _add_path_and_posture(builder, model, choice, length, speed, posture, terrain)
     return builder.simulation(order=["ctrl", "posture", "rover"]).build()
 
 
@@ -241,28 +256,12 @@ def patch_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choic
         stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
     _add_leg_wheel_rover(builder, fmu_dir, choice, {"height0": settled_height(choice)})
     builder.set_parameters("rover", soil_parameters(soil_map.soil_b, "soilB"))
-    rover = choice.rover
-    builder.add_block("ctrl", TerrainPathController(
-        "ctrl", models_of(model), path=traverse_path(length), v_target=speed, steering="inverse",
-        g=choice.soil.gravity, mass=rover.mass, yaw_inertia=rover.Izz, x_limb=(1.5, 0.0, -1.5), y_limb=1.5))
-    stepping = run_ == "step"
-    builder.add_block("posture", PostureController("posture", control=True,
-                                                   step_over=StepOver() if stepping else None))
+    posture = PostureController("posture", control=True, step_over=StepOver() if run_ == "step" else None)
+    _add_path_and_posture(builder, model, choice, length, speed, posture)
     builder.add_block("soil", LimbSoilBlock("soil", soil_map))
-    connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", range(1, 7))
-    for name in ("z", "roll", "pitch", "yaw"):
-        builder.connect(f"rover.{name}", f"posture.{name}")
     for name in ("x", "y", "yaw"):
         builder.connect(f"rover.{name}", f"soil.{name}")
     for i in range(1, 7):
-        builder.connect(f"ctrl.steer[{i}]", f"posture.steer[{i}]").connect(f"rover.Fz[{i}]", f"posture.W[{i}]")
-        if stepping:
-            builder.connect(f"ctrl.tau[{i}]", f"posture.tau_cmd[{i}]").connect(f"posture.tau[{i}]", f"rover.tau[{i}]")
-            builder.connect(f"rover.sinkage[{i}]", f"posture.sinkage[{i}]")
-        else:
-            builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
-        for joint in JOINT_INPUTS:
-            builder.connect(f"posture.{joint}[{i}]", f"rover.{joint}[{i}]")
         builder.connect(f"rover.hubX[{i}]", f"soil.hubX[{i}]").connect(f"rover.hubY[{i}]", f"soil.hubY[{i}]")
         builder.connect(f"soil.soilShare[{i}]", f"rover.soilShare[{i}]")
     return builder.simulation(order=["ctrl", "posture", "rover", "soil"]).build()
@@ -433,13 +432,3 @@ def _straight_agreement(legs: pd.DataFrame, other: pd.DataFrame) -> dict[str, fl
     return {"speed_max_difference_m_s": speed, "speed_max_difference_percent": 100 * speed / 1.0,
             "load_max_difference_N": load, "load_max_difference_percent": 100 * load / static,
             "final_x_difference_m": float(legs["x"].iloc[-1] - other["x"].iloc[-1])}
-
-
-def stance_hubs(joints: dict[str, float]) -> np.ndarray:
-    """The hubs (body frame) [m] of the set-points ``joints`` (``posture_joints``' names)."""
-    from rover_cosim.limbs import forward
-
-    limbs = athlete_limbs()
-    return np.array([forward(limb, [joints[f"{name}[{i + 1}]"] for name in JOINT_INPUTS]).hub
-                     for i, limb in enumerate(limbs)])
-
