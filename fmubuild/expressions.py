@@ -30,6 +30,12 @@ class UnsupportedConstruct(ValueError):
         self.what = what
         self.where = where
 
+    def __reduce__(self) -> tuple[type[UnsupportedConstruct], tuple[str, str]]:
+        """Pickled with its two arguments, so that a parallel build's worker can hand it to the
+        parent (pickled as a plain ValueError it failed to unpickle there, and the pool reported
+        only "a process in the process pool was terminated abruptly")."""
+        return UnsupportedConstruct, (self.what, self.where)
+
 
 def is_symbolic(value: Value) -> bool:
     return isinstance(value, (ca.MX, ca.SX))

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .checks import check_nodes, checked_array
+from .grousers import grouser_engagement, shear_radius, side_shear_factor
 from .kinematics import BoolArray, FloatArray, IndexArray, entry_angle, exit_angle, max_stress_angle
 from .lateral import lateral_integrals
 from .parameters import Soil, Wheel
@@ -152,12 +153,14 @@ def _monotone_root(low: FloatArray, high: FloatArray, guesses: tuple[FloatArray,
 
 
 def _sum_over_patch(theta: FloatArray, dtheta: FloatArray, stress: Callable[[FloatArray], FloatArray],
-                    theta_f: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
+                    theta_f: FloatArray, theta_r: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
                     lateral: tuple[FloatArray, FloatArray] | None) -> ContactForces:
     """Eqs. (11)-(13) as weighted sums over quadrature angles θ (M, pieces, nodes) with weights
     dθ; ``stress`` gives σ at the nodes from cos θ (broadcastable to θ's shape). ``lateral`` is
     (θr, β) of the rows for a wheel with a slip angle, None for β = 0 (then Fy = 0 and kx is
-    soil.kx: the paper's computation, bit for bit)."""
+    soil.kx: the paper's computation, bit for bit). A grousered wheel shears the soil at its
+    shear radius r_s and on the sides of the trapped soil (:mod:`terramechanics.grousers`): its
+    shear stress counts (r_s/r) g times in Eqs. (11)-(12) and (r_s/r)² g times in Eq. (13)."""
     cos, sin = np.cos(theta), np.sin(theta)
     sigma = stress(cos)
     # Eq. (10) written out to reuse sin θ (same as shear_displacement).
@@ -166,17 +169,27 @@ def _sum_over_patch(theta: FloatArray, dtheta: FloatArray, stress: Callable[[Flo
     change = np.sin(tf) - sin
     change *= (1.0 - slip)[:, None, None]
     j -= change
-    j *= wheel.r
+    if wheel.grousered:
+        engagement = grouser_engagement(theta_f, theta_r, wheel)[:, None, None]
+        radius = shear_radius(engagement, wheel)
+        ratio = radius / wheel.r
+        j *= radius
+    else:
+        j *= wheel.r
     kx = None if lateral is None else soil.shear_moduli(lateral[1])[0][:, None, None]
     tau = shear_stress(sigma, j, soil, kx)
     rb = wheel.r * wheel.b
+    tau_torque = tau
+    if wheel.grousered:
+        tau = tau * (ratio * side_shear_factor(engagement, wheel))
+        tau_torque = tau * ratio
     integrand = tau * sin
     integrand += sigma * cos
     fz = rb * np.einsum("ipn,ipn->i", integrand, dtheta)
     np.multiply(tau, cos, out=integrand)
     integrand -= sigma * sin
     fx = rb * np.einsum("ipn,ipn->i", integrand, dtheta)
-    tx = wheel.r * rb * np.einsum("ipn,ipn->i", tau, dtheta)
+    tx = wheel.r * rb * np.einsum("ipn,ipn->i", tau_torque, dtheta)
     if lateral is None:
         zero = np.zeros(fx.shape)
         return ContactForces(fx, fz, tx, zero, zero.copy())
@@ -186,13 +199,18 @@ def _sum_over_patch(theta: FloatArray, dtheta: FloatArray, stress: Callable[[Flo
 
 
 def contact_integrals(sinkage: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
-                      nodes: int, slip_angle: FloatArray | None = None) -> ContactForces:
+                      nodes: int, slip_angle: FloatArray | None = None,
+                      rut: FloatArray | None = None) -> ContactForces:
     """Eqs. (11)-(13) and Fy without input checks, for callers that have already checked them;
-    ``sinkage``, ``slip`` and ``slip_angle`` (None: 0) must broadcast."""
+    ``sinkage`` (below the rut's floor where there is a rut), ``slip``, ``slip_angle`` (None: 0) and
+    ``rut`` (the rut's depth [m], None: 0) must broadcast."""
     beta_in = np.zeros(()) if slip_angle is None else np.asarray(slip_angle, dtype=float)
-    h, kappa, beta = np.broadcast_arrays(np.asarray(sinkage, dtype=float), np.asarray(slip, dtype=float), beta_in)
+    rut_in = np.zeros(()) if rut is None else np.asarray(rut, dtype=float)
+    h, kappa, beta, ruts = np.broadcast_arrays(np.asarray(sinkage, dtype=float), np.asarray(slip, dtype=float),
+                                               beta_in, rut_in)
     shape = h.shape
-    h, kappa, beta = h.ravel(), kappa.ravel(), beta.ravel()
+    h, kappa, beta, ruts = h.ravel(), kappa.ravel(), beta.ravel(), ruts.ravel()
+    rutted = bool(np.any(ruts != 0.0))
     lateral = bool(np.any(beta != 0.0))
     results = [np.empty(h.size) for _ in range(5)]
     # A wheel sunk past half its radius has a patch of up to π rad, over which exp(-jx/kx)
@@ -203,15 +221,20 @@ def contact_integrals(sinkage: FloatArray, slip: FloatArray, wheel: Wheel, soil:
         for start in range(0, index.size, BLOCK_SIZE):
             block = index[start:start + BLOCK_SIZE]
             _integrate_block(h[block], kappa[block], beta[block] if lateral else None, wheel, soil, group_nodes,
-                             results, block)
+                             results, block, ruts[block] if rutted else None)
     return ContactForces(*(r.reshape(shape) for r in results))
 
 
 def _integrate_block(h: FloatArray, kappa: FloatArray, beta: FloatArray | None, wheel: Wheel, soil: Soil,
-                     nodes: int, results: list[FloatArray], into: IndexArray) -> None:
+                     nodes: int, results: list[FloatArray], into: IndexArray, rut: FloatArray | None) -> None:
     """contact_integrals on 1-D arrays small enough for the temporaries to stay in cache,
     written into ``results`` (the caller's Fx, Fz, Tx, Fy, Fy_sidewall arrays) at the indices
-    ``into``; ``beta`` None for a block without slip angle."""
+    ``into``; ``beta`` None for a block without slip angle, ``rut`` None for one without ruts."""
+    exponent = soil.sinkage_exponent(kappa) if soil.n_slip != 0.0 else None
+
+    def rows(values: FloatArray | None, i: IndexArray) -> FloatArray | None:
+        return None if values is None else values[i, None, None]
+
     theta_f = entry_angle(h, wheel)
     theta_r = exit_angle(h, wheel, soil)
     theta_m = max_stress_angle(theta_f, kappa, soil)
@@ -230,9 +253,9 @@ def _integrate_block(h: FloatArray, kappa: FloatArray, beta: FloatArray | None, 
         cos_f = np.cos(theta_f[i])[:, None, None]
 
         def mirrored_stress(cos: FloatArray) -> FloatArray:
-            return pressure_from_cosines(cos[:, 1:, :], cos_f, wheel, soil)
+            return pressure_from_cosines(cos[:, 1:, :], cos_f, wheel, soil, rows(exponent, i), rows(rut, i))
 
-        store(i, _sum_over_patch(theta, dtheta, mirrored_stress, theta_f[i], kappa[i], wheel, soil,
+        store(i, _sum_over_patch(theta, dtheta, mirrored_stress, theta_f[i], theta_r[i], kappa[i], wheel, soil,
                                  None if beta is None else (theta_r[i], beta[i])))
     if not simple.all():
         # Skidding with reversed shear somewhere in the patch: τ has a kink where jx = 0, so
@@ -247,15 +270,15 @@ def _integrate_block(h: FloatArray, kappa: FloatArray, beta: FloatArray | None, 
         tf, tr, tm = (a[i, None, None] for a in (theta_f, theta_r, theta_m))
 
         def stress(cos: FloatArray) -> FloatArray:
-            return normal_stress(theta, tf, tr, tm, wheel, soil)
+            return normal_stress(theta, tf, tr, tm, wheel, soil, rows(exponent, i), rows(rut, i))
 
-        store(i, _sum_over_patch(theta, dtheta, stress, theta_f[i], kappa[i], wheel, soil,
+        store(i, _sum_over_patch(theta, dtheta, stress, theta_f[i], theta_r[i], kappa[i], wheel, soil,
                                  None if beta is None else (theta_r[i], beta[i])))
 
 
 def contact_forces(
     sinkage: ArrayLike, slip: ArrayLike, wheel: Wheel = Wheel(), soil: Soil = Soil(),
-    nodes: int = DEFAULT_NODES, *, slip_angle: ArrayLike = 0.0,
+    nodes: int = DEFAULT_NODES, *, slip_angle: ArrayLike = 0.0, rut_depth: ArrayLike = 0.0,
 ) -> ContactForces:
     """Fx, Fz, Tx of a wheel at sinkage h [m] and slip ratio κ [-], Eqs. (1)-(13), and its
     lateral force Fy (with its sidewall part) at the slip angle β [rad] (Ishigami et al. 2007,
@@ -264,7 +287,8 @@ def contact_forces(
     Vectorized over broadcastable ``sinkage`` (each in [0, r]), ``slip`` (each in [-1, 1]) and
     ``slip_angle`` (each in (-π/2, π/2)). ``nodes`` is the Gauss-Legendre node count on each
     piece of the patch (1.5 times as many for sinkage > r/2). At β = 0 the outputs are the
-    paper's, bit for bit, and Fy = 0.
+    paper's, bit for bit, and Fy = 0. ``rut_depth`` [m] (each in [0, r]; broadcasts): the rut a
+    previous wheel left (multi-pass); ``sinkage`` is then the depth below the rut's floor.
     """
     check_nodes(nodes)
     h = checked_array("sinkage", sinkage, 0.0, wheel.r, "m")
@@ -272,4 +296,5 @@ def contact_forces(
     beta = checked_array("slip_angle", slip_angle, -math.pi / 2, math.pi / 2, "rad", low_open=True)
     if np.any(np.abs(beta) >= math.pi / 2):
         raise ValueError(f"slip_angle={float(np.max(np.abs(beta)))!r} rad: expected |slip_angle| < pi/2")
-    return contact_integrals(h, kappa, wheel, soil, nodes, beta)
+    rut = checked_array("rut_depth", rut_depth, 0.0, wheel.r, "m")
+    return contact_integrals(h, kappa, wheel, soil, nodes, beta, rut)

@@ -37,7 +37,8 @@ DEFAULT = "paper"
 METADATA = ("title", "source", "notes")
 DEGREES = {"phi_deg": "phi", "xc_deg": "xc"}
 #: numpy field -> Modelica record field, where they differ.
-MODELICA_NAMES = {"kx_beta": "kxBeta", "ky_beta": "kyBeta"}
+MODELICA_NAMES = {"kx_beta": "kxBeta", "ky_beta": "kyBeta", "n_slip": "nSlip", "grouser_height": "grouserHeight",
+                  "grouser_count": "grouserCount"}
 #: Rover field -> Modelica RoverParameters field, where they differ.
 ROVER_MODELICA_NAMES = {"mass": "M", "h_cog": "hCoG", "x_limb": "xLimb", "y_limb": "yLimb", "k_limb": "kLimb",
                         "d_limb": "dLimb"}
@@ -298,7 +299,7 @@ def _changed(soil_name: str, soil_table: dict[str, Any], wheel_name: str, wheel_
 def fmu_parameters(soil: Soil, wheel: Wheel) -> dict[str, float]:
     """The soil and wheel as the FMUs' parameters (``soil.c``, ``soil.kxBeta``, ``wheel.r`` ...)."""
     values = soil_parameters(soil)
-    values.update({f"wheel.{k}": v for k, v in asdict(wheel).items()})
+    values.update({f"wheel.{MODELICA_NAMES.get(k, k)}": v for k, v in asdict(wheel).items()})
     return values
 
 
@@ -327,7 +328,7 @@ def from_fmu_parameters(values: dict[str, float]) -> tuple[Soil, Wheel]:
     soil = {modelica.get(k[5:], k[5:]): v for k, v in values.items() if k.startswith("soil.")}
     if soil.get("xc") == 0:  # the FMUs' "from phi" (45 deg - phi/2), Soil's XC_FROM_PHI
         del soil["xc"]
-    wheel = {k[6:]: v for k, v in values.items() if k.startswith("wheel.")}
+    wheel = {modelica.get(k[6:], k[6:]): v for k, v in values.items() if k.startswith("wheel.")}
     return Soil(**soil), Wheel(**wheel)
 
 

@@ -44,24 +44,40 @@ class Wheel:
         J: wheel polar moment of inertia about its axle [kg·m²]. Not given in the paper;
             0.5 kg·m² is a uniform 8 kg disc of radius 0.355 m (J = m r² / 2), the order of a
             wheel rim of an ATHLETE-class rover. It only matters for wheel spin dynamics.
+        grouser_height: height of the grousers above the rim [m] (0: a smooth wheel, the paper's).
+        grouser_count: number of grousers around the rim [1], a whole number (0: smooth).
+            See :mod:`terramechanics.grousers` for the model; with either at 0 every result is
+            the smooth wheel's, bit for bit.
     """
 
     r: float = 0.355
     b: float = 0.175
     J: float = 0.5
+    grouser_height: float = 0.0
+    grouser_count: float = 0.0
 
     def __post_init__(self) -> None:
         _check_finite(self)
         _check("r", self.r, self.r > 0, "r > 0 m")
         _check("b", self.b, self.b > 0, "b > 0 m")
         _check("J", self.J, self.J > 0, "J > 0 kg·m²")
+        _check("grouser_height", self.grouser_height, 0 <= self.grouser_height <= 0.5 * self.r,
+               f"0 <= grouser_height <= r/2 = {0.5 * self.r!r} m")
+        _check("grouser_count", self.grouser_count,
+               0 <= self.grouser_count <= 360 and self.grouser_count == int(self.grouser_count),
+               "a whole number of grousers in [0, 360]")
+
+    @property
+    def grousered(self) -> bool:
+        """True for a wheel with grousers (height and count both above 0)."""
+        return self.grouser_height > 0 and self.grouser_count > 0
 
 
 #: The SI unit of every Soil and Wheel field (angles in rad; the library's files may give them in
 #: degrees under ``phi_deg``, ``xc_deg``).
 UNITS = {"c": "Pa", "phi": "rad", "kc": "N/m^(n+1)", "kphi": "N/m^(n+2)", "n": "1", "kx": "m", "a0": "1", "a1": "1",
          "lam": "1", "kx_beta": "m/rad", "ky": "m", "ky_beta": "m/rad", "rho": "kg/m^3", "gravity": "m/s^2",
-         "xc": "rad", "r": "m", "b": "m", "J": "kg.m^2"}
+         "xc": "rad", "n_slip": "1", "r": "m", "b": "m", "J": "kg.m^2", "grouser_height": "m", "grouser_count": "1"}
 
 #: The closed range [min, max] (SI; None: unbounded) of every Soil and Wheel field: the FMUs'
 #: min/max (the Modelica records declare them, tests/test_parameters.py keeps the two equal), and
@@ -70,7 +86,8 @@ RANGES: dict[str, tuple[float | None, float | None]] = {
     "c": (0.0, None), "phi": (0.0, math.pi / 2), "kc": (0.0, None), "kphi": (0.0, None), "n": (0.0, None),
     "kx": (0.0, None), "a0": (0.0, 1.0), "a1": (0.0, 1.0), "lam": (0.0, 1.0), "kx_beta": (0.0, None),
     "ky": (0.0, None), "ky_beta": (0.0, None), "rho": (0.0, None), "gravity": (0.0, None),
-    "xc": (0.0, math.pi / 2), "r": (0.0, None), "b": (0.0, None), "J": (0.0, None)}
+    "xc": (0.0, math.pi / 2), "n_slip": (0.0, None), "r": (0.0, None), "b": (0.0, None), "J": (0.0, None),
+    "grouser_height": (0.0, None), "grouser_count": (0.0, 360.0)}
 
 #: The value of ``Soil.xc`` that stands for "from φ": 45° - φ/2 (a NaN, replaced on construction).
 XC_FROM_PHI = float("nan")
@@ -107,6 +124,10 @@ class Soil:
             :data:`XC_FROM_PHI`), Hegedus's 45° - φ/2, from the soil's own φ (26.4° for Table 2's
             37.2°). ``dataclasses.replace(soil, phi=...)`` keeps the xc it had; ``library.vary``
             and a soil table without xc derive it anew.
+        n_slip: slip-sinkage: growth of the sinkage exponent with the slip ratio [1], n + n_slip |κ|
+            (Ding, Gao, Deng et al., J. Terramechanics 48, 2011: n = n0 + n1 s, fitted on their
+            single-wheel tests). 0 (default): the paper's soil, whose sinkage exponent does not
+            depend on slip.
 
     The accepted ranges keep the contact patch well defined for every slip in [-1, 1]:
     0 < a0 - a1 and a0 + a1 < 1 put the maximum-stress angle strictly between the exit and
@@ -128,6 +149,7 @@ class Soil:
     rho: float = 1.6e3
     gravity: float = 1.62
     xc: float = float("nan")  # XC_FROM_PHI: 45 deg - phi/2, set in __post_init__
+    n_slip: float = 0.0
 
     def __post_init__(self) -> None:
         if isinstance(self.xc, float) and math.isnan(self.xc) and isinstance(self.phi, (int, float)):
@@ -149,6 +171,7 @@ class Soil:
         _check("rho", self.rho, self.rho >= 0, "rho >= 0 kg/m³")
         _check("gravity", self.gravity, self.gravity >= 0, "gravity >= 0 m/s²")
         _check("xc", self.xc, 0 < self.xc < math.pi / 2, "0 < xc < pi/2 rad")
+        _check("n_slip", self.n_slip, self.n_slip >= 0, "n_slip >= 0 (the sinkage exponent grows with slip)")
 
     @classmethod
     def from_degrees(cls, phi_deg: float, **others: float) -> Soil:
@@ -178,6 +201,11 @@ class Soil:
             raise ValueError(f"share = {share!r}: expected a share of the other soil in [0, 1]")
         keep = 1.0 - share
         return Soil(**{f.name: keep * getattr(self, f.name) + share * getattr(other, f.name) for f in fields(self)})
+
+    def sinkage_exponent(self, slip: ArrayLike) -> FloatArray:
+        """The sinkage exponent at the slip ratio κ [-]: n + n_slip |κ| [1] (slip-sinkage, Ding et al.
+        2011); n itself where n_slip is 0."""
+        return self.n + self.n_slip * np.abs(np.asarray(slip, dtype=float))
 
     def bekker_modulus(self, b: float) -> float:
         """k = kc / b + kphi [N/m^(n+2)], the Bekker pressure-sinkage modulus for width b [m]."""

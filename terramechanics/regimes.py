@@ -105,11 +105,12 @@ def static_shear(slip_velocity: ArrayLike, strength: ArrayLike, v_stick: float) 
 
 
 def wheel_forces(load: ArrayLike, omega: ArrayLike, v: ArrayLike, wheel: Wheel = Wheel(), soil: Soil = Soil(),
-                 regimes: Regimes = Regimes(), v_lateral: ArrayLike = 0.0) -> WheelForces:
+                 regimes: Regimes = Regimes(), v_lateral: ArrayLike = 0.0, rut_depth: ArrayLike = 0.0) -> WheelForces:
     """Contact of a wheel with spin ω [rad/s], hub speed v [m/s] along its heading and v_lateral
     [m/s] to its left, under load W [N] (> 0), in any regime; vectorized over broadcastable
     arguments. See the module docstring; the lateral force is terramechanics.lateral's, mirrored
-    and blended into the static regime like Fx (static lateral hold -F_max tanh(v_y/v_stick))."""
+    and blended into the static regime like Fx (static lateral hold -F_max tanh(v_y/v_stick)).
+    ``rut_depth`` [m]: the rut the wheel rolls in (``wheel_state``); the sinkage is the total."""
     w = checked_array("load", load, 0.0, math.inf, "N", low_open=True)
     omega = checked_array("omega", omega, -math.inf, math.inf, "rad/s")
     v = checked_array("v", v, -math.inf, math.inf, "m/s")
@@ -119,8 +120,8 @@ def wheel_forces(load: ArrayLike, omega: ArrayLike, v: ArrayLike, wheel: Wheel =
     slip = slip_ratio(r_omega, v, regimes.v_eps)
     direction = travel_direction(r_omega, v)
     angle = slip_angle(r_omega, v, v_y, regimes.v_eps)
-    steady = wheel_state(w, direction * slip, wheel, soil, slip_angle=angle)
-    strength = shear_strength(w, steady.sinkage, wheel, soil)
+    steady = wheel_state(w, direction * slip, wheel, soil, slip_angle=angle, rut_depth=rut_depth)
+    strength = shear_strength(w, steady.sinkage - steady.rut_depth, wheel, soil)
     hold = static_shear(r_omega - v, strength, regimes.v_stick)
     beta = steady_weight(v, regimes.v_hold)
     fx = beta * direction * steady.Fx + (1.0 - beta) * hold

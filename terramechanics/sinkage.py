@@ -35,7 +35,7 @@ class WheelState:
 
     load: FloatArray  #: vertical load W [N]
     slip: FloatArray  #: slip ratio κ [-]
-    sinkage: FloatArray  #: sinkage h [m]
+    sinkage: FloatArray  #: sinkage h [m] below the undisturbed surface (the rut's depth included)
     Fx: FloatArray  #: longitudinal force [N], Eq. (12)
     Fz: FloatArray  #: vertical force [N], Eq. (11), equal to the load
     Tx: FloatArray  #: resistance torque [N·m], Eq. (13)
@@ -45,12 +45,13 @@ class WheelState:
     entry_angle: FloatArray  #: θf [rad], Eq. (1)
     exit_angle: FloatArray  #: θr [rad], Eq. (2), negative
     max_stress_angle: FloatArray  #: θm [rad], Eq. (3)
+    rut_depth: FloatArray  #: depth of the rut the wheel rolls in [m] (0: virgin soil); the angles are its patch's
 
     #: The table columns of each field, with their units (to_frame).
     COLUMNS = {"load": "load_N", "slip": "slip", "sinkage": "sinkage_m", "Fx": "Fx_N", "Fz": "Fz_N", "Tx": "Tx_Nm",
                "Fy": "Fy_N", "Fy_sidewall": "Fy_sidewall_N", "slip_angle": "slip_angle_rad",
                "entry_angle": "entry_angle_rad", "exit_angle": "exit_angle_rad",
-               "max_stress_angle": "max_stress_angle_rad"}
+               "max_stress_angle": "max_stress_angle_rad", "rut_depth": "rut_depth_m"}
 
     def to_frame(self) -> Any:
         """The state as a pandas DataFrame, one row per element (flattened), the columns named with
@@ -117,9 +118,10 @@ def _initial_guess(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
 
 
 def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
-                  rtol: float, nodes: int, slip_angle: FloatArray | None = None) -> tuple[FloatArray, ContactForces]:
+                  rtol: float, nodes: int, slip_angle: FloatArray | None = None,
+                  rut: FloatArray | None = None) -> tuple[FloatArray, ContactForces]:
     """Sinkage h [m] with |Fz(h, κ)/W - 1| <= rtol, and the contact forces there, for checked
-    1-D arrays ``load`` and ``slip``.
+    1-D arrays ``load`` and ``slip``; ``rut`` (None: no rut) the rut's depth [m], h then below its floor.
 
     Iterates on x = log h with the residual f = log Fz - log W: the first step is Newton's with
     an estimated slope d log Fz / d log h (see _initial_guess), later steps are secant steps;
@@ -132,7 +134,9 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
     upper = np.full(load.shape, math.log(wheel.r))
     lateral = slip_angle is not None and bool(np.any(slip_angle != 0.0))
     beta = slip_angle if lateral else None
-    x, slope = _initial_guess(load, slip, wheel, soil, nodes, lateral)
+    rutted = rut is not None and bool(np.any(rut != 0.0))
+    ruts = rut if rutted else None
+    x, slope = _initial_guess(load, slip, wheel, soil, nodes, lateral or rutted)
     x = np.clip(x, lower, upper)
     x_prev = np.full(load.shape, np.nan)
     f_prev = np.full(load.shape, np.nan)
@@ -144,7 +148,7 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
             break
         xa = x[active]
         forces = contact_integrals(np.exp(xa), slip[active], wheel, soil, nodes,
-                                   None if beta is None else beta[active])
+                                   None if beta is None else beta[active], None if ruts is None else ruts[active])
         with np.errstate(divide="ignore", invalid="ignore"):
             log_fz = np.where(forces.Fz > 0, np.log(np.maximum(forces.Fz, 1e-300)), -np.inf)
         fa = log_fz - log_load[active]
@@ -162,13 +166,14 @@ def solve_sinkage(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil,
         x[active] = np.where(done, xa, step)
         active = active[~done]
     if active.size:
-        _raise_unsolved(load[active], slip[active], wheel, soil, nodes, None if beta is None else beta[active])
+        _raise_unsolved(load[active], slip[active], wheel, soil, nodes, None if beta is None else beta[active],
+                        None if ruts is None else ruts[active])
     return np.exp(x), out
 
 
 def _raise_unsolved(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil, nodes: int,
-                    beta: FloatArray | None) -> None:
-    capacity = contact_integrals(np.full(load.shape, wheel.r), slip, wheel, soil, nodes, beta).Fz
+                    beta: FloatArray | None, rut: FloatArray | None = None) -> None:
+    capacity = contact_integrals(np.full(load.shape, wheel.r), slip, wheel, soil, nodes, beta, rut).Fz
     too_heavy = load > capacity
     if too_heavy.any():
         i = int(np.argmax(too_heavy))
@@ -182,7 +187,7 @@ def _raise_unsolved(load: FloatArray, slip: FloatArray, wheel: Wheel, soil: Soil
 
 def wheel_state(
     load: ArrayLike, slip: ArrayLike, wheel: Wheel = Wheel(), soil: Soil = Soil(), *,
-    rtol: float = 1e-10, nodes: int = DEFAULT_NODES, slip_angle: ArrayLike = 0.0,
+    rtol: float = 1e-10, nodes: int = DEFAULT_NODES, slip_angle: ArrayLike = 0.0, rut_depth: ArrayLike = 0.0,
 ) -> WheelState:
     """The wheel in equilibrium: sinkage h solving Fz(h, κ) = W, and the forces there.
 
@@ -195,6 +200,11 @@ def wheel_state(
         nodes: Gauss-Legendre nodes per piece of the contact patch.
         slip_angle: slip angle β [rad], each in (-π/2, π/2); broadcasts. At 0 every output is
             the paper's, bit for bit, and Fy = 0.
+        rut_depth: depth z_r [m] >= 0 of the rut a previous wheel left where this one rolls
+            (multi-pass, :mod:`terramechanics.multipass`); broadcasts. The wheel sinks below the
+            rut's floor into soil that already carried the pressure of depth z_r; ``sinkage`` is
+            the total below the undisturbed surface. At 0 every output is the virgin soil's, bit
+            for bit.
     """
     if not (isinstance(rtol, (int, float)) and 1e-15 <= rtol <= 1e-2):
         raise ValueError(f"rtol={rtol!r}: expected a number in [1e-15, 1e-2]")
@@ -204,20 +214,21 @@ def wheel_state(
     beta = checked_array("slip_angle", slip_angle, -math.pi / 2, math.pi / 2, "rad", low_open=True)
     if np.any(np.abs(beta) >= math.pi / 2):
         raise ValueError(f"slip_angle={float(np.max(np.abs(beta)))!r} rad: expected |slip_angle| < pi/2")
-    w, kappa, beta = np.broadcast_arrays(w, kappa, beta)
+    rut = checked_array("rut_depth", rut_depth, 0.0, wheel.r, "m")
+    w, kappa, beta, rut = np.broadcast_arrays(w, kappa, beta, rut)
     shape = w.shape
-    w, kappa, beta = w.ravel().copy(), kappa.ravel().copy(), beta.ravel().copy()
+    w, kappa, beta, rut = w.ravel().copy(), kappa.ravel().copy(), beta.ravel().copy(), rut.ravel().copy()
 
-    h, forces = solve_sinkage(w, kappa, wheel, soil, rtol, nodes, beta)
+    h, forces = solve_sinkage(w, kappa, wheel, soil, rtol, nodes, beta, rut)
     theta_f = entry_angle(h, wheel)
 
     def shaped(a: FloatArray) -> FloatArray:
         return a.reshape(shape)
 
     return WheelState(
-        load=shaped(w), slip=shaped(kappa), sinkage=shaped(h),
+        load=shaped(w), slip=shaped(kappa), sinkage=shaped(h + rut),
         Fx=shaped(forces.Fx), Fz=shaped(forces.Fz), Tx=shaped(forces.Tx),
         Fy=shaped(forces.Fy), Fy_sidewall=shaped(forces.Fy_sidewall), slip_angle=shaped(beta),
         entry_angle=shaped(theta_f), exit_angle=shaped(exit_angle(h, wheel, soil)),
-        max_stress_angle=shaped(max_stress_angle(theta_f, kappa, soil)),
+        max_stress_angle=shaped(max_stress_angle(theta_f, kappa, soil)), rut_depth=shaped(rut),
     )

@@ -83,7 +83,7 @@ def test_fmu_metadata_carries_ranges_display_units_and_its_documentation(fmus, n
     names = {v.name: v for v in md.modelVariables}
     prefix = next(p for p in ("soil.", "rover.soil.", "wheel1.soil.") if f"{p}c" in names)
     for field, (low, high) in RANGES.items():
-        kind = "wheel." if field in ("r", "b", "J") else "soil."
+        kind = "wheel." if field in ("r", "b", "J", "grouser_height", "grouser_count") else "soil."
         variable = names[prefix.replace("soil.", kind) + MODELICA_NAMES.get(field, field)]
         declared = tuple(None if b is None else float(b) for b in (variable.min, variable.max))  # FMPy keeps text
         assert declared == (low, high), variable.name
@@ -104,12 +104,14 @@ def test_model_description_interfaces_match_the_users_guide(fmus):
     outputs = {n for n, v in single.items() if v.causality == "output"}
     assert {"Fx", "Fz", "Tx", "slip", "sinkage", "omega", "v"} <= outputs
     wheel = variables(fmus["Wheel"])
-    assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub", "v_lat", "soilShare"}
+    assert {n for n, v in wheel.items() if v.causality == "input"} == {"tau", "W", "v_hub", "v_lat", "soilShare",
+                                                                       "rutDepth"}
     body = variables(fmus["RoverBody"])
     assert {f"Fx[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "input"}
     assert {f"W[{i}]" for i in range(1, 7)} <= {n for n, v in body.items() if v.causality == "output"}
     rover = variables(fmus["Rover"])
-    assert {f"tau[{i}]" for i in range(1, 7)} == {n for n, v in rover.items() if v.causality == "input"}
+    assert ({f"tau[{i}]" for i in range(1, 7)} | {f"rutDepth[{i}]" for i in range(1, 7)}
+            == {n for n, v in rover.items() if v.causality == "input"})
 
 
 @pytest.mark.parametrize("name", build.FMU_MODELS)

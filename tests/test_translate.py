@@ -52,10 +52,10 @@ def test_open_loop_rover_ode_matches_rumocas_simulation():
 
 
 @pytest.mark.parametrize("name, inputs", [
-    ("SingleWheel", ["tau", "trackAngle"]),
-    ("Wheel", ["tau", "W", "v_hub", "v_lat", "soilShare"]),
+    ("SingleWheel", ["tau", "rutDepth", "trackAngle"]),
+    ("Wheel", ["tau", "W", "v_hub", "v_lat", "soilShare", "rutDepth"]),
     ("RoverBody", [f"Fx[{i}]" for i in range(1, 7)] + [f"tau[{i}]" for i in range(1, 7)]),
-    ("Rover", [f"tau[{i}]" for i in range(1, 7)]),
+    ("Rover", [f"tau[{i}]" for i in range(1, 7)] + [f"rutDepth[{i}]" for i in range(1, 7)]),
 ])
 def test_fmu_models_translate_with_their_interfaces(name: str, inputs: list[str]):
     ode = translate(source.load(source.fmu_class(name)), name)
@@ -146,6 +146,20 @@ def test_unsupported_constructs_get_a_clear_error_naming_the_source_line(case: s
     assert "Bad.mo:" in message
 
 
+def test_an_unsupported_construct_survives_the_trip_from_a_build_worker():
+    """A parallel build's worker hands its exception to the parent pickled: an UnsupportedConstruct
+    must come back whole (it came back as a broken pool, "a process in the process pool was
+    terminated abruptly", which named nothing)."""
+    import pickle
+
+    from rover_cosim.fmubuild.expressions import UnsupportedConstruct
+
+    error = UnsupportedConstruct("an input the solver lacks comes first", "contactResidual")
+    copy = pickle.loads(pickle.dumps(error))
+    assert type(copy) is UnsupportedConstruct and str(copy) == str(error)
+    assert (copy.what, copy.where) == (error.what, error.where)
+
+
 if __name__ == "__main__":  # `python tests/test_translate.py NAME...`: pin the variables of new FMUs
     import sys
 
@@ -157,3 +171,4 @@ if __name__ == "__main__":  # `python tests/test_translate.py NAME...`: pin the 
     pins = [f"  {json.dumps(name)}: [\n" + ",\n".join(f"    {json.dumps(v)}" for v in variables) + "\n  ]"
             for name, variables in FMU_VARIABLES.items()]
     (Path(__file__).parent / "fmu_variables.json").write_text("{\n" + ",\n".join(pins) + "\n}\n")
+

@@ -24,8 +24,9 @@ equation
       kphi=(1 - soilShare)*soil.kphi + soilShare*soilB.kphi, n=(1 - soilShare)*soil.n + soilShare*soilB.n, kx=(1 - soilShare)*soil.kx + soilShare*soilB.kx,
       a0=(1 - soilShare)*soil.a0 + soilShare*soilB.a0, a1=(1 - soilShare)*soil.a1 + soilShare*soilB.a1, lam=(1 - soilShare)*soil.lam + soilShare*soilB.lam,
       kxBeta=(1 - soilShare)*soil.kxBeta + soilShare*soilB.kxBeta, ky=(1 - soilShare)*soil.ky + soilShare*soilB.ky, kyBeta=(1 - soilShare)*soil.kyBeta + soilShare*soilB.kyBeta,
-      rho=(1 - soilShare)*soil.rho + soilShare*soilB.rho, gravity=(1 - soilShare)*soil.gravity + soilShare*soilB.gravity, xc=(1 - soilShare)*soil.xc + soilShare*soilB.xc),
-    wheel, vEps, vHold, vStick, nNodes, nIterations, v_lat, logSinkageStart, slopeStart);
+      rho=(1 - soilShare)*soil.rho + soilShare*soilB.rho, gravity=(1 - soilShare)*soil.gravity + soilShare*soilB.gravity, xc=(1 - soilShare)*soil.xc + soilShare*soilB.xc,
+      nSlip=(1 - soilShare)*soil.nSlip + soilShare*soilB.nSlip),
+    wheel, vEps, vHold, vStick, nNodes, nIterations, v_lat, logSinkageStart, slopeStart, rutDepth);
   wheel.J*der(omega) = tau - Tx;
   assert(soil.c >= 0, "soil.c: the cohesion must be >= 0 Pa");
   assert(soil.phi > 0 and soil.phi < 1.5707963267948966, "soil.phi: the internal friction angle must be in (0, pi/2) rad");
@@ -57,10 +58,15 @@ equation
   assert(soilB.rho >= 0, "soilB.rho: the dry density must be >= 0 kg/m3");
   assert(soilB.gravity >= 0, "soilB.gravity: must be >= 0 m/s2");
   assert(soilB.xc >= 0 and soilB.xc < 1.5707963267948966, "soilB.xc: the destructive angle must be in (0, pi/2) rad, or 0 for 45 deg - phi/2");
+  assert(soil.nSlip >= 0, "soil.nSlip: the slip-sinkage growth of the exponent must be >= 0");
+  assert(soilB.nSlip >= 0, "soilB.nSlip: the slip-sinkage growth of the exponent must be >= 0");
   assert(noEvent(soilShare >= 0 and soilShare <= 1), "soilShare: the share of the second soil must be in [0, 1]");
+  assert(noEvent(rutDepth >= 0 and rutDepth <= wheel.r), "rutDepth: the rut's depth must be in [0, wheel.r] m");
   assert(wheel.r > 0, "wheel.r: the radius must be > 0 m");
   assert(wheel.b > 0, "wheel.b: the width must be > 0 m");
   assert(wheel.J > 0, "wheel.J: the spin inertia must be > 0 kg.m2");
+  assert(wheel.grouserHeight >= 0 and wheel.grouserHeight <= wheel.r/2, "wheel.grouserHeight: must be in [0, r/2] m");
+  assert(wheel.grouserCount >= 0 and wheel.grouserCount <= 360 and wheel.grouserCount == floor(wheel.grouserCount), "wheel.grouserCount: must be a whole number in [0, 360]");
   assert(vEps > 0, "vEps: must be a speed > 0 m/s");
   assert(vHold > 0, "vHold: must be a speed > 0 m/s");
   assert(vStick > 0, "vStick: must be a speed > 0 m/s");

@@ -4,6 +4,7 @@ model RoverOpenLoop "Open-loop run of the monolithic rover: all six wheels drive
 equation
   for i in 1:6 loop
     rover.tau[i] = openLoopTorque(time);
+    rover.rutDepth[i] = 0 "virgin soil";
   end for;
   annotation (
     experiment(StartTime=0, StopTime=6, Interval=0.01, Tolerance=1e-8),

@@ -21,12 +21,12 @@ equation
   // The connections of the co-simulated rover, one wheel instance per FMU instance:
   // body.W[i] -> wheel_i.W, body.v_hub[i] -> wheel_i.v_hub, wheel_i.Fx -> body.Fx[i],
   // tau[i] -> wheel_i.tau and body.tau[i].
-  wheel1.W = body.W[1]; wheel1.v_hub = body.v_hub[1]; wheel1.v_lat = 0; wheel1.soilShare = 0; body.Fx[1] = wheel1.Fx; wheel1.tau = tau[1]; body.tau[1] = tau[1];
-  wheel2.W = body.W[2]; wheel2.v_hub = body.v_hub[2]; wheel2.v_lat = 0; wheel2.soilShare = 0; body.Fx[2] = wheel2.Fx; wheel2.tau = tau[2]; body.tau[2] = tau[2];
-  wheel3.W = body.W[3]; wheel3.v_hub = body.v_hub[3]; wheel3.v_lat = 0; wheel3.soilShare = 0; body.Fx[3] = wheel3.Fx; wheel3.tau = tau[3]; body.tau[3] = tau[3];
-  wheel4.W = body.W[4]; wheel4.v_hub = body.v_hub[4]; wheel4.v_lat = 0; wheel4.soilShare = 0; body.Fx[4] = wheel4.Fx; wheel4.tau = tau[4]; body.tau[4] = tau[4];
-  wheel5.W = body.W[5]; wheel5.v_hub = body.v_hub[5]; wheel5.v_lat = 0; wheel5.soilShare = 0; body.Fx[5] = wheel5.Fx; wheel5.tau = tau[5]; body.tau[5] = tau[5];
-  wheel6.W = body.W[6]; wheel6.v_hub = body.v_hub[6]; wheel6.v_lat = 0; wheel6.soilShare = 0; body.Fx[6] = wheel6.Fx; wheel6.tau = tau[6]; body.tau[6] = tau[6];
+  wheel1.W = body.W[1]; wheel1.v_hub = body.v_hub[1]; wheel1.v_lat = 0; wheel1.soilShare = 0; wheel1.rutDepth = 0; body.Fx[1] = wheel1.Fx; wheel1.tau = tau[1]; body.tau[1] = tau[1];
+  wheel2.W = body.W[2]; wheel2.v_hub = body.v_hub[2]; wheel2.v_lat = 0; wheel2.soilShare = 0; wheel2.rutDepth = 0; body.Fx[2] = wheel2.Fx; wheel2.tau = tau[2]; body.tau[2] = tau[2];
+  wheel3.W = body.W[3]; wheel3.v_hub = body.v_hub[3]; wheel3.v_lat = 0; wheel3.soilShare = 0; wheel3.rutDepth = 0; body.Fx[3] = wheel3.Fx; wheel3.tau = tau[3]; body.tau[3] = tau[3];
+  wheel4.W = body.W[4]; wheel4.v_hub = body.v_hub[4]; wheel4.v_lat = 0; wheel4.soilShare = 0; wheel4.rutDepth = 0; body.Fx[4] = wheel4.Fx; wheel4.tau = tau[4]; body.tau[4] = tau[4];
+  wheel5.W = body.W[5]; wheel5.v_hub = body.v_hub[5]; wheel5.v_lat = 0; wheel5.soilShare = 0; wheel5.rutDepth = 0; body.Fx[5] = wheel5.Fx; wheel5.tau = tau[5]; body.tau[5] = tau[5];
+  wheel6.W = body.W[6]; wheel6.v_hub = body.v_hub[6]; wheel6.v_lat = 0; wheel6.soilShare = 0; wheel6.rutDepth = 0; body.Fx[6] = wheel6.Fx; wheel6.tau = tau[6]; body.tau[6] = tau[6];
   Fz = {wheel1.Fz, wheel2.Fz, wheel3.Fz, wheel4.Fz, wheel5.Fz, wheel6.Fz};
   Fx = {wheel1.Fx, wheel2.Fx, wheel3.Fx, wheel4.Fx, wheel5.Fx, wheel6.Fx};
   Tx = {wheel1.Tx, wheel2.Tx, wheel3.Tx, wheel4.Tx, wheel5.Tx, wheel6.Tx};

@@ -7,6 +7,7 @@ model SingleWheelStep "Torque step at t = 0 on the single-wheel test bed, wheel 
 equation
   testBed.tau = tauStep;
   testBed.trackAngle = 0;
+  testBed.rutDepth = 0;
   annotation (
     experiment(StartTime=0, StopTime=4, Interval=0.01, Tolerance=1e-8),
     Documentation(info="<html>

@@ -13,6 +13,7 @@ equation
   rover.groundGradientAlong = zeros(6);
   rover.groundGradientLateral = zeros(6);
   rover.soilShare = zeros(6);
+  rover.rutDepth = zeros(6);
   annotation (
     experiment(StartTime=0, StopTime=10, Interval=0.01, Tolerance=1e-6),
     Documentation(info="<html>

@@ -21,6 +21,7 @@ model LegWheelRover "Leg-wheel rover: the body on six limbs of six joint servos 
   input Real ankleRoll[6](each unit="rad", start = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}) "Set-points of the ankle roll joints (start: the paper's posture)";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel";
   input Real soilShare[6](each unit="1", each min=0, each max=1, each start=0) "Share of the second soil (soilB) in the soil under each wheel, from a soil map (0: soil)";
+  input Real rutDepth[6](each unit="m", each min=0, each start=0) "Depth of the rut a previous wheel left under each wheel, from a rut participant (0: virgin soil)";
   output Real hipYawAngle[6](each unit="rad") "Angle of each limb's hip yaw joint, deflected by the load";
   output Real hipPitchAngle[6](each unit="rad") "Angle of each limb's hip pitch joint, deflected by the load";
   output Real kneePitchAngle[6](each unit="rad") "Angle of each limb's knee pitch joint, deflected by the load";
@@ -88,6 +89,7 @@ equation
     wheels[i].v_hub = body.v_hub[i];
     wheels[i].v_lat = body.v_lat[i];
     wheels[i].soilShare = soilShare[i];
+    wheels[i].rutDepth = rutDepth[i];
     body.Fx[i] = wheels[i].Fx;
     body.Fy[i] = wheels[i].Fy;
     body.tau[i] = tau[i];

@@ -10,6 +10,7 @@ model Rover "ATHLETE-like six-limb rover in the pitch plane with six terramechan
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
+  input Real rutDepth[nWheels](each unit="m", each min=0, each start=0) "Depth of the rut a previous wheel left under each wheel, from a rut participant (0: virgin soil)";
   RoverTerramechanics.Components.Chassis body(rover=rover, slope=slope) "Body and limbs";
   RoverTerramechanics.Components.RigidWheel wheels[nWheels](each soil=soil, each soilB=soil, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
@@ -19,6 +20,7 @@ equation
     wheels[i].v_hub = body.v_hub[i];
     wheels[i].v_lat = 0 "pitch-plane rover: no sideways motion";
     wheels[i].soilShare = 0 "one soil under every wheel";
+    wheels[i].rutDepth = rutDepth[i];
     body.Fx[i] = wheels[i].Fx;
     body.tau[i] = tau[i];
     Fz[i] = wheels[i].Fz;

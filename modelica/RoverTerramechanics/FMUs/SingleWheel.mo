@@ -12,6 +12,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   parameter Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
   input Real tau(unit="N.m") "Drive torque";
+  input Real rutDepth(unit="m", min=0, start=0) "Depth of the rut a previous pass left (repeated passes on the test bed; 0: virgin soil)";
   input Real trackAngle(unit="rad", start=0) "Turn of the carriage's track during a run, added to slipAngle (optional input, 0 when not driven)";
   output Real Fx(unit="N") "Longitudinal force, Eq. (12) when rolling";
   output Real Fz(unit="N") "Vertical force, Eq. (11): the load normal to the ground, W cos(slope)";
@@ -28,6 +29,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
 equation
   rigidWheel.tau = tau;
   rigidWheel.soilShare = 0 "one soil under the test bed";
+  rigidWheel.rutDepth = rutDepth;
   rigidWheel.W = W*cos(slope);
   beta = slipAngle + trackAngle;
   rigidWheel.v_hub = v*cos(beta);

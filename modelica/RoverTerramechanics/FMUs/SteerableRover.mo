@@ -14,6 +14,7 @@ model SteerableRover "ATHLETE-like six-limb rover moving in the plane, every whe
   input Real tau[nWheels](each unit="N.m") "Drive torque of each wheel";
   input Real steer[nWheels](each unit="rad") "Steering angle of each wheel, positive to the left";
   input Real soilShare[nWheels](each unit="1", each min=0, each max=1, each start=0) "Share of the second soil (soilB) in the soil under each wheel, from a soil map (0: soil)";
+  input Real rutDepth[nWheels](each unit="m", each min=0, each start=0) "Depth of the rut a previous wheel left under each wheel, from a rut participant (0: virgin soil)";
   output Real x(unit="m") "Position of the centre of gravity along the ground's x axis (world x on level ground)";
   output Real y(unit="m") "Position of the centre of gravity along the ground's y axis (world y on level ground)";
   output Real yaw(unit="rad") "Heading against the ground's x axis, positive to the left";
@@ -39,6 +40,7 @@ equation
     wheels[i].v_hub = body.v_hub[i];
     wheels[i].v_lat = body.v_lat[i];
     wheels[i].soilShare = soilShare[i];
+    wheels[i].rutDepth = rutDepth[i];
     body.Fx[i] = wheels[i].Fx;
     body.Fy[i] = wheels[i].Fy;
     body.tau[i] = tau[i];

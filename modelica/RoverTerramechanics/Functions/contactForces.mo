@@ -7,6 +7,7 @@ function contactForces "Contact forces Fx, Fz and torque Tx of a rigid wheel at 
   input Integer nNodes = 16 "Gauss-Legendre nodes on each side of thetaM";
   input Real slipAngle(unit="rad") = 0 "Slip angle beta of the hub velocity (Ishigami et al. 2007), |beta| < pi/2";
   input Boolean lateralAtZero = false "true: evaluate the lateral terms at beta = 0 too (they are 0 there, their derivative is not)";
+  input Real rutDepth(unit="m") = 0 "Depth of the rut a previous wheel left (multi-pass); h is then the sinkage below its floor";
   output Real Fx(unit="N") "Longitudinal force (drawbar pull), Eq. (12)";
   output Real Fz(unit="N") "Vertical force, Eq. (11)";
   output Real Tx(unit="N.m") "Resistance torque about the axle, Eq. (13)";
@@ -38,6 +39,12 @@ protected
   Real d1(unit="1") "Hegedus D1";
   Real d2(unit="1") "Hegedus D2";
   Real xc(unit="rad") "Destructive angle: soil.xc, or 45 deg - phi/2 where soil.xc is 0";
+  Real exponent(unit="1") "Sinkage exponent at this slip: n + nSlip*|slip| (slip-sinkage)";
+  Real engagement(unit="1") "Mean number of grousers in the patch, at most 1";
+  Real radius(unit="m") "Shear radius r + engagement*grouserHeight";
+  Real ratio(unit="1") "radius/r";
+  Real scaleForce(unit="1") "Weight of the shear stress in Eqs. (11)-(12): ratio*(1 + 2 engagement grouserHeight/b)";
+  Real scaleTorque(unit="1") "Weight of the shear stress in Eq. (13): scaleForce*ratio";
 algorithm
   kx := soil.kx + soil.kxBeta*noEvent(abs(slipAngle));
   ky := soil.ky + soil.kyBeta*noEvent(abs(slipAngle));
@@ -52,6 +59,12 @@ algorithm
   thetaF := acos(1 - hc/wheel.r);
   thetaR := -acos(1 - soil.lam*hc/wheel.r);
   thetaM := (soil.a0 + soil.a1*slip)*thetaF;
+  exponent := soil.n + soil.nSlip*noEvent(abs(slip));
+  engagement := noEvent(min(1.0, wheel.grouserCount*(thetaF - thetaR)/(2*3.141592653589793)));
+  radius := wheel.r + engagement*wheel.grouserHeight;
+  ratio := radius/wheel.r;
+  scaleForce := ratio*(1 + 2*engagement*wheel.grouserHeight/wheel.b);
+  scaleTorque := scaleForce*ratio;
   dFront := thetaF - thetaM;
   dRear := thetaM - thetaR;
   Fx := 0;
@@ -65,11 +78,11 @@ algorithm
     ds := 2*u*w;
     // Front piece [thetaM, thetaF], Eq. (5), nodes crowding at thetaF.
     theta := thetaF - dFront*s;
-    sigma := normalStress(theta, thetaF, soil, wheel);
-    tau := shearStress(sigma, theta, thetaF, slip, soil, wheel, kx);
-    Fz := Fz + ds*dFront*(sigma*cos(theta) + tau*sin(theta));
-    Fx := Fx + ds*dFront*(tau*cos(theta) - sigma*sin(theta));
-    Tx := Tx + ds*dFront*tau;
+    sigma := normalStress(theta, thetaF, soil, wheel, exponent, rutDepth);
+    tau := shearStress(sigma, theta, thetaF, slip, soil, wheel, kx, radius);
+    Fz := Fz + ds*dFront*(sigma*cos(theta) + tau*scaleForce*sin(theta));
+    Fx := Fx + ds*dFront*(tau*scaleForce*cos(theta) - sigma*sin(theta));
+    Tx := Tx + ds*dFront*(tau*scaleForce*ratio);
     if lateralAtZero or noEvent(tanBeta <> 0) then
       // Lateral shear and sidewall: both vanish at beta = 0 (zero displacement), not computed then.
       sumFy := sumFy + ds*dFront*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
@@ -80,10 +93,10 @@ algorithm
     // angle of this node, thetaF - (theta - thetaR)/dRear*dFront, is the front node's, so the
     // normal stress is the one just computed.
     theta := thetaR + dRear*s;
-    tau := shearStress(sigma, theta, thetaF, slip, soil, wheel, kx);
-    Fz := Fz + ds*dRear*(sigma*cos(theta) + tau*sin(theta));
-    Fx := Fx + ds*dRear*(tau*cos(theta) - sigma*sin(theta));
-    Tx := Tx + ds*dRear*tau;
+    tau := shearStress(sigma, theta, thetaF, slip, soil, wheel, kx, radius);
+    Fz := Fz + ds*dRear*(sigma*cos(theta) + tau*scaleForce*sin(theta));
+    Fx := Fx + ds*dRear*(tau*scaleForce*cos(theta) - sigma*sin(theta));
+    Tx := Tx + ds*dRear*(tau*scaleForce*ratio);
     if lateralAtZero or noEvent(tanBeta <> 0) then
       sumFy := sumFy + ds*dRear*lateralShear(sigma, theta, thetaF, slip, tanBeta, ky, soil, wheel);
       depth := noEvent(max(wheel.r*(cos(theta) - cos(thetaF)), 0.0));

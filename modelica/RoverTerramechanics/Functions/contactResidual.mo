@@ -8,6 +8,7 @@ function contactResidual "Residual log(Fz/W) of the sinkage equation at a given 
   input Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
   input Real WMin(unit="N") = 1e-3 "Smallest load considered (a lifted wheel)";
   input Real slipAngle(unit="rad") = 0 "Slip angle of the hub velocity (Ishigami et al. 2007)";
+  input Real rutDepth(unit="m") = 0 "Depth of the rut a previous wheel left (multi-pass); h below its floor";
   input Boolean lateralAtZero = true "Evaluate the lateral terms at beta = 0 too (see contactForces)";
   output Real residual(unit="1") "log(Fz/W); -1e3 where Fz <= 0 (a skidding wheel barely sunk)";
   output Real h(unit="m") "Sinkage, exp(logSinkage)";
@@ -18,7 +19,7 @@ function contactResidual "Residual log(Fz/W) of the sinkage equation at a given 
   output Real FySidewall(unit="N") "Sidewall part of Fy";
 algorithm
   h := exp(logSinkage);
-  (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nNodes, slipAngle, lateralAtZero);
+  (Fx, Fz, Tx, Fy, FySidewall) := contactForces(h, slip, soil, wheel, nNodes, slipAngle, lateralAtZero, rutDepth);
   residual := if noEvent(Fz > 0) then log(Fz/noEvent(max(W, WMin))) else -1e3;
   annotation (Documentation(info="<html>
 <p>One evaluation of the sinkage equation log F<sub>z</sub>(h, &kappa;) = log W of

@@ -4,12 +4,17 @@ function normalStress "Normal stress under the wheel: front branch Eq. (5) evalu
   input Real thetaF(unit="rad") "Entry angle";
   input RoverTerramechanics.Parameters.SoilParameters soil "Soil";
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
+  input Real exponent(unit="1") "Sinkage exponent: soil.n, or n + nSlip*|slip| with slip-sinkage";
+  input Real rutDepth(unit="m") = 0 "Depth of the rut a previous wheel left: the soil under its floor carried the pressure of that depth (multi-pass); thetaF measured from the floor";
   output Real sigma(unit="Pa") "Normal stress, zero outside the contact patch";
 algorithm
-  sigma := (soil.kc/wheel.b + soil.kphi)*wheel.r^soil.n*noEvent(max(cos(theta) - cos(thetaF), 0.0))^soil.n;
+  sigma := (soil.kc/wheel.b + soil.kphi)*wheel.r^exponent*(rutDepth/wheel.r + noEvent(max(cos(theta) - cos(thetaF), 0.0)))^exponent;
   annotation (Documentation(info="<html>
 <p>Eq. (5): &sigma;<sub>f</sub>(&theta;) = r<sup>n</sup> (k<sub>c</sub>/b + k<sub>&phi;</sub>)
-(cos &theta; - cos &theta;<sub>f</sub>)<sup>n</sup>. The rear branch, Eq. (6), is this function
+(cos &theta; - cos &theta;<sub>f</sub>)<sup>n</sup>. Multi-pass: in a rut of depth z<sub>r</sub> left by a
+previous wheel, r<sup>n</sup> (k<sub>c</sub>/b + k<sub>&phi;</sub>) (z<sub>r</sub>/r + cos &theta; -
+cos &theta;<sub>f</sub>)<sup>n</sup>: the soil under the rut's floor already carried the pressure of
+depth z<sub>r</sub> and is loaded on from there (Wong's repetitive loading with a rigid reload). The rear branch, Eq. (6), is this function
 at the equivalent angle &theta;<sub>f</sub> - (&theta; - &theta;<sub>r</sub>)/(&theta;<sub>m</sub>
 - &theta;<sub>r</sub>) (&theta;<sub>f</sub> - &theta;<sub>m</sub>).</p>
 </html>"));

@@ -7,11 +7,12 @@ function shearStress "Shear stress from normal stress and shear displacement, Eq
   input RoverTerramechanics.Parameters.SoilParameters soil "Soil";
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
   input Real kx(unit="m") "Shear deformation modulus (soil.kx, grown with the slip angle)";
+  input Real radius(unit="m") "Radius at which the soil is sheared: wheel.r, or the grousers' shear radius";
   output Real tau(unit="Pa") "Shear stress";
 protected
   Real j(unit="m") "Soil shear displacement, Eq. (10)";
 algorithm
-  j := wheel.r*(thetaF - theta - (1 - slip)*(sin(thetaF) - sin(theta)));
+  j := radius*(thetaF - theta - (1 - slip)*(sin(thetaF) - sin(theta)));
   tau := (soil.c + sigma*tan(soil.phi))*(if noEvent(j >= 0) then 1 - exp(-j/kx) else exp(j/kx) - 1);
   annotation (Documentation(info="<html>
 <p>Eq. (10): j<sub>x</sub> = r[&theta;<sub>f</sub> - &theta; - (1 - &kappa;)(sin &theta;<sub>f</sub>

@@ -11,6 +11,7 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   input Real slipAngle(unit="rad") = 0 "Slip angle of the hub velocity (Ishigami et al. 2007)";
   input Real logSinkageStart(unit="1") = 0 "log(h / 1 m) to start from, e.g. the previous solve's logSinkage; used only when slopeStart > 0";
   input Real slopeStart(unit="1") = 0 "> 0: warm start from logSinkageStart with this slope d log Fz / d log h for the first step (e.g. the previous solve's slope); <= 0: cold start from Bekker's sinkage";
+  input Real rutDepth(unit="m") = 0 "Depth of the rut a previous wheel left (multi-pass): h is the sinkage below its floor";
   output Real h(unit="m") "Sinkage";
   output Real Fx(unit="N") "Longitudinal force at h, Eq. (12)";
   output Real Fz(unit="N") "Vertical force at h, Eq. (11): W once converged";
@@ -64,7 +65,7 @@ algorithm
     if not done then
       logSinkage := x;
       // A skidding wheel that has barely sunk can have Fz <= 0: f = -1e3, "too shallow".
-      (f, h, Fx, Fz, Tx, Fy, FySidewall) := contactResidual(x, W, slip, soil, wheel, nNodes, WMin, slipAngle, false);
+      (f, h, Fx, Fz, Tx, Fy, FySidewall) := contactResidual(x, W, slip, soil, wheel, nNodes, WMin, slipAngle, rutDepth, false);
       evaluations := evaluations + 1;
       if noEvent(abs(f) <= tolerance) then
         done := true;

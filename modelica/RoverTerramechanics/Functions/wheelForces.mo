@@ -13,8 +13,9 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   input Real vLat(unit="m/s") = 0 "Speed of the hub to the wheel's left (lateral, in the wheel frame)";
   input Real logSinkageStart(unit="1") = 0 "Start of the sinkage solve, log(h / 1 m) (warm start: the previous logSinkage)";
   input Real slopeStart(unit="1") = 0 "> 0: warm start with this slope d log Fz / d log h (the previous contactSlope); <= 0: cold start";
+  input Real rutDepth(unit="m") = 0 "Depth of the rut a previous wheel left where this one rolls (multi-pass); 0: virgin soil";
   output Real slip(unit="1") "Slip ratio, Eq. (4)";
-  output Real h(unit="m") "Sinkage";
+  output Real h(unit="m") "Sinkage below the undisturbed surface: the rut's depth and the sinkage below its floor";
   output Real Fx(unit="N") "Longitudinal force of the soil on the wheel";
   output Real Fz(unit="N") "Vertical force of the soil on the wheel (= W)";
   output Real Tx(unit="N.m") "Resistance torque of the soil about the axle";
@@ -25,6 +26,7 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   output Real logSinkage(unit="1") "log(h / 1 m) from the sinkage solve (a start for the next solve)";
   output Real contactSlope(unit="1") "d log Fz / d log h near the sinkage (a start for the next solve)";
 protected
+  Real hFloor(unit="m") "Sinkage below the rut's floor (the undisturbed surface without a rut)";
   Real direction "+1 travelling forwards, -1 backwards";
   Real FxSteady(unit="N") "Paper's Fx of the mirrored wheel";
   Real TxSteady(unit="N.m") "Paper's Tx of the mirrored wheel";
@@ -40,10 +42,11 @@ algorithm
   slip := slipRatio(wheel.r*omega, v, vEps);
   direction := if noEvent(v > 0) then 1.0 else if noEvent(v < 0) then -1.0 else if noEvent(omega < 0) then -1.0 else 1.0;
   slipAngle := atan2(direction*vLat, noEvent(max(abs(v), vEps)));
-  (h, FxSteady, Fz, TxSteady, FySteady, FySidewall, contactEvaluations, logSinkage, contactSlope) := wheelContact(W,
-    direction*slip, soil, wheel, nNodes, nIterations, 1e-10, 1e-3, slipAngle, logSinkageStart, slopeStart);
-  thetaF := acos(1 - h/wheel.r);
-  thetaR := -acos(1 - soil.lam*h/wheel.r);
+  (hFloor, FxSteady, Fz, TxSteady, FySteady, FySidewall, contactEvaluations, logSinkage, contactSlope) := wheelContact(W,
+    direction*slip, soil, wheel, nNodes, nIterations, 1e-10, 1e-3, slipAngle, logSinkageStart, slopeStart, rutDepth);
+  h := hFloor + rutDepth;
+  thetaF := acos(1 - hFloor/wheel.r);
+  thetaR := -acos(1 - soil.lam*hFloor/wheel.r);
   entryAngle := direction*thetaF;
   strength := soil.c*wheel.b*wheel.r*(thetaF - thetaR) + noEvent(max(W, 0.0))*tan(soil.phi);
   staticShear := strength*tanh((wheel.r*omega - v)/vStick);

@@ -16,7 +16,9 @@ of mass W/g that moves freely along the ground, (W/g)&middot;dv/dt = Fx - W&midd
 with the load W&middot;cos(slope) normal to the ground on the wheel.</p>
 <ul>
 <li>inputs: <code>tau</code> [N&middot;m] drive torque; <code>trackAngle</code> [rad] (optional,
-start 0) turns the carriage's track during a run, added to <code>slipAngle</code></li>
+start 0) turns the carriage's track during a run, added to <code>slipAngle</code>;
+<code>rutDepth</code> [m] (optional, start 0) the rut a previous pass left: repeated passes of the
+test bed (multi-pass)</li>
 <li>outputs: <code>Fx</code> [N], <code>Fz</code> [N], <code>Tx</code> [N&middot;m],
 <code>Fy</code> [N] (lateral, wheel frame), <code>slip</code> [1], <code>sinkage</code> [m],
 <code>omega</code> [rad/s], <code>entryAngle</code> [rad] (signed with the direction of travel),
@@ -40,7 +42,7 @@ monolithic: <code>Components.Chassis</code> plus six <code>Components.RigidWheel
 by the limb forces. Inputs and outputs: <code>Interfaces.PitchPlaneRover</code>.</p>
 <ul>
 <li>inputs: <code>tau[1..6]</code> [N&middot;m]; limb 1 front, 2 middle, 3 rear of one side,
-4-6 mirror them</li>
+4-6 mirror them; <code>rutDepth[1..6]</code> [m]: the depth of the rut a previous wheel left under each wheel, from a rut participant (multi-pass; optional, start 0: virgin soil)</li>
 <li>outputs: <code>x</code> [m], <code>v</code> [m/s], <code>pitch</code> [rad] (nose up
 positive), and per wheel <code>Fz[i]</code> [N] (= its load), <code>Fx[i]</code> [N],
 <code>Tx[i]</code> [N&middot;m], <code>slip[i]</code> [1], <code>sinkage[i]</code> [m],
@@ -78,7 +80,8 @@ co-simulation (the wheel side of the cut: <code>Interfaces.WheelHub</code>; phys
 <li>inputs: <code>tau</code> [N&middot;m], <code>W</code> [N] load, <code>v_hub</code> [m/s] hub
 speed, <code>v_lat</code> [m/s] the hub's speed to the wheel's left (start 0, optional: a system
 may leave it unconnected), <code>soilShare</code> [1] the share of the second soil under the wheel
-(start 0, optional: from a soil map)</li>
+(start 0, optional: from a soil map), <code>rutDepth</code> [m] the depth of the rut a previous wheel
+left under it (start 0, optional: from a rut participant; multi-pass)</li>
 <li>outputs: <code>Fx</code> [N], <code>Fz</code> [N], <code>Tx</code> [N&middot;m],
 <code>Fy</code> [N], <code>slipAngle</code> [rad], <code>slip</code> [1], <code>sinkage</code>
 [m], <code>omega</code> [rad/s] (a state with a start value), <code>entryAngle</code> [rad]</li>
@@ -98,7 +101,7 @@ against the heading, positive to the left; <code>groundHeight[1..6]</code> [m], 
 <code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: a height map
 over the ground plane hub by hub (<code>Interfaces.GroundContacts</code>; optional, start 0: the
 plane itself); <code>soilShare[1..6]</code> [1]: the share of the second soil under each wheel
-(optional, start 0: <code>soil</code> everywhere)</li>
+(optional, start 0: <code>soil</code> everywhere); <code>rutDepth[1..6]</code> [m]: the depth of the rut a previous wheel left under each wheel, from a rut participant (multi-pass; optional, start 0: virgin soil)</li>
 <li>outputs: <code>x</code>, <code>y</code> [m], <code>yaw</code> [rad], <code>v</code>,
 <code>vy</code> [m/s] (CoG velocity along and to the left of the heading), <code>yawRate</code>
 [rad/s], <code>pitch</code>, <code>roll</code> [rad] (roll positive: left side up), per wheel
@@ -153,7 +156,7 @@ servo has a stiffness, a damping and a torque limit; the limb's compliance along
 normal carries the wheel's load (the load comes out of the limb, the sinkage is not fed back).</p>
 <ul>
 <li>inputs: the 36 joint set-points <code>hipYaw</code>, <code>hipPitch</code>, <code>kneePitch</code>, <code>anklePitch</code>, <code>ankleSteer</code>, <code>ankleRoll</code> [rad], six each (limbs 1-3 front, middle, rear on the left, 4-6 on the right; start: the paper's posture, hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity); <code>tau[1..6]</code> [N&middot;m] the drive torques; <code>groundHeight[1..6]</code> [m], <code>groundHeightRate[1..6]</code> [m/s], <code>groundGradientAlong[1..6]</code>, <code>groundGradientLateral[1..6]</code> [1]: the ground under each hub (<code>Interfaces.GroundContacts</code>; optional, start 0); <code>soilShare[1..6]</code>
-[1] the share of the second soil under each wheel (optional, start 0)</li>
+[1] the share of the second soil under each wheel (optional, start 0); <code>rutDepth[1..6]</code> [m]: the depth of the rut a previous wheel left under each wheel, from a rut participant (multi-pass; optional, start 0: virgin soil)</li>
 <li>outputs: joint angles <code>hipYawAngle</code>, <code>hipPitchAngle</code>, <code>kneePitchAngle</code>, <code>anklePitchAngle</code>, <code>ankleSteerAngle</code>, <code>ankleRollAngle</code> [rad] (the set-points deflected by the load), servo torques <code>hipYawTorque</code>, <code>hipPitchTorque</code>, <code>kneePitchTorque</code>, <code>anklePitchTorque</code>, <code>ankleSteerTorque</code>, <code>ankleRollTorque</code> [N&middot;m], hub positions <code>hubX</code>, <code>hubY</code>, <code>hubZ</code> [m] (body frame, from the joint angles), wheel headings <code>steer</code> [rad] (from the ankle steer joints); per wheel <code>Fz</code>, <code>Fx</code>, <code>Fy</code> [N],
 <code>Tx</code> [N&middot;m], <code>slip</code> [1], <code>slipAngle</code> [rad],
 <code>sinkage</code> [m], <code>omega</code> [rad/s]; the body's pose and velocity <code>x</code>, <code>y</code>, <code>z</code> [m] (z: the centre of gravity over the ground plane), <code>yaw</code>, <code>pitch</code>, <code>roll</code> [rad], <code>v</code>, <code>vy</code> [m/s], <code>yawRate</code> [rad/s], <code>heaveRate</code> [m/s], <code>pitchRate</code>, <code>rollRate</code> [rad/s]</li>
