@@ -18,6 +18,11 @@ from typing import Any
 from .fits import IdentifiedModel
 from .lateral import LateralModel
 
+#: Soil and wheel fields added after model files were first written, with the value those files were
+#: identified with (the field's default: a soil without slip-sinkage, a smooth wheel).
+FIELD_DEFAULTS: dict[str, dict[str, float]] = {"soil": {"n_slip": 0.0},
+                                                "wheel": {"grouser_height": 0.0, "grouser_count": 0.0}}
+
 #: Bumped when the layout of model.json changes; files without it are version 1 (the same layout).
 SCHEMA_VERSION = 1
 
@@ -66,6 +71,9 @@ class ModelSet:
                                                                                   wheel_name)):
             if known is None:
                 continue
+            # a file written before a field existed was identified with the field's default (e.g. a
+            # smooth wheel before grousers, a soil without slip-sinkage)
+            known = {**FIELD_DEFAULTS[kind], **known}
             differ = sorted(k for k in set(known) | set(given) if known.get(k) != given.get(k))
             if differ:
                 identified = self.details.get(kind, {}).get("name", "?")

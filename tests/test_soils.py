@@ -24,8 +24,8 @@ def test_every_shipped_soil_builds_and_documents_what_its_source_does_not_give(n
     assert isinstance(soil, Soil) and table["title"] and table["source"]
     given = {library.DEGREES.get(k, k) for k in table if k not in library.METADATA}
     notes = set(table.get("notes", {}))
-    # xc (45 deg - phi/2) and gravity (the scenario's) follow the file's stated rules
-    undocumented = {f.name for f in fields(Soil)} - given - notes - {"xc", "gravity"}
+    # xc (45 deg - phi/2), gravity (the scenario's) and n_slip (0: none) follow the file's stated rules
+    undocumented = {f.name for f in fields(Soil)} - given - notes - {"xc", "gravity", "n_slip"}
     assert not undocumented, f"{name}: no value and no note for {sorted(undocumented)}"
     if "xc" not in given:
         assert soil.xc == pytest.approx(math.radians(45.0) - soil.phi / 2)

@@ -23,7 +23,7 @@ from .options import (
 )
 
 #: The parts of ``simulate`` (--only), in the order they run.
-PARTS = ("straight", "path", "terrain", "legwheel")
+PARTS = ("straight", "path", "terrain", "legwheel", "effects")
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,8 +34,9 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="only the paper's straight run, only the path following, only the terrain "
                              "scenarios (side-slope traverses) or only the leg-wheel rover's (LegWheelRover.fmu: "
                              "the straight run and a 20 deg side slope with and without posture control; the "
-                             "paper's rover only); default: all four (the leg-wheel part only for the paper's "
-                             "rover)")
+                             "paper's rover only) or only the wheel effects (the straight run with grousers, "
+                             "slip-sinkage and multi-pass ruts each switched on: their ablation of Table 3); "
+                             "default: all five (the leg-wheel part only for the paper's rover)")
     parser.add_argument("--allow-model-mismatch", action="store_true",
                         help="use a model identified on another soil or wheel (refused otherwise; recorded)")
     parser.add_argument("--adapt", action="store_true",
@@ -109,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
 def _runs(args: argparse.Namespace, choice: Any, calibration: Any) -> None:
     """The runs asked for (``--only``): the paper's straight run, the path following, the terrain
     scenarios, each writing its files."""
+    from rover_cosim.jobs.effects import run_effects
     from rover_cosim.jobs.legwheel import run_legwheel
     from rover_cosim.jobs.path_following import run_path_following
     from rover_cosim.jobs.simulate import run_simulation
@@ -141,6 +143,12 @@ def _runs(args: argparse.Namespace, choice: Any, calibration: Any) -> None:
                                 progress=bar, record_interval=args.record_interval)
         bar.close()
         print_legwheel(legwheel)
+    if args.only in (None, "effects"):
+        bar = ProgressBar("simulate: grousers, slip-sinkage, multi-pass", enabled=not args.quiet)
+        effects = run_effects(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                              progress=bar)
+        bar.close()
+        print_effects(effects)
 
 
 def _print_path(outcome: Any) -> None:
@@ -151,6 +159,19 @@ def _print_path(outcome: Any) -> None:
     table["largest RMS(Fx - Fx_des) [N]"] = rms.filter(like="rms_Fx").max(axis=1)
     table["largest RMS(Fy - Fy_des) [N]"] = rms.filter(like="rms_Fy").max(axis=1)
     print(table.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    print_written(outcome.files)
+
+
+def print_effects(outcome: Any) -> None:
+    """What the wheel-effects ablation measured (jobs.effects.EffectsResult)."""
+    print("The straight run with each wheel effect on (controller and model of the smooth wheel), at cruise:")
+    table = outcome.ablation.pivot(index="wheel", columns="variant", values=["sinkage_mean_m", "rms_N"])
+    table.columns = [f"{'sinkage [mm]' if name == 'sinkage_mean_m' else 'RMS [N]'} {variant}"
+                     for name, variant in table.columns]
+    for column in table.columns:
+        if column.startswith("sinkage"):
+            table[column] = 1e3 * table[column]
+    print(table.to_string(float_format=lambda v: f"{v:.3g}"))
     print_written(outcome.files)
 
 

@@ -92,6 +92,12 @@ def _closed_loop(name: str) -> SystemBuilder:
 
 def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
     """The closed loop on Rover.fmu (``options``: the controller's keyword arguments)."""
+    return monolithic_builder(fmu_dir, model, choice, **options).build()
+
+
+def monolithic_builder(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None,
+                       **options: Any) -> SystemBuilder:
+    """monolithic_system's builder, for a caller that adds participants (e.g. a rut block) to it."""
     builder = _closed_loop("closed loop (monolithic)")
     plant = rover_fmu(fmu_dir, "Rover", choice)
     limbs = hubs(plant)
@@ -101,7 +107,7 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | No
     builder.connect("rover.x", "ctrl.x").connect("rover.v", "ctrl.v")
     for i in limbs:
         builder.connect(f"rover.Fz[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]")
-    return builder.build()
+    return builder
 
 
 def soil_and_wheel_of(models: ModelSet) -> tuple[Soil, Wheel]:

@@ -33,6 +33,7 @@ def build_report(results: Path) -> str:
     parts += sections.path_section(simulation)
     parts += sections.terrain_section(simulation)
     parts += sections.legwheel_section(simulation)
+    parts += sections.effects_section(simulation)
     parts += sections.coupling_section(results)
     parts += sections.montecarlo_section(results / "montecarlo")
     parts += sections.scope_section(results)

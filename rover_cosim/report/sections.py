@@ -563,12 +563,47 @@ def legwheel_section(simulation: Path) -> list[str]:
     return sections
 
 
+def effects_section(simulation: Path) -> list[str]:
+    """Grousers, slip-sinkage and multi-pass ruts (issue 48): the straight run with each switched on,
+    per wheel its sinkage and the controller's force error (Table 3's ablation), and the trends."""
+    sections = ["<h2>Wheel effects: grousers, slip-sinkage, multi-pass ruts</h2>",
+                ("<p>The paper's straight run on Rover.fmu with one effect switched on at a time; the controller "
+                 "and its model are the smooth wheel's, so the RMS column shows the error each effect adds to the "
+                 "identified model. <b>Grousers</b>: the soil sheared at the grouser tips and on the trapped soil's "
+                 "sides (Ding et al. 2011; the wheel's own grousers, else 10 mm &times; 24, illustrative). "
+                 "<b>Slip-sinkage</b>: the sinkage exponent n + n<sub>slip</sub>|s| (Ding et al. 2011; the soil's "
+                 "own n<sub>slip</sub>, else 0.5, illustrative). <b>Multi-pass</b>: a rut participant gives the "
+                 "middle and rear wheels the rut the wheel ahead left; the soil under its floor carried that "
+                 "pressure (Wong's repetitive loading, rigid reload). Cruise: t &ge; 10 s.</p>")]
+    path = simulation / "effects_ablation.csv"
+    if not path.exists():
+        return [*sections, "<p>Not run (<code>rover-cosim simulate --only effects</code>).</p>"]
+    ablation = pd.read_csv(path)
+    names = {"smooth": "smooth wheel", "grousers": "grousers", "slip_sinkage": "slip-sinkage",
+             "multi_pass": "multi-pass"}
+    wheels = sorted(ablation["wheel"].unique())
+    half = wheels[: max(1, len(wheels) // 2)]  # one side: the other mirrors it on the straight run
+    rows = []
+    for variant, group in ablation.groupby("variant", sort=False):
+        group = group.set_index("wheel")
+        rows.append({"variant": names.get(str(variant), str(variant)),
+                     **{f"sinkage {i} [mm]": 1000 * group.loc[i, "sinkage_mean_m"] for i in half},
+                     **{f"RMS {i} [N]": group.loc[i, "rms_N"] for i in half}})
+    sections += [f"<p>Wheels {', '.join(map(str, half))} (one side; the other mirrors it).</p>",
+                 table(pd.DataFrame(rows), default="{:.3g}"),
+                 image(simulation / "effects_trends.png", "the models' trends: drawbar pull at 20 % slip against "
+                       "grouser height and count, sinkage against slip with slip-sinkage")]
+    return sections
+
+
 def provenance_section(results: Path) -> list[str]:
     records = [fig3_file(results, "json"), results / "identification" / "identification.json",
                results / "simulation" / "simulation.json", results / "simulation" / "path_following.json",
                results / "simulation" / "terrain.json"]
     if (results / "simulation" / "legwheel.json").exists():  # the paper's rover only
         records.append(results / "simulation" / "legwheel.json")
+    if (results / "simulation" / "effects.json").exists():
+        records.append(results / "simulation" / "effects.json")
     if (results / "montecarlo" / "summary.json").exists():  # an optional study: listed only when run
         records.append(results / "montecarlo" / "summary.json")
     return ["<h2>Provenance</h2>", *(provenance(path) for path in records)]

@@ -1,0 +1,70 @@
+"""The rut participant (multi-pass, issue 48): a block that remembers where each wheel went and how
+deep it sank (``terramechanics.multipass.RutMap``) and gives each wheel the rut another wheel left
+under it (the ``rutDepth`` inputs of Rover, SteerableRover, LegWheelRover or of each Wheel).
+
+Inputs: the body's pose (``x`` for the pitch-plane rover; ``x``, ``y``, ``yaw`` for a rover free in
+the plane) and ``sinkage[i]`` of each wheel. Outputs: ``rutDepth[i]`` [m]. The wheels' sinkage
+depends on their rut, so the block has no direct feedthrough (``feedthrough = False``): a step
+marks the ruts with the sinkages and poses it receives and gives the ruts under the hubs there,
+one communication step late (1 mm at 1 m/s and 1 ms), which closes no algebraic loop.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from rover_cosim.terramechanics.multipass import RutMap
+from rover_cosim.terramechanics.terrain import hub_positions
+
+
+class RutBlock:
+    """Orchestrator block: the ruts under the wheels of a rover whose hubs sit at ``x_limb`` [m]
+    (one side, front to rear; the other side mirrors it) and ±``y_limb`` [m] in the body frame, each
+    wheel ``width`` [m] wide; ``planar``: inputs x, y, yaw (a rover free in the plane), else x alone
+    (the pitch-plane rover, on the line y = 0 heading along x)."""
+
+    feedthrough = False
+
+    def __init__(self, name: str, x_limb: tuple[float, ...], y_limb: float, width: float, *,
+                 planar: bool = False, cell: float = 0.02):
+        if not (len(x_limb) >= 1 and y_limb > 0 and width > 0):
+            raise ValueError(f"block {name!r}: x_limb = {x_limb!r}, y_limb = {y_limb!r} m, width = {width!r} m: "
+                             "expected hubs, y_limb > 0 m and a wheel width > 0 m")
+        self.name = name
+        self.x_hub = np.array([*x_limb, *x_limb], float)
+        self.y_hub = np.array([y_limb] * len(x_limb) + [-y_limb] * len(x_limb), float)
+        self.wheels = self.x_hub.size
+        self.half_width = 0.5 * float(width)
+        self.planar = planar
+        self.map = RutMap(self.wheels, cell)
+        numbers = range(1, self.wheels + 1)
+        pose = ("x", "y", "yaw") if planar else ("x",)
+        self.inputs: tuple[str, ...] = (*pose, *[f"sinkage[{i}]" for i in numbers])
+        self.outputs: tuple[str, ...] = tuple(f"rutDepth[{i}]" for i in numbers)
+        self.units = {"x": "m", "y": "m", "yaw": "rad", **{n: "m" for n in self.inputs if n.startswith("sinkage")},
+                      **{n: "m" for n in self.outputs}}
+
+    def _hubs(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.planar:
+            return hub_positions(float(u[0]), float(u[1]), float(u[2]), self.x_hub, self.y_hub)
+        return float(u[0]) + self.x_hub, self.y_hub.copy()
+
+    def _advance(self, u: np.ndarray) -> np.ndarray:
+        pose = 3 if self.planar else 1
+        x, y = self._hubs(u)
+        self.map.stamp(x, y, np.asarray(u[pose:pose + self.wheels], float), self.half_width)
+        return self.map.depths(x, y)
+
+    def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
+        return self._advance(u0)
+
+    def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        return self._advance(u)
+
+    def get_state(self) -> Any:
+        return self.map.get_state()
+
+    def set_state(self, state: Any) -> None:
+        self.map.set_state(state)
