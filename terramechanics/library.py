@@ -183,7 +183,10 @@ def build(kind: str, name: str, table: dict[str, Any]) -> Soil | Wheel | Rover:
     values = _values(kind, name, table)
     if kind == "wheel":
         base_wheel = Wheel(**_values("wheel", DEFAULT, _shipped(WHEELS)[DEFAULT]))
-        return replace(base_wheel, **values)
+        try:
+            return replace(base_wheel, **values)
+        except ValueError as error:
+            raise ValueError(f"wheel {name!r}: {error}") from None
     base = _values("soil", DEFAULT, _shipped(SOILS)[DEFAULT])
     if "xc" not in values:
         base.pop("xc", None)  # Soil derives it from the soil's own phi: 45 deg - phi/2

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Callable
 from typing import Any
 
 from .command import Command
@@ -108,47 +109,55 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _runs(args: argparse.Namespace, choice: Any, calibration: Any) -> None:
-    """The runs asked for (``--only``): the paper's straight run, the path following, the terrain
-    scenarios, each writing its files."""
-    from rover_cosim.jobs.effects import run_effects
-    from rover_cosim.jobs.legwheel import run_legwheel
-    from rover_cosim.jobs.path_following import run_path_following
-    from rover_cosim.jobs.simulate import run_simulation
-    from rover_cosim.jobs.terrain import SoilCrossingScenario, run_terrain
+    """The parts asked for (``--only``; all of PARTS by default, the leg-wheel part only for the
+    paper's rover), each run under its progress bar, printed and writing its files."""
     from rover_cosim.progress import ProgressBar
 
     allow = args.allow_model_mismatch or args.adapt
-    if args.only in (None, "straight"):
-        bar = ProgressBar("simulate: the paper's straight run", enabled=not args.quiet)
-        straight = run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow,
-                                  progress=bar, record_interval=args.record_interval, adapt=calibration)
+    for part in PARTS:
+        if args.only not in (None, part) or (args.only is None and part == "legwheel"
+                                             and choice.rover_name != "paper"):
+            continue
+        title, run, show = _PART_RUNS[part]
+        bar = ProgressBar(f"simulate: {title}", enabled=not args.quiet)
+        outcome = run(args, choice, allow, calibration, bar)
         bar.close()
-        print_straight(straight)
-    if args.only in (None, "path"):
-        bar = ProgressBar("simulate: path following", enabled=not args.quiet)
-        path = run_path_following(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
-                                  progress=bar, record_interval=args.record_interval)
-        bar.close()
-        _print_path(path)
-    if args.only in (None, "terrain"):
-        bar = ProgressBar("simulate: side-slope traverses", enabled=not args.quiet)
-        crossing = SoilCrossingScenario(soil_b=args.crossing_soil, believed_soil_b=args.crossing_belief)
-        terrain = run_terrain(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
-                              progress=bar, record_interval=args.record_interval, crossing=crossing)
-        bar.close()
-        _print_terrain(terrain)
-    if args.only == "legwheel" or (args.only is None and choice.rover_name == "paper"):
-        bar = ProgressBar("simulate: the leg-wheel rover", enabled=not args.quiet)
-        legwheel = run_legwheel(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
-                                progress=bar, record_interval=args.record_interval)
-        bar.close()
-        print_legwheel(legwheel)
-    if args.only in (None, "effects"):
-        bar = ProgressBar("simulate: grousers, slip-sinkage, multi-pass", enabled=not args.quiet)
-        effects = run_effects(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
-                              progress=bar)
-        bar.close()
-        print_effects(effects)
+        show(outcome)
+
+
+def _straight(args: argparse.Namespace, choice: Any, allow: bool, calibration: Any, bar: Any) -> Any:
+    from rover_cosim.jobs.simulate import run_simulation
+
+    return run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow, progress=bar,
+                          record_interval=args.record_interval, adapt=calibration)
+
+
+def _path(args: argparse.Namespace, choice: Any, allow: bool, calibration: Any, bar: Any) -> Any:
+    from rover_cosim.jobs.path_following import run_path_following
+
+    return run_path_following(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow,
+                              progress=bar, record_interval=args.record_interval)
+
+
+def _terrain(args: argparse.Namespace, choice: Any, allow: bool, calibration: Any, bar: Any) -> Any:
+    from rover_cosim.jobs.terrain import SoilCrossingScenario, run_terrain
+
+    crossing = SoilCrossingScenario(soil_b=args.crossing_soil, believed_soil_b=args.crossing_belief)
+    return run_terrain(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow, progress=bar,
+                       record_interval=args.record_interval, crossing=crossing)
+
+
+def _legwheel(args: argparse.Namespace, choice: Any, allow: bool, calibration: Any, bar: Any) -> Any:
+    from rover_cosim.jobs.legwheel import run_legwheel
+
+    return run_legwheel(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow, progress=bar,
+                        record_interval=args.record_interval)
+
+
+def _effects(args: argparse.Namespace, choice: Any, allow: bool, calibration: Any, bar: Any) -> Any:
+    from rover_cosim.jobs.effects import run_effects
+
+    return run_effects(args.fmu_dir, args.model, args.out, choice=choice, allow_model_mismatch=allow, progress=bar)
 
 
 def _print_path(outcome: Any) -> None:
@@ -236,6 +245,16 @@ def print_straight(outcome: Any) -> None:
     print_written(outcome.files)
 
 
+#: Each part of PARTS: its progress bar's title, how it runs, how its outcome is printed.
+_PART_RUNS: dict[str, tuple[str, Callable[..., Any], Callable[[Any], None]]] = {
+    "straight": ("the paper's straight run", _straight, print_straight),
+    "path": ("path following", _path, _print_path),
+    "terrain": ("side-slope traverses", _terrain, _print_terrain),
+    "legwheel": ("the leg-wheel rover", _legwheel, print_legwheel),
+    "effects": ("grousers, slip-sinkage, multi-pass", _effects, print_effects),
+}
+
+
 def result_sets(args: argparse.Namespace) -> int | None:
     """One result set per part run (each writes its files into the folder as one set)."""
     if args.only:
@@ -250,3 +269,4 @@ COMMAND = Command(
     summary="Paper Sec. 4: the closed-loop rover on Rover.fmu and RoverBody + 6 Wheel, then path following.",
     examples=("rover-cosim simulate --out results/simulation", "rover-cosim simulate --only straight --quiet"),
     arguments=arguments, run=run, needs_bytes=60e6, result_sets=result_sets)
+

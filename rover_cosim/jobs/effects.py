@@ -26,7 +26,9 @@ from rover_cosim.common.outputs import json_bytes
 from rover_cosim.terramechanics.library import Choice, as_choice
 from rover_cosim.terramechanics.sinkage import wheel_state
 
+from . import effects_figures
 from .campaign import Campaign
+from .effects_figures import Trends
 from .plants import rover_fmu
 from .ruts import RutBlock
 from .simulate import STEP, checked_models, monolithic_builder, rms, trajectories
@@ -64,8 +66,9 @@ def variant_choice(choice: Choice, variant: str) -> Choice:
 
 
 def straight_system(fmu_dir: Path, models: Any, choice: Choice, variant: str) -> Any:
-    """The monolithic straight run of ``variant`` (a rut block on Rover.fmu's rutDepth for multi_pass)."""
-    builder = monolithic_builder(fmu_dir, models, variant_choice(choice, variant))
+    """The monolithic straight run of ``variant`` on ``choice`` (its variant_choice: the effect on; a rut
+    block on Rover.fmu's rutDepth for multi_pass)."""
+    builder = monolithic_builder(fmu_dir, models, choice)
     if variant == "multi_pass":
         rover = choice.rover
         block = RutBlock("ruts", rover.x_limb, rover.y_limb, choice.wheel.b)
@@ -85,45 +88,22 @@ def cruise(table: pd.DataFrame) -> pd.DataFrame:
                          "slip_mean": [float(after[f"slip_{i}"].mean()) for i in wheels]})
 
 
-def trends(choice: Choice) -> bytes:
-    """The figure of the trends: drawbar pull at 20 % slip and the rover's static wheel load against
-    grouser height (24 grousers) and count (10 mm), sinkage against slip for some n_slip."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import io
-
-    import matplotlib.pyplot as plt
-
+def trends(choice: Choice) -> Trends:
+    """The models' trends on the choice's wheel (without its grousers) and soil at the rover's static
+    wheel load: drawbar pull at 20 % slip against grouser height (24 grousers) and count (10 mm),
+    sinkage against slip for some n_slip."""
     load = choice.rover.static_wheel_load(choice.soil.gravity)
     wheel, soil = replace(choice.wheel, grouser_height=0.0, grouser_count=0.0), choice.soil
-    heights = np.linspace(0.0, 0.04, 9)
-    counts = np.arange(0, 49, 4)
-    pull_h = [float(wheel_state(load, 0.2, replace(wheel, grouser_height=h, grouser_count=24.0), soil).Fx)
-              for h in heights]
-    pull_n = [float(wheel_state(load, 0.2, replace(wheel, grouser_height=0.01, grouser_count=float(n)), soil).Fx)
-              for n in counts]
-    slips = np.linspace(0.0, 0.8, 17)
-    figure, axes = plt.subplots(1, 3, figsize=(13, 4.2))
-    axes[0].plot(1e3 * heights, pull_h, "o-")
-    axes[0].set(xlabel="grouser height [mm] (24 grousers)", ylabel="drawbar pull Fx at 20 % slip [N]",
-                title="grousers: height")
-    axes[1].plot(counts, pull_n, "o-")
-    axes[1].set(xlabel="number of grousers (10 mm high)", ylabel="drawbar pull Fx at 20 % slip [N]",
-                title="grousers: count (saturates once one is always engaged)")
-    for n_slip in (0.0, 0.25, 0.5, 1.0):
-        sinkage = wheel_state(load, slips, wheel, replace(soil, n_slip=n_slip)).sinkage
-        axes[2].plot(slips, 1e3 * sinkage, label=f"n_slip = {n_slip:g}")
-    axes[2].set(xlabel="slip ratio [-]", ylabel="sinkage [mm]", title="slip-sinkage: n + n_slip |slip|")
-    axes[2].legend()
-    for axis in axes:
-        axis.grid(alpha=0.3)
-    figure.suptitle(f"wheel r = {wheel.r:g} m, b = {wheel.b:g} m at {load:.0f} N on the chosen soil")
-    figure.tight_layout()
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=100)
-    plt.close(figure)
-    return buffer.getvalue()
+    heights, counts, slips = np.linspace(0.0, 0.04, 9), np.arange(0.0, 49.0, 4.0), np.linspace(0.0, 0.8, 17)
+    count_at, height_at = 24.0, 0.01
+    pull_by_height = np.array([float(wheel_state(load, 0.2, replace(wheel, grouser_height=h, grouser_count=count_at),
+                                                 soil).Fx) for h in heights])
+    pull_by_count = np.array([float(wheel_state(load, 0.2, replace(wheel, grouser_height=height_at, grouser_count=n),
+                                                soil).Fx) for n in counts])
+    sinkage = {n_slip: wheel_state(load, slips, wheel, replace(soil, n_slip=n_slip)).sinkage
+               for n_slip in (0.0, 0.25, 0.5, 1.0)}
+    return Trends(heights, count_at, pull_by_height, counts, height_at, pull_by_count, slips, sinkage,
+                  f"wheel r = {wheel.r:g} m, b = {wheel.b:g} m at {load:.0f} N on the chosen soil")
 
 
 def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None, *,
@@ -133,9 +113,10 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
     campaign = Campaign("rover-cosim simulate --only effects", len(VARIANTS), progress)
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
+    chosen = {v: variant_choice(choice, v) for v in VARIANTS}
     rows, sinkage = [], {}
-    for variant in VARIANTS:
-        table = trajectories(campaign.run(variant, straight_system(fmu_dir, models, choice, variant)).data,
+    for variant, variant_chosen in chosen.items():
+        table = trajectories(campaign.run(variant, straight_system(fmu_dir, models, variant_chosen, variant)).data,
                              "monolithic")
         errors = rms(table).rename(columns={"limb": "wheel"})
         at_cruise = cruise(table).merge(errors, on="wheel")
@@ -144,7 +125,6 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
         sinkage[f"sinkage_{variant}_m"] = at_cruise["sinkage_mean_m"].to_numpy()
     ablation = pd.concat(rows, ignore_index=True)[["variant", "wheel", "rms_N", "sinkage_mean_m", "slip_mean"]]
     sinkage_table = pd.DataFrame({"wheel": rows[0]["wheel"], **sinkage})
-    chosen = {v: variant_choice(choice, v) for v in VARIANTS}
     variants = {v: {"wheel": asdict(c.wheel), "soil_n_slip": c.soil.n_slip, "what": VARIANTS[v]}
                 for v, c in chosen.items()}
     record = campaign.record({"stop_time_s": 20.0, "step_s": STEP, "cruise_from_s": CRUISE_FROM, "model": str(model),
@@ -155,7 +135,7 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
     out = Path(out_dir)
     files = {out / "effects_ablation.csv": ablation.to_csv(index=False, float_format="%.6g").encode(),
              out / "effects_sinkage.csv": sinkage_table.to_csv(index=False, float_format="%.6g").encode(),
-             out / "effects_trends.png": trends(choice),
+             out / "effects_trends.png": effects_figures.trends(trends(choice)),
              out / "effects.json": json_bytes(record)}
     written = campaign.write(out, files)
     return EffectsResult(written, record, ablation, sinkage_table)

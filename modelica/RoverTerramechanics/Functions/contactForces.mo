@@ -43,8 +43,7 @@ protected
   Real engagement(unit="1") "Mean number of grousers in the patch, at most 1";
   Real radius(unit="m") "Shear radius r + engagement*grouserHeight";
   Real ratio(unit="1") "radius/r";
-  Real scaleForce(unit="1") "Weight of the shear stress in Eqs. (11)-(12): ratio*(1 + 2 engagement grouserHeight/b)";
-  Real scaleTorque(unit="1") "Weight of the shear stress in Eq. (13): scaleForce*ratio";
+  Real scaleForce(unit="1") "Weight of the shear stress in Eqs. (11)-(12): ratio*(1 + 2 engagement grouserHeight/b); scaleForce*ratio in Eq. (13)";
 algorithm
   kx := soil.kx + soil.kxBeta*noEvent(abs(slipAngle));
   ky := soil.ky + soil.kyBeta*noEvent(abs(slipAngle));
@@ -64,7 +63,6 @@ algorithm
   radius := wheel.r + engagement*wheel.grouserHeight;
   ratio := radius/wheel.r;
   scaleForce := ratio*(1 + 2*engagement*wheel.grouserHeight/wheel.b);
-  scaleTorque := scaleForce*ratio;
   dFront := thetaF - thetaM;
   dRear := thetaM - thetaR;
   Fx := 0;
@@ -133,6 +131,15 @@ nodes (sinkage 3 mm to 0.3 m): with 16 nodes the error is below 3e-10 of F<sub>z
 driving slips (composite Simpson with 17 nodes per piece, used before: 1e-4); while skidding,
 where &tau; has a kink at j<sub>x</sub> = 0 inside the patch, 4e-6 of F<sub>z</sub> up to
 h = 0.1 m and 6e-4 for a wheel sunk deeper (Simpson-17: 4e-6 and 7e-4). The test suite measures it against the Python reference.</p>
+<p>Wheel effects (issue 48; each off by default, and then the results are the paper's bit for bit):
+<b>grousers</b> shear the soil at r<sub>s</sub> = r + e h<sub>g</sub> (Eq. 10 with r<sub>s</sub>,
+Ding et al., J. Terramechanics 48, 2011) and on the trapped soil's sides, so the shear stress counts
+(r<sub>s</sub>/r) g in Eqs. (11)-(12) and (r<sub>s</sub>/r)<sup>2</sup> g in Eq. (13), g = 1 + 2 e
+h<sub>g</sub>/b, e = min(1, N<sub>g</sub>(&theta;<sub>f</sub> - &theta;<sub>r</sub>)/2&pi;);
+<b>slip-sinkage</b> makes the exponent of Eq. (5) n + nSlip |&kappa;|; in a <b>rut</b> of depth
+<code>rutDepth</code> the normal stress is that of <code>normalStress</code> with the rut (h is then the
+sinkage below the rut's floor). The Python reference: <code>terramechanics.grousers</code>,
+<code>Soil.sinkage_exponent</code>, <code>terramechanics.multipass</code>.</p>
 <p>Lateral force (Ishigami, Miwa, Nagatani, Yoshida, J. Field Robotics 24(3), 2007) at the slip
 angle &beta;: k<sub>x</sub> and k<sub>y</sub> grow with |&beta;|; lateral shear from
 j<sub>y</sub> = r(1 - s)(&theta;<sub>f</sub> - &theta;) tan &beta; (<code>lateralShear</code>);
