@@ -20,12 +20,20 @@ BACKEND ?= auto
 SOIL ?= paper
 ROVER ?= paper
 WHEEL ?=
-SOIL_OPTIONS := --soil $(SOIL) --rover $(ROVER) $(if $(WHEEL),--wheel $(WHEEL))
+# SET: single values changed for fig3, identify and simulate (each KIND.NAME=VALUE of `--set`, space-
+# separated); RUTS=1: the straight run with multi-pass ruts (`simulate --ruts`). The wheel effects of
+# issue 48, e.g. `make run SET="wheel.grouser_height=0.01 wheel.grouser_count=24 soil.n_slip=0.5" RUTS=1`.
+SET ?=
+RUTS ?=
+SOIL_OPTIONS := --soil $(SOIL) --rover $(ROVER) $(if $(WHEEL),--wheel $(WHEEL)) $(foreach a,$(SET),--set $(a))
 # Results: results/ for the paper's soil, rover and wheel; any other choice gets its own folder
-# (results_<rover>_<soil>[_<wheel>]), so that its files never mix with the paper's.
+# (results_<rover>_<soil>[_<wheel>][_<set>][_ruts]), so that its files never mix with the paper's.
 name_of = $(basename $(notdir $(1)))
-PAPER_CHOICE := $(and $(filter paper,$(SOIL)),$(filter paper,$(ROVER)),$(if $(WHEEL),$(filter paper,$(WHEEL)),yes))
-RESULTS ?= $(if $(PAPER_CHOICE),results,results_$(call name_of,$(ROVER))_$(call name_of,$(SOIL))$(if $(WHEEL),_$(call name_of,$(WHEEL))))
+empty :=
+space := $(empty) $(empty)
+SET_NAME := $(subst =,-,$(subst $(space),_,$(strip $(SET))))
+PAPER_CHOICE := $(and $(filter paper,$(SOIL)),$(filter paper,$(ROVER)),$(if $(WHEEL),$(filter paper,$(WHEEL)),yes),$(if $(SET)$(RUTS),,yes))
+RESULTS ?= $(if $(PAPER_CHOICE),results,results_$(call name_of,$(ROVER))_$(call name_of,$(SOIL))$(if $(WHEEL),_$(call name_of,$(WHEEL)))$(if $(SET_NAME),_$(SET_NAME))$(if $(RUTS),_ruts))
 # The FMUs are the classes of modelica/RoverTerramechanics/FMUs (its package.order): build-fmus without
 # names builds them all; FMUS=Wheel,Rover (space- or comma-separated) builds some.
 FMUS ?=
@@ -68,7 +76,7 @@ identify: fmus
 ## simulate: paper Sec. 4, closed loop on Rover.fmu and RoverBody + 6 Wheel, then the steerable rover's paths
 ## and side-slope traverses (issue 35), then the leg-wheel rover (issue 47; the paper's rover only) -> results/simulation/
 simulate: identify
-	$(VENV)/bin/rover-cosim simulate --out $(RESULTS)/simulation --fmu-dir fmus --model $(RESULTS)/identification/model.json $(SOIL_OPTIONS)
+	$(VENV)/bin/rover-cosim simulate --out $(RESULTS)/simulation --fmu-dir fmus --model $(RESULTS)/identification/model.json $(SOIL_OPTIONS) $(if $(RUTS),--ruts)
 
 ## montecarlo: the closed loop on sampled lunar soils, controller unchanged -> results/montecarlo/
 ## STUDY: a study file or a shipped study; its nominal soil must be the one `make identify` used

@@ -43,14 +43,18 @@ def test_the_effects_ablation_runs_and_the_rear_wheels_sink_deeper_in_the_ruts(f
                                                                                tmp_path):
     import pandas as pd
 
-    from rover_cosim.jobs.effects import VARIANTS, run_effects
+    from rover_cosim.identification.model_set import ModelSet
+    from rover_cosim.jobs.effects import OWN_MODEL, REIDENTIFIED, SMOOTH_MODEL, VARIANTS, run_effects
 
-    result = run_effects(fmus["Rover"].parent, results_root / "identification" / "model.json", tmp_path)
+    result = run_effects(fmus["Rover"].parent, results_root / "identification" / "model.json", tmp_path,
+                         straight=3.0)  # the turn's straights shortened from 10 m
     ablation = pd.read_csv(tmp_path / "effects_ablation.csv")
     assert list(ablation["variant"].unique()) == list(VARIANTS)
+    by_model = {label: ablation[ablation["model"] == label] for label in (SMOOTH_MODEL, OWN_MODEL)}
+    assert list(by_model[OWN_MODEL]["variant"].unique()) == list(REIDENTIFIED)
     sinkage = result.sinkage.set_index("wheel")
     # the paper's smooth wheel: the straight run's Table 3 figures (below 1 N), wheels 4-6 mirror 1-3
-    smooth = ablation[ablation["variant"] == "smooth"].set_index("wheel")
+    smooth = by_model[SMOOTH_MODEL][by_model[SMOOTH_MODEL]["variant"] == "smooth"].set_index("wheel")
     assert (smooth["rms_N"] < 1.0).all()
     np.testing.assert_allclose(smooth.loc[[4, 5, 6], "rms_N"].to_numpy(), smooth.loc[[1, 2, 3], "rms_N"].to_numpy())
     # multi-pass: each wheel deeper than the one ahead, by less each time; the front one on virgin soil
@@ -59,8 +63,52 @@ def test_the_effects_ablation_runs_and_the_rear_wheels_sink_deeper_in_the_ruts(f
     assert ruts[3] > ruts[2] > ruts[1] and ruts[3] - ruts[2] < ruts[2] - ruts[1]
     # slip-sinkage sinks every wheel at least as deep; grousers change the pull, hence the model's error
     assert (sinkage["sinkage_slip_sinkage_m"] >= sinkage["sinkage_smooth_m"]).all()
-    grousers = ablation[ablation["variant"] == "grousers"].set_index("wheel")
-    assert (grousers["rms_N"] > smooth["rms_N"]).all()
+    for variant in REIDENTIFIED:
+        unaware = by_model[SMOOTH_MODEL][by_model[SMOOTH_MODEL]["variant"] == variant].set_index("wheel")
+        aware = by_model[OWN_MODEL][by_model[OWN_MODEL]["variant"] == variant].set_index("wheel")
+        assert (unaware["rms_N"] > smooth["rms_N"]).all(), variant
+        # the model identified with the effect controls better than the smooth wheel's
+        assert (aware["rms_N"] < unaware["rms_N"]).all(), variant
+    # Table 1: the smooth row is `identify`'s Table 1 (the same sweep, fits and staircase); with an effect
+    # on, the smooth wheel's model fits worse than the one identified with it
+    fits = result.table1.set_index(["variant", "load_N"])
+    paper = pd.read_csv(results_root / "identification" / "fit_table.csv").set_index("load_N")["fit_percent"]
+    np.testing.assert_allclose(fits.loc["smooth", f"fit_percent_{SMOOTH_MODEL}"].to_numpy(), paper.to_numpy(),
+                               atol=1e-3)
+    for variant in REIDENTIFIED:
+        assert (fits.loc[variant, f"fit_percent_{OWN_MODEL}"] > fits.loc[variant, f"fit_percent_{SMOOTH_MODEL}"]).all()
     assert {p.name for p in result.files} == {"effects_ablation.csv", "effects_sinkage.csv", "effects_trends.png",
-                                              "effects.json"}
+                                              "effects.json", "effects_table1.csv", "effects_model_grousers.json",
+                                              "effects_model_slip_sinkage.json", "effects_path_sinkage.csv"}
+    # the turn: on the straight the middle and rear wheels run in ruts and sink deeper, the front ones not;
+    # on the arc the middle wheels leave the front wheels' tracks in part: a shallower rut under them
+    turn = result.path_sinkage.set_index(["phase", "wheel"])
+    straight = turn.loc["straight"]
+    assert straight.loc[1, "rut_depth_m"] == 0.0 and (straight.loc[[2, 5], "rut_depth_m"] > 0.01).all()
+    assert (straight.loc[[2, 5], "sinkage_multi_pass_m"] > straight.loc[[2, 5], "sinkage_smooth_m"] + 2e-3).all()
+    assert (turn.loc["arc"].loc[[2, 5], "rut_depth_m"] < 0.5 * straight.loc[[2, 5], "rut_depth_m"]).all()
+    reread = ModelSet.read(tmp_path / "effects_model_grousers.json")
+    assert reread.details["wheel"]["values"]["grouser_count"] == 24.0
     assert result.record["parameters"]["variants"]["grousers"]["wheel"]["grouser_count"] == 24.0
+
+
+def test_the_straight_run_with_ruts_agrees_on_both_plants(fmus, identified, results_root):
+    """``simulate --ruts``: Rover.fmu and RoverBody + 6 Wheel, each with the rut block on its wheels'
+    rutDepth inputs, give the same ruts and sinkage (two implementations of the same plant)."""
+    import dataclasses
+
+    from rover_cosim.jobs.simulate import cosim_system, monolithic_system
+    from rover_cosim.orchestrator.master import run
+
+    model = results_root / "identification" / "model.json"
+    sinkage = {}
+    for plant, build, wheel in (("monolithic", monolithic_system, "rover.sinkage[{}]"),
+                                ("cosim", cosim_system, "wheel{}.sinkage")):
+        system = dataclasses.replace(build(fmus["Rover"].parent, model, ruts=True), stop_time=10.0)
+        data = run(system).data
+        after = data[data["time"] >= 8.5]  # 3.8 m on: every wheel past the front wheels' start
+        sinkage[plant] = np.array([after[wheel.format(i)].mean() for i in range(1, 7)])
+        ruts = np.array([after[f"ruts.rutDepth[{i}]"].mean() for i in range(1, 7)])
+        assert ruts[0] == 0.0 and ruts[1] > 0.02 and ruts[2] > ruts[1], plant
+        assert sinkage[plant][2] > sinkage[plant][1] > sinkage[plant][0] + 2e-3, plant
+    np.testing.assert_allclose(sinkage["cosim"], sinkage["monolithic"], rtol=2e-3)

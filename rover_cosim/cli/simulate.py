@@ -44,6 +44,10 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="also run the straight run with the adaptive controller: a calibration phase, the "
                         "soil estimated from the rover's telemetry, the model identified again on SingleWheel.fmu "
                         "(implies --allow-model-mismatch: the point is a soil the model was not identified on)")
+    parser.add_argument("--ruts", action="store_true",
+                        help="the paper's straight run (both plants and the fixed-load ablation) with multi-pass "
+                        "ruts: each wheel rolls in the rut the wheels ahead left, on soil they compacted (issue 48; "
+                        "the effects part compares with and without)")
     parser.add_argument("--calibration", type=float, default=3.0, metavar="SECONDS",
                         help="with --adapt: the calibration phase's length [s] (default 3)")
     parser.add_argument("--sinkage-sensor", action="store_true",
@@ -129,7 +133,7 @@ def _straight(args: argparse.Namespace, choice: Any, allow: bool, calibration: A
     from rover_cosim.jobs.simulate import run_simulation
 
     return run_simulation(args.fmu_dir, args.model, args.out, choice, allow_model_mismatch=allow, progress=bar,
-                          record_interval=args.record_interval, adapt=calibration)
+                          record_interval=args.record_interval, adapt=calibration, ruts=args.ruts)
 
 
 def _path(args: argparse.Namespace, choice: Any, allow: bool, calibration: Any, bar: Any) -> Any:
@@ -172,15 +176,29 @@ def _print_path(outcome: Any) -> None:
 
 
 def print_effects(outcome: Any) -> None:
-    """What the wheel-effects ablation measured (jobs.effects.EffectsResult)."""
-    print("The straight run with each wheel effect on (controller and model of the smooth wheel), at cruise:")
-    table = outcome.ablation.pivot(index="wheel", columns="variant", values=["sinkage_mean_m", "rms_N"])
-    table.columns = [f"{'sinkage [mm]' if name == 'sinkage_mean_m' else 'RMS [N]'} {variant}"
-                     for name, variant in table.columns]
-    for column in table.columns:
-        if column.startswith("sinkage"):
-            table[column] = 1e3 * table[column]
-    print(table.to_string(float_format=lambda v: f"{v:.3g}"))
+    """What the wheel-effects ablation measured (jobs.effects.EffectsResult): Table 1 and, per run, the
+    sinkage and RMS(Fx - Fx_des) of one side's wheels (the other mirrors it on the straight run)."""
+    print("Table 1 with each wheel effect on: Fit [%] on the variant's test bed of the smooth wheel's model and "
+          "of the model identified with the effect:")
+    fits = outcome.table1.melt(id_vars=["variant", "load_N"], var_name="model", value_name="fit")
+    fits["model"] = fits["model"].str.removeprefix("fit_percent_")
+    order = [(v, m) for v in outcome.table1["variant"].unique() for m in fits["model"].unique()]
+    print(fits.pivot(index=["variant", "model"], columns="load_N", values="fit").reindex(order)
+          .rename(columns=lambda load: f"{load:g} N").to_string(float_format=lambda v: f"{v:.1f}"))
+    ablation = outcome.ablation
+    half = sorted(ablation["wheel"].unique())[: max(1, ablation["wheel"].nunique() // 2)]
+    print(f"The straight run with each effect on, at cruise, wheels {', '.join(map(str, half))}:")
+    runs = ablation[ablation["wheel"].isin(half)].pivot(index=["variant", "model"], columns="wheel",
+                                                          values=["sinkage_mean_m", "rms_N"])
+    runs = runs.reindex(ablation[["variant", "model"]].drop_duplicates().itertuples(index=False))
+    runs.columns = [f"{'sinkage [mm]' if name == 'sinkage_mean_m' else 'RMS [N]'} {wheel}"
+                    for name, wheel in runs.columns]
+    runs[[c for c in runs.columns if c.startswith("sinkage")]] *= 1e3
+    print(runs.to_string(float_format=lambda v: f"{v:.3g}"))
+    turn = outcome.path_sinkage.set_index(["phase", "wheel"]) * 1e3
+    print("The turn without and with ruts, mean per phase [mm]:")
+    print(turn.rename(columns={"sinkage_smooth_m": "sinkage, virgin soil", "sinkage_multi_pass_m": "sinkage, ruts",
+                               "rut_depth_m": "rut under the wheel"}).to_string(float_format=lambda v: f"{v:.3g}"))
     print_written(outcome.files)
 
 

@@ -1,15 +1,24 @@
 """``rover-cosim simulate --only effects``: the paper's straight run (Sec. 4, Table 3) with each wheel
 effect of issue 48 switched on alone (grousers, slip-sinkage, multi-pass ruts), on Rover.fmu with the
-controller and the model identified on the smooth wheel: how much each effect changes the sinkage of
-every wheel and the controller's force error (the ablation of Table 3), and the trends each model
-claims (drawbar pull against grouser height and count, sinkage against slip).
+controller and the model identified on the smooth wheel, and for grousers and slip-sinkage also with
+the model identified again on SingleWheel.fmu with the effect on (the identification plan for the
+variant, ``identification.plan.plan_for``): how much each effect changes the sinkage of every wheel,
+Table 1's Fit of the smooth wheel's model and of the re-identified one on the variant's test bed, and
+the controller's force error with each (the ablation of Table 1 and Table 3); and the trends each
+model claims (drawbar pull against grouser height and count, sinkage against slip). Multi-pass has no
+re-identification: a single-wheel test bed runs one pass on virgin soil.
 
 results/simulation/
-  effects_ablation.csv   variant, limb, rms_N (RMS(Fx - Fx_des), Table 3), sinkage_mean_m and slip_mean
-                         (cruise, t >= 10 s) per wheel
-  effects_sinkage.csv    wheel, sinkage [m] at cruise of every variant side by side
+  effects_ablation.csv   variant, model (smooth_model / own_model), wheel, rms_N (RMS(Fx - Fx_des),
+                         Table 3), sinkage_mean_m and slip_mean (cruise, t >= 10 s)
+  effects_table1.csv     variant, load_N, fit_percent of the smooth model and of the variant's own
+                         model (Table 1's Eq. (15) on the variant's validation staircase)
+  effects_sinkage.csv    wheel, sinkage [m] at cruise of every variant side by side (smooth model)
+  effects_path_sinkage.csv  the turn: wheel, phase (straight before the arc, arc), sinkage [m] without and
+                         with ruts, the mean rut depth [m] under the wheel
+  effects_model_<variant>.json   the models identified with grousers, with slip-sinkage
   effects_trends.png     drawbar pull at 20 % slip against grouser height and count; sinkage against slip
-  effects.json           parameters, the variants' wheel and soil, FMU hashes, versions
+  effects.json           parameters, the variants' wheel, soil and plan, FMU hashes, versions
 """
 
 from __future__ import annotations
@@ -22,15 +31,22 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rover_cosim.common.outputs import json_bytes
-from rover_cosim.terramechanics.library import Choice, as_choice
+from rover_cosim.common.outputs import file_sha256, json_bytes
+from rover_cosim.common.rows import indices
+from rover_cosim.identification.model_set import ModelSet
+from rover_cosim.identification.online import identify_on_soil
+from rover_cosim.identification.plan import IdentificationPlan, plan_for
+from rover_cosim.identification.sweep import SweepPlan
+from rover_cosim.identification.testbed import shared_test_bed
+from rover_cosim.identification.validate import validate
+from rover_cosim.terramechanics.library import Choice, as_choice, describe
 from rover_cosim.terramechanics.sinkage import wheel_state
 
-from . import effects_figures
+from . import effects_figures, path_following
 from .campaign import Campaign
 from .effects_figures import Trends
 from .plants import rover_fmu
-from .ruts import RutBlock
+from .ruts import add_ruts
 from .simulate import STEP, checked_models, monolithic_builder, rms, trajectories
 
 #: The variants in the order they run, and what each switches on.
@@ -38,6 +54,10 @@ VARIANTS = {"smooth": "the paper's smooth wheel on virgin soil",
             "grousers": "grousers (terramechanics.grousers)",
             "slip_sinkage": "slip-sinkage (Soil.n_slip)",
             "multi_pass": "multi-pass ruts (RutBlock on the rutDepth inputs)"}
+#: The variants identified again on the test bed (a single-wheel test bed runs one pass: not multi_pass).
+REIDENTIFIED = ("grousers", "slip_sinkage")
+#: The ablation's two controllers: the smooth wheel's identified model, the variant's own.
+SMOOTH_MODEL, OWN_MODEL = "smooth_model", "own_model"
 #: Grousers for a wheel that has none of its own: 10 mm, 24 around the rim (illustrative: the size
 #: class of the single-wheel test beds' grousers, e.g. Ding et al. 2011's 10 mm).
 DEFAULT_GROUSERS = (0.01, 24.0)
@@ -52,6 +72,8 @@ class EffectsResult:
     record: dict[str, Any]
     ablation: pd.DataFrame
     sinkage: pd.DataFrame
+    table1: pd.DataFrame
+    path_sinkage: pd.DataFrame
 
 
 def variant_choice(choice: Choice, variant: str) -> Choice:
@@ -65,19 +87,72 @@ def variant_choice(choice: Choice, variant: str) -> Choice:
     return choice
 
 
+def reidentified(single_wheel: Path, models: ModelSet, choice: Choice, variant: str) -> ModelSet:
+    """``models`` with the longitudinal model identified again by the sweep on ``single_wheel`` with
+    ``choice``'s soil and wheel (the variant's), by the identification plan for it; the lateral model
+    kept (the straight run does not steer)."""
+    import tempfile
+
+    plan, label = plan_for(choice), models.recommended
+    with tempfile.TemporaryDirectory(prefix="rover-cosim-effects-") as cache:
+        model, _ = identify_on_soil(single_wheel, choice.soil, choice.wheel, Path(cache), models.model().degree,
+                                    SweepPlan(loads=plan.loads, torques=plan.torques), plan.fit_torque_max)
+    return ModelSet(label, {label: model}, models.lateral, {
+        "identified_for": f"the wheel effects' ablation, variant {variant} (rover-cosim simulate --only effects)",
+        "identification_plan": plan.to_dict(), "fmu": {"path": str(single_wheel), "sha256": file_sha256(single_wheel)},
+        **describe(choice)}, source=f"effects_model_{variant}.json")
+
+
+def table1(single_wheel: Path, choice: Choice, models: dict[str, ModelSet]) -> pd.DataFrame:
+    """Table 1 on ``choice``'s test bed (SingleWheel.fmu with its soil and wheel): the Fit [%] of
+    Eq. (15) of each of ``models`` (by label) on the validation staircase of the plan for ``choice``."""
+    plan: IdentificationPlan = plan_for(choice)
+    bed = shared_test_bed(single_wheel)
+    bed.parameters = SweepPlan(soil=choice.soil, wheel=choice.wheel).parameters
+    fits = validate(bed, {label: m.model() for label, m in models.items()}, plan.validation_loads,
+                    plan.validation_torques).fit
+    return fits[["load_N", *(f"fit_percent_{label}" for label in models)]]
+
+
 def straight_system(fmu_dir: Path, models: Any, choice: Choice, variant: str) -> Any:
     """The monolithic straight run of ``variant`` on ``choice`` (its variant_choice: the effect on; a rut
     block on Rover.fmu's rutDepth for multi_pass)."""
     builder = monolithic_builder(fmu_dir, models, choice)
     if variant == "multi_pass":
-        rover = choice.rover
-        block = RutBlock("ruts", rover.x_limb, rover.y_limb, choice.wheel.b)
-        builder.add_block("ruts", block)
-        builder.connect("rover.x", "ruts.x")
-        for i in range(1, block.wheels + 1):
-            builder.connect(f"rover.sinkage[{i}]", f"ruts.sinkage[{i}]").connect(f"ruts.rutDepth[{i}]",
-                                                                                  f"rover.rutDepth[{i}]")
+        add_ruts(builder, choice, "rover", lambda i, name: f"rover.{name}[{i}]")
     return builder.build()
+
+
+#: The path scenario run without and with ruts.
+PATH_SCENARIO = "turn"
+
+
+def path_system(fmu_dir: Path, models: ModelSet, choice: Choice, ruts: bool,
+                straight: float = path_following.STRAIGHT) -> Any:
+    """The path following's PATH_SCENARIO on SteerableRover.fmu (straights of ``straight`` [m]); with
+    ``ruts``, a rut block in the plane on its rutDepth inputs."""
+    builder = path_following.monolithic_builder(fmu_dir, models, PATH_SCENARIO, choice=choice, straight=straight)
+    if ruts:
+        add_ruts(builder, choice, "rover", lambda i, name: f"rover.{name}[{i}]", planar=True)
+    return builder.build()
+
+
+def path_phases(data: pd.DataFrame, straight: float) -> pd.DataFrame:
+    """Per wheel and phase of the turn (``straight``: on the first straight after its first metre;
+    ``arc``: the reference on the arc), the mean sinkage [m] and, where the run had ruts, the mean rut
+    depth [m] under the wheel."""
+    table = path_following.trajectories(data, cosim=False)
+    length = path_following.scenario_path(PATH_SCENARIO, straight).length
+    phases = {"straight": (table["s"] > 1.0) & (table["s"] < straight),
+              "arc": (table["s"] >= straight) & (table["s"] <= length - straight)}
+    wheels = indices(data.columns, "ctrl.tau")
+    rows = []
+    for phase, rows_in in phases.items():
+        for i in wheels:
+            rut = data.get(f"ruts.rutDepth[{i}]")
+            rows.append({"wheel": i, "phase": phase, "sinkage_m": float(table.loc[rows_in, f"sinkage_{i}"].mean()),
+                         "rut_depth_m": float(rut[rows_in.to_numpy()].mean()) if rut is not None else 0.0})
+    return pd.DataFrame(rows)
 
 
 def cruise(table: pd.DataFrame) -> pd.DataFrame:
@@ -107,35 +182,69 @@ def trends(choice: Choice) -> Trends:
 
 
 def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None, *,
-                allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None) -> EffectsResult:
-    """The four straight runs, the ablation and the trends; writes every file (all or none)."""
+                allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
+                straight: float = path_following.STRAIGHT) -> EffectsResult:
+    """The straight runs (each variant with the smooth wheel's model, grousers and slip-sinkage also with
+    their own), the identifications, Table 1, the ablation, the turn without and with ruts (its straights
+    ``straight`` [m] long) and the trends; writes every file (all or none)."""
     choice = as_choice(choice)
-    campaign = Campaign("rover-cosim simulate --only effects", len(VARIANTS), progress)
+    campaign = Campaign("rover-cosim simulate --only effects", len(VARIANTS) + len(REIDENTIFIED) + 2, progress)
     fmu_dir = Path(fmu_dir).resolve()
+    single_wheel = fmu_dir / "SingleWheel.fmu"
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     chosen = {v: variant_choice(choice, v) for v in VARIANTS}
+    own = {v: reidentified(single_wheel, models, chosen[v], v) for v in REIDENTIFIED}
+    fits = []
+    for variant in ("smooth", *REIDENTIFIED):
+        fit = table1(single_wheel, chosen[variant], {SMOOTH_MODEL: models, OWN_MODEL: own.get(variant, models)})
+        fit.insert(0, "variant", variant)
+        fits.append(fit)
     rows, sinkage = [], {}
     for variant, variant_chosen in chosen.items():
-        table = trajectories(campaign.run(variant, straight_system(fmu_dir, models, variant_chosen, variant)).data,
-                             "monolithic")
-        errors = rms(table).rename(columns={"limb": "wheel"})
-        at_cruise = cruise(table).merge(errors, on="wheel")
-        at_cruise.insert(0, "variant", variant)
-        rows.append(at_cruise)
-        sinkage[f"sinkage_{variant}_m"] = at_cruise["sinkage_mean_m"].to_numpy()
-    ablation = pd.concat(rows, ignore_index=True)[["variant", "wheel", "rms_N", "sinkage_mean_m", "slip_mean"]]
+        for label, controlled in ((SMOOTH_MODEL, models), (OWN_MODEL, own.get(variant))):
+            if controlled is None:
+                continue
+            key = variant if label == SMOOTH_MODEL else f"{variant}_{label}"
+            table = trajectories(campaign.run(key, straight_system(fmu_dir, controlled, variant_chosen, variant)).data,
+                                 "monolithic")
+            at_cruise = cruise(table).merge(rms(table).rename(columns={"limb": "wheel"}), on="wheel")
+            at_cruise.insert(0, "model", label)
+            at_cruise.insert(0, "variant", variant)
+            rows.append(at_cruise)
+            if label == SMOOTH_MODEL:
+                sinkage[f"sinkage_{variant}_m"] = at_cruise["sinkage_mean_m"].to_numpy()
+    turn = {}
+    for ruts in (False, True):
+        run = campaign.run(f"{PATH_SCENARIO}{'_ruts' if ruts else ''}",
+                           path_system(fmu_dir, models, choice, ruts, straight))
+        turn[ruts] = path_phases(run.data, straight)
+    path_sinkage = turn[False][["wheel", "phase"]].assign(
+        sinkage_smooth_m=turn[False]["sinkage_m"], sinkage_multi_pass_m=turn[True]["sinkage_m"],
+        rut_depth_m=turn[True]["rut_depth_m"])
+    ablation = pd.concat(rows, ignore_index=True)[["variant", "model", "wheel", "rms_N", "sinkage_mean_m",
+                                                   "slip_mean"]]
+    table_1 = pd.concat(fits, ignore_index=True)
     sinkage_table = pd.DataFrame({"wheel": rows[0]["wheel"], **sinkage})
-    variants = {v: {"wheel": asdict(c.wheel), "soil_n_slip": c.soil.n_slip, "what": VARIANTS[v]}
+    variants = {v: {"wheel": asdict(c.wheel), "soil_n_slip": c.soil.n_slip, "what": VARIANTS[v],
+                    "identification_plan": plan_for(c).to_dict() if v in ("smooth", *REIDENTIFIED) else None}
                 for v, c in chosen.items()}
     record = campaign.record({"stop_time_s": 20.0, "step_s": STEP, "cruise_from_s": CRUISE_FROM, "model": str(model),
+                              "path": {"scenario": PATH_SCENARIO, "straight_m": straight,
+                                       "stop_time_s": path_following.stop_time(PATH_SCENARIO, straight)},
                               "variants": variants,
-                              "controller": "the model identified on the smooth wheel, in every variant"},
-                             fmu_dir=fmu_dir, fmus=(rover_fmu(fmu_dir, "Rover", choice),), model=model, choice=choice,
-                             mismatch=mismatch)
+                              "controllers": {SMOOTH_MODEL: "the model identified on the smooth wheel (--model)",
+                                              OWN_MODEL: "the variant's model, identified again on SingleWheel.fmu "
+                                                         "with the effect on (grousers, slip-sinkage)"}},
+                             fmu_dir=fmu_dir, model=model, choice=choice, mismatch=mismatch,
+                             fmus=(rover_fmu(fmu_dir, "Rover", choice), rover_fmu(fmu_dir, "SteerableRover", choice),
+                                   "SingleWheel"))
     out = Path(out_dir)
     files = {out / "effects_ablation.csv": ablation.to_csv(index=False, float_format="%.6g").encode(),
+             out / "effects_table1.csv": table_1.to_csv(index=False, float_format="%.3f").encode(),
              out / "effects_sinkage.csv": sinkage_table.to_csv(index=False, float_format="%.6g").encode(),
+             out / "effects_path_sinkage.csv": path_sinkage.to_csv(index=False, float_format="%.6g").encode(),
+             **{out / f"effects_model_{v}.json": m.to_json() for v, m in own.items()},
              out / "effects_trends.png": effects_figures.trends(trends(choice)),
              out / "effects.json": json_bytes(record)}
     written = campaign.write(out, files)
-    return EffectsResult(written, record, ablation, sinkage_table)
+    return EffectsResult(written, record, ablation, sinkage_table, table_1, path_sinkage)

@@ -119,6 +119,12 @@ def _path_run(name: str, scenario: str, straight: float) -> SystemBuilder:
 def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, steering: str = "inverse",
                       choice: Choice | None = None, straight: float = STRAIGHT) -> System:
     """``scenario`` on SteerableRover.fmu, started rolling at its speed."""
+    return monolithic_builder(fmu_dir, model, scenario, steering, choice, straight).build()
+
+
+def monolithic_builder(fmu_dir: Path, model: ModelSet | Path, scenario: str, steering: str = "inverse",
+                       choice: Choice | None = None, straight: float = STRAIGHT) -> SystemBuilder:
+    """monolithic_system's builder, for a caller that adds participants (e.g. a rut block) to it."""
     speed = SCENARIOS[scenario]
     builder = _path_run(f"path {scenario} ({steering})", scenario, straight)
     plant = rover_fmu(fmu_dir, "SteerableRover", choice)
@@ -129,7 +135,7 @@ def monolithic_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, stee
     connect_controller(builder, "rover", lambda i, name: f"rover.{name}[{i}]", wheels)
     for i in wheels:
         builder.connect(f"ctrl.tau[{i}]", f"rover.tau[{i}]").connect(f"ctrl.steer[{i}]", f"rover.steer[{i}]")
-    return builder.build()
+    return builder
 
 
 def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice: Choice | None = None, *,

@@ -11,10 +11,13 @@ one communication step late (1 mm at 1 m/s and 1 ms), which closes no algebraic 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from rover_cosim.orchestrator.builder import SystemBuilder
+from rover_cosim.terramechanics.library import Choice
 from rover_cosim.terramechanics.multipass import RutMap
 from rover_cosim.terramechanics.terrain import hub_positions
 
@@ -68,3 +71,18 @@ class RutBlock:
 
     def set_state(self, state: Any) -> None:
         self.map.set_state(state)
+
+
+def add_ruts(builder: SystemBuilder, choice: Choice, body: str, wheel: Callable[[int, str], str], *,
+             planar: bool = False) -> RutBlock:
+    """A rut block ``ruts`` for the rover and wheel of ``choice`` in ``builder``, wired to the pose of the
+    participant ``body`` (x; with ``planar`` x, y, yaw) and to each wheel's ``sinkage`` output and
+    ``rutDepth`` input (``wheel(i, name)``: the variable of wheel i, 1-based)."""
+    rover = choice.rover
+    block = RutBlock("ruts", rover.x_limb, rover.y_limb, choice.wheel.b, planar=planar)
+    builder.add_block("ruts", block)
+    for name in ("x", "y", "yaw") if planar else ("x",):
+        builder.connect(f"{body}.{name}", f"ruts.{name}")
+    for i in range(1, block.wheels + 1):
+        builder.connect(wheel(i, "sinkage"), f"ruts.sinkage[{i}]").connect(f"ruts.rutDepth[{i}]", wheel(i, "rutDepth"))
+    return block

@@ -37,6 +37,7 @@ from rover_cosim.terramechanics.library import Choice, as_choice, choose
 
 from .campaign import Campaign
 from .plants import add_plant_fmu, add_rover, hubs, rover_fmu, wire_hub
+from .ruts import add_ruts
 
 STOP_TIME = 20.0  # s
 STEP = 1e-3       # s
@@ -90,9 +91,14 @@ def _closed_loop(name: str) -> SystemBuilder:
     return SystemBuilder(name).simulation(stop_time=STOP_TIME, step=STEP, algorithm="gauss-seidel")
 
 
-def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
-    """The closed loop on Rover.fmu (``options``: the controller's keyword arguments)."""
-    return monolithic_builder(fmu_dir, model, choice, **options).build()
+def monolithic_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, *, ruts: bool = False,
+                      **options: Any) -> System:
+    """The closed loop on Rover.fmu (``options``: the controller's keyword arguments); with ``ruts``,
+    a rut block gives each wheel the rut the wheels ahead left (multi-pass, ``jobs.ruts``)."""
+    builder = monolithic_builder(fmu_dir, model, choice, **options)
+    if ruts:
+        add_ruts(builder, as_choice(choice), "rover", lambda i, name: f"rover.{name}[{i}]")
+    return builder.build()
 
 
 def monolithic_builder(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None,
@@ -173,8 +179,10 @@ def connect_telemetry(builder: SystemBuilder, plant: str, calibration: Calibrati
             builder.connect(f"{plant}.sinkage[{i}]", f"ctrl.sinkage[{i}]")
 
 
-def cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, **options: Any) -> System:
-    """The closed loop on RoverBody + N Wheel (``options``: the controller's keyword arguments)."""
+def cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None, *, ruts: bool = False,
+                 **options: Any) -> System:
+    """The closed loop on RoverBody + N Wheel (``options``: the controller's keyword arguments; ``ruts``
+    as for monolithic_system, on the Wheel FMUs' rutDepth inputs)."""
     builder = _closed_loop("closed loop (cosim)")
     body = rover_fmu(fmu_dir, "RoverBody", choice)
     limbs = hubs(body)
@@ -186,6 +194,8 @@ def cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = 
         wire_hub(builder, "body", wheel, i)
         builder.connect(f"body.W[{i}]", f"ctrl.W[{i}]").connect(f"ctrl.tau[{i}]", f"{wheel}.tau")
         builder.connect(f"ctrl.tau[{i}]", f"body.tau[{i}]")
+    if ruts:
+        add_ruts(builder, as_choice(choice), "body", lambda i, name: f"wheel{i}.{name}")
     return builder.build()
 
 
@@ -257,14 +267,16 @@ def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> 
 
 def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soil | Wheel | None = None, *,
                    allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
-                   record_interval: float = RECORD_INTERVAL, adapt: Calibration | None = None) -> SimulationResult:
+                   record_interval: float = RECORD_INTERVAL, adapt: Calibration | None = None,
+                   ruts: bool = False) -> SimulationResult:
     """The closed loop on both plants and the ablation; writes every file (all or none). The
     FMUs run on the soil and wheel of ``choice`` (default: the paper's); a model identified on
     another soil or wheel is refused (ModelMismatch) unless ``allow_model_mismatch``; ``progress``
     is told how far the three runs are; the trajectory files keep a row every ``record_interval``
     [s] (the metrics and figures use every step). ``adapt``: also the run with the adaptive
     controller and that calibration (trajectories_adaptive.csv, rms_adaptive.csv, and what it
-    estimated and when it switched in simulation.json's ``adaptation``)."""
+    estimated and when it switched in simulation.json's ``adaptation``). ``ruts``: the three runs with
+    multi-pass ruts (``jobs.ruts``; the adaptive one without)."""
     choice = as_choice(choice)
     check_options(record_interval, adapt)  # refused before anything runs
     campaign = Campaign("rover-cosim simulate", 4 if adapt else 3, progress)
@@ -275,10 +287,10 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     static_load = choice.rover.static_wheel_load(choice.soil.gravity)  # N, the fixed load of the ablation
     cosim_label = f"RoverBody + {choice.rover.wheels} Wheel"
     for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
-        tables[plant] = trajectories(campaign.run(plant, build(fmu_dir, models, choice)).data, plant)
+        tables[plant] = trajectories(campaign.run(plant, build(fmu_dir, models, choice, ruts=ruts)).data, plant)
         results[plant] = checks(tables[plant])
     ablation = rms(trajectories(campaign.run("fixed_load_ablation", monolithic_system(
-        fmu_dir, models, choice, fixed_load=static_load)).data, "monolithic"))
+        fmu_dir, models, choice, ruts=ruts, fixed_load=static_load)).data, "monolithic"))
     adaptation = None
     if adapt is not None:
         system = adaptive_system(fmu_dir, models, choice, calibration=adapt)
@@ -293,7 +305,9 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     ablation_table = pd.DataFrame({"limb": rms_mono["limb"], "rms_lut_N": rms_mono["rms_N"],
                                    "rms_fixed_load_N": ablation["rms_N"]})
     record = campaign.record({"stop_time_s": STOP_TIME, "model": str(model), "record_interval_s": record_interval,
-                              "fixed_load_ablation_N": static_load},
+                              "fixed_load_ablation_N": static_load,
+                              **({"ruts": "multi-pass ruts (jobs.ruts.RutBlock on the wheels' rutDepth)"} if ruts
+                                 else {})},
                              fmu_dir=fmu_dir, fmus=(rover_fmu(fmu_dir, "Rover", choice),
                                                     rover_fmu(fmu_dir, "RoverBody", choice), "Wheel"),
                              model=model, choice=choice,

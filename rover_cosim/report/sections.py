@@ -564,34 +564,62 @@ def legwheel_section(simulation: Path) -> list[str]:
 
 
 def effects_section(simulation: Path) -> list[str]:
-    """Grousers, slip-sinkage and multi-pass ruts (issue 48): the straight run with each switched on,
-    per wheel its sinkage and the controller's force error (Table 3's ablation), and the trends."""
+    """Grousers, slip-sinkage and multi-pass ruts (issue 48): Table 1 and Table 3 with each switched on,
+    with the smooth wheel's model and with the model identified with the effect; per wheel its sinkage;
+    the trends."""
     sections = ["<h2>Wheel effects: grousers, slip-sinkage, multi-pass ruts</h2>",
-                ("<p>The paper's straight run on Rover.fmu with one effect switched on at a time; the controller "
-                 "and its model are the smooth wheel's, so the RMS column shows the error each effect adds to the "
-                 "identified model. <b>Grousers</b>: the soil sheared at the grouser tips and on the trapped soil's "
+                ("<p>The paper's identification (Table 1) and straight run on Rover.fmu (Table 3) with one effect "
+                 "switched on at a time, each with the controller's model of the smooth wheel (what the effect "
+                 "costs an unaware model) and, for grousers and slip-sinkage, with the model identified again on "
+                 "SingleWheel.fmu with the effect on (the identification plan for that wheel and soil). "
+                 "<b>Grousers</b>: the soil sheared at the grouser tips and on the trapped soil's "
                  "sides (Ding et al. 2011; the wheel's own grousers, else 10 mm &times; 24, illustrative). "
                  "<b>Slip-sinkage</b>: the sinkage exponent n + n<sub>slip</sub>|s| (Ding et al. 2011; the soil's "
                  "own n<sub>slip</sub>, else 0.5, illustrative). <b>Multi-pass</b>: a rut participant gives the "
                  "middle and rear wheels the rut the wheel ahead left; the soil under its floor carried that "
-                 "pressure (Wong's repetitive loading, rigid reload). Cruise: t &ge; 10 s.</p>")]
+                 "pressure (Wong's repetitive loading, rigid reload); a single-wheel test bed runs one pass, so "
+                 "it has no model of its own. Cruise: t &ge; 10 s.</p>")]
     path = simulation / "effects_ablation.csv"
     if not path.exists():
         return [*sections, "<p>Not run (<code>rover-cosim simulate --only effects</code>).</p>"]
-    ablation = pd.read_csv(path)
     names = {"smooth": "smooth wheel", "grousers": "grousers", "slip_sinkage": "slip-sinkage",
              "multi_pass": "multi-pass"}
+    models = {"smooth_model": "smooth wheel's", "own_model": "identified with the effect"}
+    fits_path = simulation / "effects_table1.csv"
+    if fits_path.exists():
+        fits = pd.read_csv(fits_path)
+        rows = [{"variant": names.get(str(variant), str(variant)), "model": label,
+                 **{f"Fit {load:g} N [%]": fit for load, fit in zip(group["load_N"], group[f"fit_percent_{model}"])}}
+                for variant, group in fits.groupby("variant", sort=False) for model, label in models.items()]
+        sections += ["<p>Table 1 on each variant's test bed (Eq. 15 on the validation staircase).</p>",
+                     table(pd.DataFrame(rows), default="{:.1f}")]
+    ablation = pd.read_csv(path)
+    if "model" not in ablation:  # written before the re-identification
+        ablation = ablation.assign(model="smooth_model")
     wheels = sorted(ablation["wheel"].unique())
     half = wheels[: max(1, len(wheels) // 2)]  # one side: the other mirrors it on the straight run
     rows = []
-    for variant, group in ablation.groupby("variant", sort=False):
+    for (variant, model), group in ablation.groupby(["variant", "model"], sort=False):
         group = group.set_index("wheel")
-        rows.append({"variant": names.get(str(variant), str(variant)),
+        rows.append({"variant": names.get(str(variant), str(variant)), "model": models.get(str(model), str(model)),
                      **{f"sinkage {i} [mm]": 1000 * group.loc[i, "sinkage_mean_m"] for i in half},
                      **{f"RMS {i} [N]": group.loc[i, "rms_N"] for i in half}})
-    sections += [f"<p>Wheels {', '.join(map(str, half))} (one side; the other mirrors it).</p>",
-                 table(pd.DataFrame(rows), default="{:.3g}"),
-                 image(simulation / "effects_trends.png", "the models' trends: drawbar pull at 20 % slip against "
+    sections += [f"<p>Table 3 with each effect: wheels {', '.join(map(str, half))} (one side; the other mirrors "
+                 "it).</p>",
+                 table(pd.DataFrame(rows), default="{:.3g}")]
+    turn_path = simulation / "effects_path_sinkage.csv"
+    if turn_path.exists():
+        turn = pd.read_csv(turn_path)
+        turn = turn[turn["wheel"].isin(half) | turn["wheel"].isin([w + len(half) for w in half])]
+        sections += ["<p>The path following's turn (90&deg; left, radius 10 m, SteerableRover.fmu) without and with "
+                     "ruts: mean sinkage per wheel on the first straight and on the arc, where the rear wheels leave "
+                     "the front wheels' tracks in part (wheels 1&ndash;3 left, 4&ndash;6 right, front to rear).</p>",
+                     table(turn.assign(**{"sinkage, virgin soil [mm]": 1000 * turn["sinkage_smooth_m"],
+                                          "sinkage, ruts [mm]": 1000 * turn["sinkage_multi_pass_m"],
+                                          "rut under the wheel [mm]": 1000 * turn["rut_depth_m"]})
+                           [["phase", "wheel", "sinkage, virgin soil [mm]", "sinkage, ruts [mm]",
+                             "rut under the wheel [mm]"]], default="{:.3g}")]
+    sections += [image(simulation / "effects_trends.png", "the models' trends: drawbar pull at 20 % slip against "
                        "grouser height and count, sinkage against slip with slip-sinkage")]
     return sections
 
