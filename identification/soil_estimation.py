@@ -94,6 +94,7 @@ SPECS: dict[str, ParameterSpec] = {spec.name: spec for spec in (
     ParameterSpec("ky", "lateral shear modulus k_y", True, 1e-4, 0.3, 1.0, _FACTOR_4),
     ParameterSpec("ky_beta", "growth of k_y with the slip angle", False, 0.0, 0.3, 0.01, 0.02),
     ParameterSpec("kx_beta", "growth of k_x with the slip angle", False, 0.0, 0.3, 0.01, 0.02),
+    ParameterSpec("n_slip", "slip-sinkage growth of n (n + n_slip |s|)", False, 0.0, 2.0, 0.1, 0.2),
 )}
 #: The search bounds of each parameter [SI]: (low, high).
 BOUNDS = {name: (spec.low, spec.high) for name, spec in SPECS.items()}
@@ -151,6 +152,8 @@ def plan_parameters(data: TestBedData, prior: Soil = Soil(), parameters: Sequenc
     _plan_pressure(facts, estimated, fixed, statements, wheel)
     _plan_patch(facts, optional, fixed, statements)
     _plan_lateral(facts, estimated, optional, fixed, statements)
+    _plan_slip_sinkage(facts, prior, estimated, fixed, statements)
+    _plan_grousers(wheel, statements)
     return ParameterPlan(tuple(estimated), tuple(optional),
                          tuple(FixedParameter(name, getattr(prior, name), reason) for name, reason in fixed.items()),
                          tuple(statements))
@@ -166,14 +169,16 @@ class _Facts:
     loads: int  # distinct loads
     angles_force: int  # distinct |slip angle| among rows (with a force column)
     angles_lateral: int  # distinct |slip angle| != 0
+    slips: int  # the most distinct |slip| at one load
 
     @staticmethod
     def of(data: TestBedData) -> _Facts:
         beta = np.abs(data.slip_angle_rad)
         force = data.Fx_N is not None or data.Tx_Nm is not None
         lateral = data.Fy_N is not None and bool(np.any(beta > 0))
+        slips = max(_distinct(np.abs(data.slip[data.load_N == load])) for load in np.unique(data.load_N))
         return _Facts(force, data.sinkage_m is not None, lateral, _distinct(data.load_N),
-                      _distinct(beta) if force else 0, _distinct(beta[beta > 0]) if lateral else 0)
+                      _distinct(beta) if force else 0, _distinct(beta[beta > 0]) if lateral else 0, slips)
 
 
 def _plan_shear(facts: _Facts, estimated: list[str], fixed: dict[str, str], statements: list[str]) -> None:
@@ -243,6 +248,38 @@ def _plan_lateral(facts: _Facts, estimated: list[str], optional: list[str], fixe
                       "gravity); X_c follows the estimated φ where the prior derives it from φ.")
 
 
+#: Distinct |slip| at one load that slip-sinkage needs: its growth of the exponent beside n itself.
+SLIP_SINKAGE_SLIPS = 3
+
+
+def _plan_slip_sinkage(facts: _Facts, prior: Soil, estimated: list[str], fixed: dict[str, str],
+                       statements: list[str]) -> None:
+    """Slip-sinkage (Soil.n_slip) is estimated where the prior has it on (n_slip > 0: the user's
+    choice of the model) and the data show a load at several slips; off, nothing changes."""
+    if prior.n_slip == 0:
+        return
+    if facts.slips < SLIP_SINKAGE_SLIPS or not (facts.sinkage or facts.force):
+        fixed["n_slip"] = (f"slip-sinkage on (the prior's n_slip = {prior.n_slip:g}) but no load measured at "
+                           f"{SLIP_SINKAGE_SLIPS} or more slips: its growth of the exponent with slip needs them")
+        return
+    estimated.append("n_slip")
+    statements.append(f"Slip-sinkage on (the prior's n_slip = {prior.n_slip:g}): n_slip is estimated from how the "
+                      "sinkage and the forces change with slip at a fixed load" + (
+                          "." if facts.sinkage else "; without sinkage_m it is seen only through the compaction "
+                          "resistance and trades off with n and k_φ (expect wide intervals)."))
+
+
+def _plan_grousers(wheel: Wheel, statements: list[str]) -> None:
+    """What a grousered wheel means for the estimate (its grousers are the wheel's, not estimated)."""
+    if not wheel.grousered:
+        return
+    statements.append(f"The wheel's grousers ({wheel.grouser_count:g} of {1000 * wheel.grouser_height:g} mm) are "
+                      "part of the model (terramechanics.grousers: the soil sheared at the grousers' tips and on the "
+                      "trapped soil's sides); c, φ and k_x are the soil's under that model. The grouser model's own "
+                      "assumptions (how many grousers engage) are not estimated: a smooth wheel's fit to these data "
+                      "would put the grousers' thrust into c and φ.")
+
+
 def _requested(parameters: Sequence[str], facts: _Facts, prior: Soil, wheel: Wheel) -> ParameterPlan:
     names = [str(p).strip() for p in parameters]
     unknown = [p for p in names if p not in SPECS]
@@ -253,10 +290,12 @@ def _requested(parameters: Sequence[str], facts: _Facts, prior: Soil, wheel: Whe
         raise ValueError(f"parameters {names}: expected one or more distinct names" + (f" ({twice[0]} twice)"
                                                                                         if twice else ""))
     needs = {"c": facts.force, "phi": facts.force, "kx": facts.force, "ky": facts.lateral,
-             "ky_beta": facts.angles_lateral >= 2, "kx_beta": facts.force and facts.angles_force >= 2}
+             "ky_beta": facts.angles_lateral >= 2, "kx_beta": facts.force and facts.angles_force >= 2,
+             "n_slip": facts.slips >= SLIP_SINKAGE_SLIPS and (facts.sinkage or facts.force)}
     why = {"c": "a Fx_N or Tx_Nm column", "phi": "a Fx_N or Tx_Nm column", "kx": "a Fx_N or Tx_Nm column",
            "ky": "Fy_N at a slip angle other than 0", "ky_beta": "Fy_N at two or more slip angles other than 0",
-           "kx_beta": "Fx_N or Tx_Nm at two or more slip angles"}
+           "kx_beta": "Fx_N or Tx_Nm at two or more slip angles",
+           "n_slip": f"a load measured at {SLIP_SINKAGE_SLIPS} or more slips (sinkage or forces)"}
     for name in names:
         if not needs.get(name, True):
             raise ValueError(f"parameter {name} ({SPECS[name].words}) cannot be estimated from these data: it needs "
@@ -265,8 +304,9 @@ def _requested(parameters: Sequence[str], facts: _Facts, prior: Soil, wheel: Whe
     if "kc" in names and "kphi" in names:
         statements.append(f"k_c and k_φ both asked: they act only as k_c/b + k_φ (b = {wheel.b:g} m), so the data "
                           "cannot separate them; see their intervals.")
+    _plan_grousers(wheel, statements)
     fixed = tuple(FixedParameter(name, getattr(prior, name), "not asked (--parameters)")
-                  for name in SPECS if name not in names)
+                  for name in SPECS if name not in names and (name != "n_slip" or prior.n_slip != 0))
     return ParameterPlan(tuple(names), (), fixed, tuple(statements))
 
 

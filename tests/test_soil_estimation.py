@@ -117,6 +117,34 @@ def test_kc_and_kphi_asked_together_are_reported_as_inseparable():
     assert any("cannot separate them" in s for s in estimate.identifiability.statements)
 
 
+def test_a_grousered_wheel_with_slip_sinkage_gives_back_the_truth_and_a_smooth_fit_does_not(lunar: Soil):
+    """Issue 48: data of a grousered wheel on a soil with slip-sinkage. With the wheel's grousers and
+    slip-sinkage on in the prior, the noise-free data give back the soil, n_slip too; a smooth wheel's
+    fit puts the grousers' thrust into c and phi; the plan says what the grousers and n_slip mean."""
+    truth = replace(lunar, n_slip=0.3)
+    wheel = replace(Wheel(), grouser_height=0.01, grouser_count=24.0)
+    data = generate_testbed_data(truth, wheel)
+    right = estimate_soil(data, wheel, replace(Soil(), n_slip=0.1), ["c", "phi", "kphi", "n", "kx", "n_slip"])
+    for name in ("c", "phi", "kx", "n", "n_slip"):
+        assert right.parameters[name].value == pytest.approx(getattr(truth, name), rel=1e-6), name
+    statements = " ".join(right.identifiability.statements)
+    assert "grousers (24 of 10 mm) are part of the model" in statements
+    smooth = estimate_soil(data, Wheel(), Soil())
+    assert smooth.parameters["c"].value > 1.5 * truth.c and smooth.parameters["phi"].value > truth.phi + 0.05
+    # the default plan: n_slip estimated where the prior has slip-sinkage on and a load has 3+ slips
+    plan = plan_parameters(data, replace(Soil(), n_slip=0.1), wheel=wheel)
+    assert "n_slip" in plan.estimated and any("Slip-sinkage on" in s for s in plan.statements)
+    few = generate_testbed_data(truth, wheel, slips=(0.1, 0.4))
+    fixed = {f.name: f.reason for f in plan_parameters(few, replace(Soil(), n_slip=0.1), wheel=wheel).fixed}
+    assert "3 or more slips" in fixed["n_slip"]
+    with pytest.raises(ValueError, match=r"parameter n_slip .* cannot be estimated from these data: it needs a load "
+                                         r"measured at 3 or more slips"):
+        estimate_soil(few, wheel, parameters=["phi", "n_slip"])
+    # slip-sinkage off in the prior: the plan as before, n_slip nowhere
+    off = plan_parameters(data)
+    assert "n_slip" not in off.estimated and "n_slip" not in {f.name for f in off.fixed}
+
+
 def test_too_few_points_for_the_parameters_are_refused_with_the_counts():
     data = generate_testbed_data(Soil(), loads=(200, 400), slips=(0.1, 0.5), channels=("Fx_N",))
     with pytest.raises(ValueError, match=r"4 rows x 1 measured columns = 4 measurements for 5 parameters \(c, phi, "
