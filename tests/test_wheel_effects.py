@@ -151,3 +151,18 @@ def test_bad_effect_parameters_name_the_value():
     with pytest.raises(ValueError, match="rut_depth"):
         wheel_state(LOAD, 0.1, rut_depth=-0.01)
     assert replace(GROUSERED, grouser_count=0).grousered is False
+
+
+def test_slip_sinkage_reaches_the_band_a_source_measured_and_the_smooth_law_does_not():
+    """Ding et al. 2010 measured lugged wheels sinking 3-7 times their static sinkage at 60 % slip: the
+    smooth law stays near 1, the n_slip band that spans 3-7 holds the ablation's default n_slip and
+    gives the band's ends back."""
+    from rover_cosim.jobs.effects import DEFAULT_N_SLIP, SLIP_SINKAGE_REPORTED, n_slip_band, sinkage_ratio
+
+    slip, low, high, _ = SLIP_SINKAGE_REPORTED
+    wheel, soil, load = Wheel(), Soil(), 424.0
+    assert sinkage_ratio(wheel, soil, load, 0.0, slip) < 1.2 < low
+    first, last = n_slip_band(wheel, soil, load)
+    assert 0 < first < DEFAULT_N_SLIP < last
+    assert sinkage_ratio(wheel, soil, load, first, slip) == pytest.approx(low, rel=1e-6)
+    assert sinkage_ratio(wheel, soil, load, last, slip) == pytest.approx(high, rel=1e-6)

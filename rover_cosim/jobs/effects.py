@@ -23,6 +23,7 @@ results/simulation/
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -39,6 +40,7 @@ from rover_cosim.identification.plan import IdentificationPlan, plan_for
 from rover_cosim.identification.sweep import SweepPlan
 from rover_cosim.identification.testbed import shared_test_bed
 from rover_cosim.identification.validate import validate
+from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.library import Choice, as_choice, describe
 from rover_cosim.terramechanics.sinkage import wheel_state
 
@@ -58,11 +60,16 @@ VARIANTS = {"smooth": "the paper's smooth wheel on virgin soil",
 REIDENTIFIED = ("grousers", "slip_sinkage")
 #: The ablation's two controllers: the smooth wheel's identified model, the variant's own.
 SMOOTH_MODEL, OWN_MODEL = "smooth_model", "own_model"
+#: Slip-sinkage as measured: at 60 % slip lugged wheels sank 3-7 times their static sinkage (Ding, Gao,
+#: Deng, Tao, "Wheel slip-sinkage and its prediction model of lunar rover", J. Cent. South Univ. Technol.
+#: 17:129-135, 2010, abstract; three wheels with lugs of several heights and counts on a lunar simulant).
+SLIP_SINKAGE_REPORTED = (0.6, 3.0, 7.0, "Ding et al. 2010")
 #: Grousers for a wheel that has none of its own: 10 mm, 24 around the rim (illustrative: the size
 #: class of the single-wheel test beds' grousers, e.g. Ding et al. 2011's 10 mm).
 DEFAULT_GROUSERS = (0.01, 24.0)
-#: Slip-sinkage growth of the sinkage exponent for a soil without its own (illustrative).
-DEFAULT_N_SLIP = 0.5
+#: Slip-sinkage growth of the sinkage exponent for a soil without its own: inside the band that gives
+#: SLIP_SINKAGE_REPORTED on the paper's soil (n_slip 0.79-1.99; ``n_slip_band``).
+DEFAULT_N_SLIP = 1.0
 CRUISE_FROM = 10.0  # s
 
 
@@ -176,9 +183,38 @@ def trends(choice: Choice) -> Trends:
     pull_by_count = np.array([float(wheel_state(load, 0.2, replace(wheel, grouser_height=height_at, grouser_count=n),
                                                 soil).Fx) for n in counts])
     sinkage = {n_slip: wheel_state(load, slips, wheel, replace(soil, n_slip=n_slip)).sinkage
-               for n_slip in (0.0, 0.25, 0.5, 1.0)}
+               for n_slip in (0.0, 0.25, 0.5, 1.0, 2.0)}
     return Trends(heights, count_at, pull_by_height, counts, height_at, pull_by_count, slips, sinkage,
-                  f"wheel r = {wheel.r:g} m, b = {wheel.b:g} m at {load:.0f} N on the chosen soil")
+                  f"wheel r = {wheel.r:g} m, b = {wheel.b:g} m at {load:.0f} N on the chosen soil",
+                  SLIP_SINKAGE_REPORTED, n_slip_band(wheel, soil, load))
+
+
+def sinkage_ratio(wheel: Wheel, soil: Soil, load: float, n_slip: float, slip: float) -> float:
+    """The sinkage at ``slip`` over the static sinkage [1] under ``load`` [N] with ``n_slip``; inf where the
+    wheel sinks to its radius."""
+    try:
+        state = wheel_state(load, np.array([0.0, slip]), wheel, replace(soil, n_slip=n_slip))
+    except ValueError:
+        return math.inf
+    return float(state.sinkage[1] / state.sinkage[0])
+
+
+def n_slip_band(wheel: Wheel, soil: Soil, load: float) -> tuple[float, float]:
+    """The n_slip [1] whose sinkage ratio at the reported slip spans SLIP_SINKAGE_REPORTED's band on
+    ``soil`` (the ratio grows with n_slip; bisection; nan where the band is out of reach)."""
+    slip, low, high, _ = SLIP_SINKAGE_REPORTED
+
+    def solve(ratio: float) -> float:
+        below, above = 0.0, 4.0
+        if not sinkage_ratio(wheel, soil, load, below, slip) < ratio < sinkage_ratio(wheel, soil, load, above, slip):
+            return math.nan
+        for _ in range(50):
+            middle = 0.5 * (below + above)
+            below, above = (middle, above) if sinkage_ratio(wheel, soil, load, middle, slip) < ratio else (below,
+                                                                                                           middle)
+        return 0.5 * (below + above)
+
+    return solve(low), solve(high)
 
 
 def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None = None, *,
@@ -228,10 +264,15 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
     variants = {v: {"wheel": asdict(c.wheel), "soil_n_slip": c.soil.n_slip, "what": VARIANTS[v],
                     "identification_plan": plan_for(c).to_dict() if v in ("smooth", *REIDENTIFIED) else None}
                 for v, c in chosen.items()}
+    trend = trends(choice)
     record = campaign.record({"stop_time_s": 20.0, "step_s": STEP, "cruise_from_s": CRUISE_FROM, "model": str(model),
                               "path": {"scenario": PATH_SCENARIO, "straight_m": straight,
                                        "stop_time_s": path_following.stop_time(PATH_SCENARIO, straight)},
                               "variants": variants,
+                              "slip_sinkage_reported": {"slip": SLIP_SINKAGE_REPORTED[0],
+                                                        "sinkage_ratio": list(SLIP_SINKAGE_REPORTED[1:3]),
+                                                        "source": SLIP_SINKAGE_REPORTED[3],
+                                                        "n_slip_band": list(trend.n_slip_band)},
                               "controllers": {SMOOTH_MODEL: "the model identified on the smooth wheel (--model)",
                                               OWN_MODEL: "the variant's model, identified again on SingleWheel.fmu "
                                                          "with the effect on (grousers, slip-sinkage)"}},
@@ -244,7 +285,7 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
              out / "effects_sinkage.csv": sinkage_table.to_csv(index=False, float_format="%.6g").encode(),
              out / "effects_path_sinkage.csv": path_sinkage.to_csv(index=False, float_format="%.6g").encode(),
              **{out / f"effects_model_{v}.json": m.to_json() for v, m in own.items()},
-             out / "effects_trends.png": effects_figures.trends(trends(choice)),
+             out / "effects_trends.png": effects_figures.trends(trend),
              out / "effects.json": json_bytes(record)}
     written = campaign.write(out, files)
     return EffectsResult(written, record, ablation, sinkage_table, table_1, path_sinkage)

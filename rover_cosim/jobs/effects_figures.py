@@ -25,6 +25,10 @@ class Trends(NamedTuple):
     slips: FloatArray  #: slip ratios [1]
     sinkage_by_n_slip: dict[float, FloatArray]  #: sinkage [m] per slip, for each n_slip [1]
     title: str
+    #: A source's measured sinkage at a slip: (slip [1], least and largest ratio to the static
+    #: sinkage [1], the source in words), and the n_slip [1] range that gives it on the chosen soil.
+    reported: tuple[float, float, float, str]
+    n_slip_band: tuple[float, float]
 
 
 def trends(data: Trends) -> bytes:
@@ -36,11 +40,16 @@ def trends(data: Trends) -> bytes:
     axes[1].plot(data.counts, data.pull_by_count, "o-")
     axes[1].set(xlabel=f"number of grousers ({1e3 * data.height_at:g} mm high)",
                 ylabel="drawbar pull Fx at 20 % slip [N]",
-                title="grousers: count (saturates once one is always engaged)")
+                title="grousers: count")
     for n_slip, sinkage in data.sinkage_by_n_slip.items():
-        axes[2].plot(data.slips, 1e3 * sinkage, label=f"n_slip = {n_slip:g}")
-    axes[2].set(xlabel="slip ratio [-]", ylabel="sinkage [mm]", title="slip-sinkage: n + n_slip |slip|")
-    axes[2].legend()
+        axes[2].plot(data.slips, sinkage / sinkage[0], label=f"n_slip = {n_slip:g}")
+    slip, low, high, source = data.reported
+    axes[2].errorbar([slip], [0.5 * (low + high)], yerr=[[0.5 * (high - low)]], fmt="none", ecolor="black",
+                     capsize=6, lw=2, label=f"measured, {source}: {low:g}-{high:g}x at slip {slip:g}\n"
+                                            f"(n_slip {data.n_slip_band[0]:.2g}-{data.n_slip_band[1]:.2g} here)")
+    axes[2].set(xlabel="slip ratio [-]", ylabel="sinkage / static sinkage [-]",
+                title="slip-sinkage: exponent n + n_slip |slip|")
+    axes[2].legend(fontsize=8)
     for axis in axes:
         axis.grid(alpha=0.3)
     figure.suptitle(data.title)

@@ -575,7 +575,10 @@ def effects_section(simulation: Path) -> list[str]:
                  "<b>Grousers</b>: the soil sheared at the grouser tips and on the trapped soil's "
                  "sides (Ding et al. 2011; the wheel's own grousers, else 10 mm &times; 24, illustrative). "
                  "<b>Slip-sinkage</b>: the sinkage exponent n + n<sub>slip</sub>|s| (Ding et al. 2011; the soil's "
-                 "own n<sub>slip</sub>, else 0.5, illustrative). <b>Multi-pass</b>: a rut participant gives the "
+                 "own n<sub>slip</sub>, else 1.0: lugged wheels sank 3&ndash;7 times their static sinkage at 60 % "
+                 "slip in Ding et al. 2010's tests, which n<sub>slip</sub> 0.8&ndash;2 gives on the paper's soil; see "
+                 "the "
+                 "figure). <b>Multi-pass</b>: a rut participant gives the "
                  "middle and rear wheels the rut the wheel ahead left; the soil under its floor carried that "
                  "pressure (Wong's repetitive loading, rigid reload); a single-wheel test bed runs one pass, so "
                  "it has no model of its own. Cruise: t &ge; 10 s.</p>")]
