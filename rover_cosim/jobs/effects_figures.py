@@ -45,11 +45,11 @@ def trends(data: Trends) -> bytes:
         axes[2].plot(data.slips, sinkage / sinkage[0], label=f"n_slip = {n_slip:g}")
     slip, low, high, source = data.reported
     axes[2].errorbar([slip], [0.5 * (low + high)], yerr=[[0.5 * (high - low)]], fmt="none", ecolor="black",
-                     capsize=6, lw=2, label=f"measured, {source}: {low:g}-{high:g}x at slip {slip:g}\n"
+                     capsize=6, lw=2, label=f"measured, {source}:\n{low:g}-{high:g}x at slip {slip:g}\n"
                                             f"(n_slip {data.n_slip_band[0]:.2g}-{data.n_slip_band[1]:.2g} here)")
     axes[2].set(xlabel="slip ratio [-]", ylabel="sinkage / static sinkage [-]",
                 title="slip-sinkage: exponent n + n_slip |slip|")
-    axes[2].legend(fontsize=8)
+    axes[2].legend(fontsize=8, loc="upper left")
     for axis in axes:
         axis.grid(alpha=0.3)
     figure.suptitle(data.title)
