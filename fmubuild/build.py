@@ -22,9 +22,9 @@ import tempfile
 import threading
 import time
 import zipfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
-from contextlib import ExitStack
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
@@ -239,6 +239,26 @@ def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries
     return seconds
 
 
+@contextmanager
+def _one_build_at_a_time(lock: Path) -> Iterator[None]:
+    """Hold the advisory lock file ``lock`` (created where missing, in the temporary folder: the FMUs'
+    folder holds FMUs only): another process building the same FMU into the same folder (a second
+    `make fmus`, a parallel test worker) waits, then finds it up to date. Where the platform has no ``fcntl`` (Windows) builds are not serialised; each FMU still
+    appears whole (written to a partial file, then renamed)."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    with open(lock, "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
 def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Sequence[str] = (HOST,),
               compile_jobs: int | None = None, step: StepReport | None = None, fmi_version: int = 2,
               axles: int | None = None) -> BuildResult:
@@ -247,7 +267,17 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
     zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time; ``step`` hears of
     each stage as it ends. ``fmi_version`` 3: an FMI 3.0 FMU of the same model code (the runtime's
     FMI 3.0 layer, the FMI 3.0 model description and platform folders). ``axles``: a rover FMU
-    built for that many wheels per side (:func:`source.variant_source`; None: the package's own)."""
+    built for that many wheels per side (:func:`source.variant_source`; None: the package's own).
+    One process at a time builds a given FMU into a given folder (``_one_build_at_a_time``)."""
+    folder = hashlib.sha256(str(Path(out_dir).resolve()).encode()).hexdigest()[:16]
+    with _one_build_at_a_time(Path(tempfile.gettempdir()) / "rover-cosim-build-locks" / f"{folder}-{name}.lock"):
+        return _build_fmu(name, Path(out_dir), force=force, platforms=platforms, compile_jobs=compile_jobs,
+                          step=step, fmi_version=fmi_version, axles=axles)
+
+
+def _build_fmu(name: str, out_dir: Path, *, force: bool, platforms: Sequence[str], compile_jobs: int | None,
+               step: StepReport | None, fmi_version: int, axles: int | None) -> BuildResult:
+    """build_fmu, the lock held."""
     _check_version(fmi_version)
     if axles is not None:
         source.variant_source(name, axles)  # a clear error for a model or count it cannot take
