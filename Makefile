@@ -115,14 +115,18 @@ cosim-study: fmus
 
 ## test: the test suite (python -P keeps the checkout's folder off sys.path, as for an installed
 ## wheel; without it the layer folders still import only as rover_cosim.*: `import orchestrator`
-## fails with a message, so `python -m pytest` works the same)
+## fails with a message, so `python -m pytest` works the same). On every core (pytest-xdist: TEST_WORKERS
+## processes, each module on one of them so that its fixtures are built once; TEST_WORKERS=0 runs
+## in this process); the 30 slowest tests listed at the end.
+TEST_WORKERS ?= auto
+TEST_PARALLEL := $(if $(filter 0,$(TEST_WORKERS)),,-n $(TEST_WORKERS) --dist loadscope)
 test: $(STAMP)
-	$(PY) -P -m pytest
+	$(PY) -P -m pytest $(TEST_PARALLEL) --durations=30
 
 ## test-fast: the tests that build and run no FMU (physics, engine logic, CLI parsing, soils, report
 ## pages, fuzz): seconds, for the edit-test loop; make test runs them all
 test-fast: $(STAMP)
-	$(PY) -P -m pytest -m "not fmu and not slow" -q
+	$(PY) -P -m pytest $(TEST_PARALLEL) -m "not fmu and not slow" -q
 
 ## fuzz: a seeded fuzz of hostile inputs through the command line (system files, studies, soils,
 ## options, model descriptions, report inputs): every case must end in a message and exit 0/1/2,
