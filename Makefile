@@ -159,6 +159,7 @@ bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_identification.py --out $(RESULTS)/bench/identification.json
 	$(PY) -P benchmarks/bench_controller.py --out $(RESULTS)/bench/controller.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_soil_estimation.py --out $(RESULTS)/bench/soil_estimation.json --markdown $(RESULTS)/bench/soil_estimation.md
+	$(PY) -P benchmarks/bench_quadrature.py --out $(RESULTS)/bench/quadrature.json --markdown $(RESULTS)/bench/quadrature.md
 	$(PY) -P benchmarks/bench_closed_loop.py --out $(RESULTS)/bench/closed_loop.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_path_following.py --out $(RESULTS)/bench/path_following.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_legwheel.py --out $(RESULTS)/bench/legwheel.json --model $(RESULTS)/identification/model.json
