@@ -71,9 +71,9 @@ def measure() -> dict[str, Any]:
                 started = time.perf_counter()
                 state = wheel_state(load, slip, wheel, soil, nodes=n, rtol=RTOL, slip_angle=beta)
                 seconds[n] += time.perf_counter() - started
-                for channel, error in _errors(state, reference, wheel.r).items():
-                    if error > worst[n][channel]:
-                        worst[n][channel] = error
+                for channel, value in _errors(state, reference, wheel.r).items():
+                    if value > worst[n][channel]:
+                        worst[n][channel] = value
                         where[n][channel] = f"{soil_name}/{wheel_name} at {factor:g}x the static load"
     rows = [{"nodes_per_piece": n, **{f"max_error_{k}": worst[n][k] for k in CHANNELS},
              "worst_case_Fx": where[n].get("Fx", ""), "numpy_seconds": seconds[n]} for n in COUNTS]

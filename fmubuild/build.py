@@ -243,8 +243,9 @@ def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries
 def _one_build_at_a_time(lock: Path) -> Iterator[None]:
     """Hold the advisory lock file ``lock`` (created where missing, in the temporary folder: the FMUs'
     folder holds FMUs only): another process building the same FMU into the same folder (a second
-    `make fmus`, a parallel test worker) waits, then finds it up to date. Where the platform has no ``fcntl`` (Windows) builds are not serialised; each FMU still
-    appears whole (written to a partial file, then renamed)."""
+    `make fmus`, a parallel test worker) waits, then finds it up to date. Where the platform has no
+    ``fcntl`` (Windows) builds are not serialised; each FMU still appears whole (written to a partial
+    file, then renamed)."""
     try:
         import fcntl
     except ImportError:
