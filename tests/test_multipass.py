@@ -44,17 +44,18 @@ def test_the_effects_ablation_runs_and_the_rear_wheels_sink_deeper_in_the_ruts(f
     import pandas as pd
 
     from rover_cosim.identification.model_set import ModelSet
-    from rover_cosim.jobs.effects import OWN_MODEL, REIDENTIFIED, SMOOTH_MODEL, VARIANTS, run_effects
+    from rover_cosim.jobs.effects import GIVEN_MODEL, OWN_MODEL, VARIANTS, run_effects
 
     result = run_effects(fmus["Rover"].parent, results_root / "identification" / "model.json", tmp_path,
                          straight=3.0)  # the turn's straights shortened from 10 m
     ablation = pd.read_csv(tmp_path / "effects_ablation.csv")
     assert list(ablation["variant"].unique()) == list(VARIANTS)
-    by_model = {label: ablation[ablation["model"] == label] for label in (SMOOTH_MODEL, OWN_MODEL)}
-    assert list(by_model[OWN_MODEL]["variant"].unique()) == list(REIDENTIFIED)
+    by_model = {label: ablation[ablation["model"] == label] for label in (GIVEN_MODEL, OWN_MODEL)}
+    reidentified = ["grousers", "slip_sinkage"]  # the paper's model is the smooth wheel's: its own elsewhere
+    assert list(by_model[OWN_MODEL]["variant"].unique()) == reidentified
     sinkage = result.sinkage.set_index("wheel")
     # the paper's smooth wheel: the straight run's Table 3 figures (below 1 N), wheels 4-6 mirror 1-3
-    smooth = by_model[SMOOTH_MODEL][by_model[SMOOTH_MODEL]["variant"] == "smooth"].set_index("wheel")
+    smooth = by_model[GIVEN_MODEL][by_model[GIVEN_MODEL]["variant"] == "smooth"].set_index("wheel")
     assert (smooth["rms_N"] < 1.0).all()
     np.testing.assert_allclose(smooth.loc[[4, 5, 6], "rms_N"].to_numpy(), smooth.loc[[1, 2, 3], "rms_N"].to_numpy())
     # multi-pass: each wheel deeper than the one ahead, by less each time; the front one on virgin soil
@@ -63,8 +64,8 @@ def test_the_effects_ablation_runs_and_the_rear_wheels_sink_deeper_in_the_ruts(f
     assert ruts[3] > ruts[2] > ruts[1] and ruts[3] - ruts[2] < ruts[2] - ruts[1]
     # slip-sinkage sinks every wheel at least as deep; grousers change the pull, hence the model's error
     assert (sinkage["sinkage_slip_sinkage_m"] >= sinkage["sinkage_smooth_m"]).all()
-    for variant in REIDENTIFIED:
-        unaware = by_model[SMOOTH_MODEL][by_model[SMOOTH_MODEL]["variant"] == variant].set_index("wheel")
+    for variant in reidentified:
+        unaware = by_model[GIVEN_MODEL][by_model[GIVEN_MODEL]["variant"] == variant].set_index("wheel")
         aware = by_model[OWN_MODEL][by_model[OWN_MODEL]["variant"] == variant].set_index("wheel")
         assert (unaware["rms_N"] > smooth["rms_N"]).all(), variant
         # the model identified with the effect controls better than the smooth wheel's
@@ -73,10 +74,10 @@ def test_the_effects_ablation_runs_and_the_rear_wheels_sink_deeper_in_the_ruts(f
     # on, the smooth wheel's model fits worse than the one identified with it
     fits = result.table1.set_index(["variant", "load_N"])
     paper = pd.read_csv(results_root / "identification" / "fit_table.csv").set_index("load_N")["fit_percent"]
-    np.testing.assert_allclose(fits.loc["smooth", f"fit_percent_{SMOOTH_MODEL}"].to_numpy(), paper.to_numpy(),
+    np.testing.assert_allclose(fits.loc["smooth", f"fit_percent_{GIVEN_MODEL}"].to_numpy(), paper.to_numpy(),
                                atol=1e-3)
-    for variant in REIDENTIFIED:
-        assert (fits.loc[variant, f"fit_percent_{OWN_MODEL}"] > fits.loc[variant, f"fit_percent_{SMOOTH_MODEL}"]).all()
+    for variant in reidentified:
+        assert (fits.loc[variant, f"fit_percent_{OWN_MODEL}"] > fits.loc[variant, f"fit_percent_{GIVEN_MODEL}"]).all()
     assert {p.name for p in result.files} == {"effects_ablation.csv", "effects_sinkage.csv", "effects_trends.png",
                                               "effects.json", "effects_table1.csv", "effects_model_grousers.json",
                                               "effects_model_slip_sinkage.json", "effects_path_sinkage.csv"}
@@ -85,7 +86,7 @@ def test_the_effects_ablation_runs_and_the_rear_wheels_sink_deeper_in_the_ruts(f
     turn = result.path_sinkage.set_index(["phase", "wheel"])
     straight = turn.loc["straight"]
     assert straight.loc[1, "rut_depth_m"] == 0.0 and (straight.loc[[2, 5], "rut_depth_m"] > 0.01).all()
-    assert (straight.loc[[2, 5], "sinkage_multi_pass_m"] > straight.loc[[2, 5], "sinkage_smooth_m"] + 2e-3).all()
+    assert (straight.loc[[2, 5], "sinkage_ruts_m"] > straight.loc[[2, 5], "sinkage_virgin_m"] + 2e-3).all()
     assert (turn.loc["arc"].loc[[2, 5], "rut_depth_m"] < 0.5 * straight.loc[[2, 5], "rut_depth_m"]).all()
     reread = ModelSet.read(tmp_path / "effects_model_grousers.json")
     assert reread.details["wheel"]["values"]["grouser_count"] == 24.0
@@ -112,3 +113,27 @@ def test_the_straight_run_with_ruts_agrees_on_both_plants(fmus, identified, resu
         assert ruts[0] == 0.0 and ruts[1] > 0.02 and ruts[2] > ruts[1], plant
         assert sinkage[plant][2] > sinkage[plant][1] > sinkage[plant][0] + 2e-3, plant
     np.testing.assert_allclose(sinkage["cosim"], sinkage["monolithic"], rtol=2e-3)
+
+
+def test_each_variant_has_its_effect_alone_on_the_chosen_wheel_made_smooth():
+    """The ablation's variants on a grousered wheel and a soil with slip-sinkage (MSL's wheel): smooth
+    and multi-pass without either, grousers with the wheel's own, slip-sinkage with the soil's own."""
+    from dataclasses import replace
+
+    from rover_cosim.jobs.effects import DEFAULT_GROUSERS, DEFAULT_N_SLIP, variant_choice
+    from rover_cosim.terramechanics.library import choose
+
+    msl = choose(wheel="msl")
+    msl = replace(msl, soil=replace(msl.soil, n_slip=0.7))
+    smooth = variant_choice(msl, "smooth")
+    assert not smooth.wheel.grousered and smooth.soil.n_slip == 0 and smooth.wheel.r == msl.wheel.r
+    assert variant_choice(msl, "multi_pass") == smooth
+    grousers = variant_choice(msl, "grousers")
+    assert (grousers.wheel.grouser_height, grousers.wheel.grouser_count) == (0.0075, 24.0)
+    assert grousers.soil.n_slip == 0
+    assert variant_choice(msl, "slip_sinkage").soil.n_slip == 0.7
+    assert not variant_choice(msl, "slip_sinkage").wheel.grousered
+    paper = choose()
+    assert (variant_choice(paper, "grousers").wheel.grouser_height,
+            variant_choice(paper, "grousers").wheel.grouser_count) == DEFAULT_GROUSERS
+    assert variant_choice(paper, "slip_sinkage").soil.n_slip == DEFAULT_N_SLIP

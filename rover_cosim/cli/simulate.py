@@ -178,8 +178,8 @@ def _print_path(outcome: Any) -> None:
 def print_effects(outcome: Any) -> None:
     """What the wheel-effects ablation measured (jobs.effects.EffectsResult): Table 1 and, per run, the
     sinkage and RMS(Fx - Fx_des) of one side's wheels (the other mirrors it on the straight run)."""
-    print("Table 1 with each wheel effect on: Fit [%] on the variant's test bed of the smooth wheel's model and "
-          "of the model identified with the effect:")
+    print("Table 1 with each wheel effect on: Fit [%] on the variant's test bed of the given model (--model) and "
+          "of the variant's own:")
     fits = outcome.table1.melt(id_vars=["variant", "load_N"], var_name="model", value_name="fit")
     fits["model"] = fits["model"].str.removeprefix("fit_percent_")
     order = [(v, m) for v in outcome.table1["variant"].unique() for m in fits["model"].unique()]
@@ -197,7 +197,7 @@ def print_effects(outcome: Any) -> None:
     print(runs.to_string(float_format=lambda v: f"{v:.3g}"))
     turn = outcome.path_sinkage.set_index(["phase", "wheel"]) * 1e3
     print("The turn without and with ruts, mean per phase [mm]:")
-    print(turn.rename(columns={"sinkage_smooth_m": "sinkage, virgin soil", "sinkage_multi_pass_m": "sinkage, ruts",
+    print(turn.rename(columns={"sinkage_virgin_m": "sinkage, virgin soil", "sinkage_ruts_m": "sinkage, ruts",
                                "rut_depth_m": "rut under the wheel"}).to_string(float_format=lambda v: f"{v:.3g}"))
     print_written(outcome.files)
 

@@ -1,22 +1,27 @@
 """``rover-cosim simulate --only effects``: the paper's straight run (Sec. 4, Table 3) with each wheel
-effect of issue 48 switched on alone (grousers, slip-sinkage, multi-pass ruts), on Rover.fmu with the
-controller and the model identified on the smooth wheel, and for grousers and slip-sinkage also with
-the model identified again on SingleWheel.fmu with the effect on (the identification plan for the
-variant, ``identification.plan.plan_for``): how much each effect changes the sinkage of every wheel,
-Table 1's Fit of the smooth wheel's model and of the re-identified one on the variant's test bed, and
-the controller's force error with each (the ablation of Table 1 and Table 3); and the trends each
-model claims (drawbar pull against grouser height and count, sinkage against slip). Multi-pass has no
-re-identification: a single-wheel test bed runs one pass on virgin soil.
+effect of issue 48 switched on alone on the chosen wheel and soil made smooth (grousers, slip-sinkage,
+multi-pass ruts), on Rover.fmu, with the controller and model given (identified on the chosen wheel and
+soil: for the paper's, the smooth wheel) and with the variant's own model, identified again on
+SingleWheel.fmu with its wheel and soil (the identification plan for it, ``identification.plan.plan_for``)
+where these are not the chosen ones: how much each effect changes the sinkage of every wheel, Table 1's
+Fit of both models on the variant's test bed, and the controller's force error with each (the ablation
+of Table 1 and Table 3); and the trends each model claims (drawbar pull against grouser height and
+count, sinkage against slip, with a source's measurement). Multi-pass takes the smooth variant's model:
+a single-wheel test bed runs one pass on virgin soil. And the path following's turn
+(``path_following``, SteerableRover.fmu) on the chosen wheel and soil without and with ruts: in a turn
+the rear wheels leave the front wheels' tracks in part (off-tracking), so the ruts' share differs on
+the straights and the arc.
 
 results/simulation/
-  effects_ablation.csv   variant, model (smooth_model / own_model), wheel, rms_N (RMS(Fx - Fx_des),
+  effects_ablation.csv   variant, model (given_model / own_model), wheel, rms_N (RMS(Fx - Fx_des),
                          Table 3), sinkage_mean_m and slip_mean (cruise, t >= 10 s)
-  effects_table1.csv     variant, load_N, fit_percent of the smooth model and of the variant's own
+  effects_table1.csv     variant, load_N, fit_percent of the given model and of the variant's own
                          model (Table 1's Eq. (15) on the variant's validation staircase)
-  effects_sinkage.csv    wheel, sinkage [m] at cruise of every variant side by side (smooth model)
-  effects_path_sinkage.csv  the turn: wheel, phase (straight before the arc, arc), sinkage [m] without and
-                         with ruts, the mean rut depth [m] under the wheel
-  effects_model_<variant>.json   the models identified with grousers, with slip-sinkage
+  effects_sinkage.csv    wheel, sinkage [m] at cruise of every variant side by side (given model)
+  effects_path_sinkage.csv  the turn on the chosen wheel and soil: wheel, phase (straight before the arc,
+                         arc), sinkage [m] on virgin soil and with ruts, the mean rut depth [m] under the wheel
+  effects_model_<variant>.json   the models identified for the variants whose wheel or soil is not the
+                         chosen one (for the paper's: grousers, slip_sinkage)
   effects_trends.png     drawbar pull at 20 % slip against grouser height and count; sinkage against slip
   effects.json           parameters, the variants' wheel, soil and plan, FMU hashes, versions
 """
@@ -56,10 +61,11 @@ VARIANTS = {"smooth": "the paper's smooth wheel on virgin soil",
             "grousers": "grousers (terramechanics.grousers)",
             "slip_sinkage": "slip-sinkage (Soil.n_slip)",
             "multi_pass": "multi-pass ruts (RutBlock on the rutDepth inputs)"}
-#: The variants identified again on the test bed (a single-wheel test bed runs one pass: not multi_pass).
-REIDENTIFIED = ("grousers", "slip_sinkage")
-#: The ablation's two controllers: the smooth wheel's identified model, the variant's own.
-SMOOTH_MODEL, OWN_MODEL = "smooth_model", "own_model"
+#: The variants a test bed identifies (a single-wheel test bed runs one pass: multi_pass takes smooth's).
+IDENTIFIABLE = ("smooth", "grousers", "slip_sinkage")
+#: The ablation's two controllers: the model given (--model, identified on the chosen wheel and soil:
+#: the smooth wheel's for the paper's), and the variant's own, identified with its wheel and soil.
+GIVEN_MODEL, OWN_MODEL = "given_model", "own_model"
 #: Slip-sinkage as measured: at 60 % slip lugged wheels sank 3-7 times their static sinkage (Ding, Gao,
 #: Deng, Tao, "Wheel slip-sinkage and its prediction model of lunar rover", J. Cent. South Univ. Technol.
 #: 17:129-135, 2010, abstract; three wheels with lugs of several heights and counts on a lunar simulant).
@@ -84,14 +90,22 @@ class EffectsResult:
 
 
 def variant_choice(choice: Choice, variant: str) -> Choice:
-    """The choice with the variant's effect on: its own grousers or DEFAULT_GROUSERS, its own n_slip
-    or DEFAULT_N_SLIP; the others unchanged."""
-    if variant == "grousers" and not choice.wheel.grousered:
-        height, count = DEFAULT_GROUSERS
-        return replace(choice, wheel=replace(choice.wheel, grouser_height=height, grouser_count=count))
-    if variant == "slip_sinkage" and choice.soil.n_slip == 0:
-        return replace(choice, soil=replace(choice.soil, n_slip=DEFAULT_N_SLIP))
-    return choice
+    """The choice's wheel and soil with the variant's effect alone on: ``smooth`` and ``multi_pass``
+    without grousers and slip-sinkage; ``grousers`` with the wheel's own grousers or DEFAULT_GROUSERS;
+    ``slip_sinkage`` with the soil's own n_slip or DEFAULT_N_SLIP."""
+    smooth = replace(choice, wheel=replace(choice.wheel, grouser_height=0.0, grouser_count=0.0),
+                     soil=replace(choice.soil, n_slip=0.0))
+    if variant == "grousers":
+        height, count = ((choice.wheel.grouser_height, choice.wheel.grouser_count) if choice.wheel.grousered
+                         else DEFAULT_GROUSERS)
+        return replace(smooth, wheel=replace(smooth.wheel, grouser_height=height, grouser_count=count))
+    if variant == "slip_sinkage":
+        return replace(smooth, soil=replace(smooth.soil, n_slip=choice.soil.n_slip or DEFAULT_N_SLIP))
+    return smooth
+
+
+def _same_plant(a: Choice, b: Choice) -> bool:
+    return a.wheel == b.wheel and a.soil == b.soil
 
 
 def reidentified(single_wheel: Path, models: ModelSet, choice: Choice, variant: str) -> ModelSet:
@@ -224,30 +238,34 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
     their own), the identifications, Table 1, the ablation, the turn without and with ruts (its straights
     ``straight`` [m] long) and the trends; writes every file (all or none)."""
     choice = as_choice(choice)
-    campaign = Campaign("rover-cosim simulate --only effects", len(VARIANTS) + len(REIDENTIFIED) + 2, progress)
     fmu_dir = Path(fmu_dir).resolve()
     single_wheel = fmu_dir / "SingleWheel.fmu"
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     chosen = {v: variant_choice(choice, v) for v in VARIANTS}
-    own = {v: reidentified(single_wheel, models, chosen[v], v) for v in REIDENTIFIED}
+    # the variant's own models: the given ones where its wheel and soil are the choice's
+    own = {v: models if _same_plant(chosen[v], choice) else reidentified(single_wheel, models, chosen[v], v)
+           for v in IDENTIFIABLE}
+    own["multi_pass"] = own["smooth"]
+    runs = sum(1 if own[v] is models else 2 for v in VARIANTS) + 2
+    campaign = Campaign("rover-cosim simulate --only effects", runs, progress)
     fits = []
-    for variant in ("smooth", *REIDENTIFIED):
-        fit = table1(single_wheel, chosen[variant], {SMOOTH_MODEL: models, OWN_MODEL: own.get(variant, models)})
+    for variant in IDENTIFIABLE:
+        fit = table1(single_wheel, chosen[variant], {GIVEN_MODEL: models, OWN_MODEL: own[variant]})
         fit.insert(0, "variant", variant)
         fits.append(fit)
     rows, sinkage = [], {}
     for variant, variant_chosen in chosen.items():
-        for label, controlled in ((SMOOTH_MODEL, models), (OWN_MODEL, own.get(variant))):
-            if controlled is None:
+        for label, controlled in ((GIVEN_MODEL, models), (OWN_MODEL, own[variant])):
+            if label == OWN_MODEL and controlled is models:
                 continue
-            key = variant if label == SMOOTH_MODEL else f"{variant}_{label}"
+            key = variant if label == GIVEN_MODEL else f"{variant}_{label}"
             table = trajectories(campaign.run(key, straight_system(fmu_dir, controlled, variant_chosen, variant)).data,
                                  "monolithic")
             at_cruise = cruise(table).merge(rms(table).rename(columns={"limb": "wheel"}), on="wheel")
             at_cruise.insert(0, "model", label)
             at_cruise.insert(0, "variant", variant)
             rows.append(at_cruise)
-            if label == SMOOTH_MODEL:
+            if label == GIVEN_MODEL:
                 sinkage[f"sinkage_{variant}_m"] = at_cruise["sinkage_mean_m"].to_numpy()
     turn = {}
     for ruts in (False, True):
@@ -255,14 +273,14 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
                            path_system(fmu_dir, models, choice, ruts, straight))
         turn[ruts] = path_phases(run.data, straight)
     path_sinkage = turn[False][["wheel", "phase"]].assign(
-        sinkage_smooth_m=turn[False]["sinkage_m"], sinkage_multi_pass_m=turn[True]["sinkage_m"],
+        sinkage_virgin_m=turn[False]["sinkage_m"], sinkage_ruts_m=turn[True]["sinkage_m"],
         rut_depth_m=turn[True]["rut_depth_m"])
     ablation = pd.concat(rows, ignore_index=True)[["variant", "model", "wheel", "rms_N", "sinkage_mean_m",
                                                    "slip_mean"]]
     table_1 = pd.concat(fits, ignore_index=True)
     sinkage_table = pd.DataFrame({"wheel": rows[0]["wheel"], **sinkage})
     variants = {v: {"wheel": asdict(c.wheel), "soil_n_slip": c.soil.n_slip, "what": VARIANTS[v],
-                    "identification_plan": plan_for(c).to_dict() if v in ("smooth", *REIDENTIFIED) else None}
+                    "identification_plan": plan_for(c).to_dict() if own[v] is not models else None}
                 for v, c in chosen.items()}
     trend = trends(choice)
     record = campaign.record({"stop_time_s": 20.0, "step_s": STEP, "cruise_from_s": CRUISE_FROM, "model": str(model),
@@ -273,9 +291,10 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
                                                         "sinkage_ratio": list(SLIP_SINKAGE_REPORTED[1:3]),
                                                         "source": SLIP_SINKAGE_REPORTED[3],
                                                         "n_slip_band": list(trend.n_slip_band)},
-                              "controllers": {SMOOTH_MODEL: "the model identified on the smooth wheel (--model)",
+                              "controllers": {GIVEN_MODEL: "the model given (--model), identified on the chosen "
+                                                           "wheel and soil",
                                               OWN_MODEL: "the variant's model, identified again on SingleWheel.fmu "
-                                                         "with the effect on (grousers, slip-sinkage)"}},
+                                                         "with its wheel and soil (multi_pass: smooth's)"}},
                              fmu_dir=fmu_dir, model=model, choice=choice, mismatch=mismatch,
                              fmus=(rover_fmu(fmu_dir, "Rover", choice), rover_fmu(fmu_dir, "SteerableRover", choice),
                                    "SingleWheel"))
@@ -284,7 +303,7 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
              out / "effects_table1.csv": table_1.to_csv(index=False, float_format="%.3f").encode(),
              out / "effects_sinkage.csv": sinkage_table.to_csv(index=False, float_format="%.6g").encode(),
              out / "effects_path_sinkage.csv": path_sinkage.to_csv(index=False, float_format="%.6g").encode(),
-             **{out / f"effects_model_{v}.json": m.to_json() for v, m in own.items()},
+             **{out / f"effects_model_{v}.json": own[v].to_json() for v in IDENTIFIABLE if own[v] is not models},
              out / "effects_trends.png": effects_figures.trends(trend),
              out / "effects.json": json_bytes(record)}
     written = campaign.write(out, files)

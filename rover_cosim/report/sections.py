@@ -569,9 +569,10 @@ def effects_section(simulation: Path) -> list[str]:
     the trends."""
     sections = ["<h2>Wheel effects: grousers, slip-sinkage, multi-pass ruts</h2>",
                 ("<p>The paper's identification (Table 1) and straight run on Rover.fmu (Table 3) with one effect "
-                 "switched on at a time, each with the controller's model of the smooth wheel (what the effect "
-                 "costs an unaware model) and, for grousers and slip-sinkage, with the model identified again on "
-                 "SingleWheel.fmu with the effect on (the identification plan for that wheel and soil). "
+                 "switched on at a time on the chosen wheel and soil made smooth, each with the controller's model "
+                 "given to <code>simulate</code> (identified on the chosen wheel and soil: for the paper's, the "
+                 "smooth wheel; what the effect costs an unaware model) and with the variant's own model, identified "
+                 "again on SingleWheel.fmu with the effect on (the identification plan for that wheel and soil). "
                  "<b>Grousers</b>: the soil sheared at the grouser tips and on the trapped soil's "
                  "sides (Ding et al. 2011; the wheel's own grousers, else 10 mm &times; 24, illustrative). "
                  "<b>Slip-sinkage</b>: the sinkage exponent n + n<sub>slip</sub>|s| (Ding et al. 2011; the soil's "
@@ -587,18 +588,20 @@ def effects_section(simulation: Path) -> list[str]:
         return [*sections, "<p>Not run (<code>rover-cosim simulate --only effects</code>).</p>"]
     names = {"smooth": "smooth wheel", "grousers": "grousers", "slip_sinkage": "slip-sinkage",
              "multi_pass": "multi-pass"}
-    models = {"smooth_model": "smooth wheel's", "own_model": "identified with the effect"}
+    models = {"given_model": "given (--model)", "own_model": "identified for the variant",
+              "smooth_model": "given (--model)"}  # the last: files written before "given_model"
     fits_path = simulation / "effects_table1.csv"
     if fits_path.exists():
         fits = pd.read_csv(fits_path)
         rows = [{"variant": names.get(str(variant), str(variant)), "model": label,
                  **{f"Fit {load:g} N [%]": fit for load, fit in zip(group["load_N"], group[f"fit_percent_{model}"])}}
-                for variant, group in fits.groupby("variant", sort=False) for model, label in models.items()]
+                for variant, group in fits.groupby("variant", sort=False) for model, label in models.items()
+                if f"fit_percent_{model}" in group]
         sections += ["<p>Table 1 on each variant's test bed (Eq. 15 on the validation staircase).</p>",
                      table(pd.DataFrame(rows), default="{:.1f}")]
     ablation = pd.read_csv(path)
     if "model" not in ablation:  # written before the re-identification
-        ablation = ablation.assign(model="smooth_model")
+        ablation = ablation.assign(model="given_model")
     wheels = sorted(ablation["wheel"].unique())
     half = wheels[: max(1, len(wheels) // 2)]  # one side: the other mirrors it on the straight run
     rows = []
@@ -617,8 +620,8 @@ def effects_section(simulation: Path) -> list[str]:
         sections += ["<p>The path following's turn (90&deg; left, radius 10 m, SteerableRover.fmu) without and with "
                      "ruts: mean sinkage per wheel on the first straight and on the arc, where the rear wheels leave "
                      "the front wheels' tracks in part (wheels 1&ndash;3 left, 4&ndash;6 right, front to rear).</p>",
-                     table(turn.assign(**{"sinkage, virgin soil [mm]": 1000 * turn["sinkage_smooth_m"],
-                                          "sinkage, ruts [mm]": 1000 * turn["sinkage_multi_pass_m"],
+                     table(turn.assign(**{"sinkage, virgin soil [mm]": 1000 * turn["sinkage_virgin_m"],
+                                          "sinkage, ruts [mm]": 1000 * turn["sinkage_ruts_m"],
                                           "rut under the wheel [mm]": 1000 * turn["rut_depth_m"]})
                            [["phase", "wheel", "sinkage, virgin soil [mm]", "sinkage, ruts [mm]",
                              "rut under the wheel [mm]"]], default="{:.3g}")]
