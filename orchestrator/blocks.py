@@ -87,6 +87,8 @@ class Step(Source):
     def __init__(self, name: str, height: float, time: float = 0.0, offset: float = 0.0, unit: str | None = None):
         super().__init__(name, unit)
         self.height, self.time, self.offset = float(height), float(time), float(offset)
+        #: s: where the signal jumps, for a Model Exchange FMU an input event there
+        self.jump_times = np.array([self.time] if self.height != 0 else [])
 
     def value(self, t: float) -> float:
         return self.offset + (self.height if t >= self.time else 0.0)
@@ -194,6 +196,8 @@ class CsvInput:
         self.held = np.array([c in set(hold) for c in self.outputs], dtype=bool)
         self.types = dict(types or {})
         self.units: dict[str, str] = {}
+        #: s: where the signals jump (a repeated time), for a Model Exchange FMU an input event there
+        self.jump_times = np.unique(self.times[1:][np.diff(self.times) == 0])
 
     def values_at(self, t: float) -> np.ndarray:
         """Every output at ``t`` [s]."""

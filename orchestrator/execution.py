@@ -48,16 +48,25 @@ class Execution:
         self.signal_inputs = self._signal_inputs()
         algorithm.prepare(self)
 
-    def _signal_inputs(self) -> list[tuple[int, np.ndarray]]:
+    def _signal_inputs(self) -> list[tuple[int, np.ndarray, np.ndarray]]:
         """The Model Exchange FMUs fed by a source (a block without inputs: an input signal), with
-        which of their inputs it feeds: at a communication point where the signal jumps they take
-        its new value at once (in Event Mode where a discrete input changes), so that the row there
-        shows it, as FMPy records an input event."""
+        which of their inputs it feeds and the times [s] where those sources jump (a csv input's
+        repeated time, a step): at a communication point they take the signals' new values at once,
+        in Event Mode (with an event iteration) where a discrete input changes or a signal jumps,
+        so that the row there shows them, as FMPy records an input event."""
         from .algorithms import sources
 
-        fed = np.concatenate([self.outputs[i] for i in sources(self.participants, self.inputs)] or [np.zeros(0, int)])
-        return [(i, np.isin(self.inputs[i], fed)) for i, p in enumerate(self.participants)
-                if getattr(p, "takes_signals", False) and np.isin(self.inputs[i], fed).any()]
+        found = []
+        feeding = sources(self.participants, self.inputs)
+        fed = np.concatenate([self.outputs[i] for i in feeding] or [np.zeros(0, int)])
+        for i, p in enumerate(self.participants):
+            mine = np.isin(self.inputs[i], fed)
+            if not (getattr(p, "takes_signals", False) and mine.any()):
+                continue
+            jumps = [np.asarray(getattr(getattr(self.participants[k], "block", None), "jump_times", ()), float)
+                     for k in feeding if np.isin(self.outputs[k], self.inputs[i]).any()]
+            found.append((i, mine, np.unique(np.concatenate(jumps or [np.zeros(0)]))))
+        return found
 
     def _steppable(self, i: int) -> bool:
         """Whether participant ``i`` can be stepped natively: an FMU whose exchanged variables are
@@ -104,10 +113,14 @@ class Execution:
     def step(self, values: np.ndarray, t: float, h: float) -> None:
         """Advance every participant from ``t`` to ``t + h``; ``values`` then holds the outputs at ``t + h``."""
         self.algorithm.step(self, values, t, h)
-        for i, fed in self.signal_inputs:  # the input signals' values at t + h, taken there
+        end = t + h
+        for i, fed, jumps in self.signal_inputs:  # the input signals' values at t + h, taken there
             participant = self.participants[i]
-            if participant.take_signals(values[self.inputs[i]], fed, t + h):  # type: ignore[attr-defined]
-                values[self.outputs[i]] = participant.get_outputs(t + h)
+            # a jump in (t, t + h], to the rounding of the communication points
+            slack = 1e-9 * h
+            jump = bool(jumps.size) and bool(np.any((jumps > t + slack) & (jumps <= end + slack)))
+            if participant.take_signals(values[self.inputs[i]], fed, end, jump):  # type: ignore[attr-defined]
+                values[self.outputs[i]] = participant.get_outputs(end)
 
     def run_stage(self, stage: Sequence[int], values: np.ndarray, t: float, h: float) -> None:
         """Step the participants of ``stage`` from the values as they are now."""

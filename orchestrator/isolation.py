@@ -293,8 +293,8 @@ class IsolatedFmu:
             return self._last
         return self._got(self._call(f"fmi{self.version}Get", "get_outputs", (t,), t), t)
 
-    def take_signals(self, u: np.ndarray, fed: np.ndarray, t: float) -> bool:
-        taken, reply = self._call("input event", "take_signals", (t, *self._send_inputs(u), fed), t)
+    def take_signals(self, u: np.ndarray, fed: np.ndarray, t: float, jump: bool = False) -> bool:
+        taken, reply = self._call("input event", "take_signals", (t, *self._send_inputs(u), fed, jump), t)
         self._got(reply, t)
         return bool(taken)
 
@@ -418,8 +418,9 @@ class _Child:
         self.fmu.do_step(t, h, u)
         return self.fmu.get_outputs(t + h)
 
-    def take_signals(self, t: float, u: np.ndarray, texts: list[str], fed: np.ndarray) -> tuple[bool, Any]:
-        taken = self.fmu.take_signals(self._inputs(u, texts), fed, t)  # type: ignore[attr-defined]  # an ME FMU's
+    def take_signals(self, t: float, u: np.ndarray, texts: list[str], fed: np.ndarray,
+                     jump: bool = False) -> tuple[bool, Any]:
+        taken = self.fmu.take_signals(self._inputs(u, texts), fed, t, jump)  # type: ignore[attr-defined]  # ME's
         return taken, self._outputs(self.fmu.get_outputs(t))
 
     def get_state(self, t: float) -> int:

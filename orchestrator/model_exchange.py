@@ -167,23 +167,26 @@ class ModelExchangeParticipant(FmuParticipant):
         if now != end:
             self._call(f"fmi{self.version}SetTime", lambda: self.fmu.setTime(end), end)
 
-    def take_signals(self, u: np.ndarray, fed: np.ndarray, t: float) -> bool:
+    def take_signals(self, u: np.ndarray, fed: np.ndarray, t: float, jump: bool = False) -> bool:
         """At the end of a step (``t``): the inputs ``fed`` by input signals take their values in
-        ``u`` there (an event where a discrete one jumps); whether any changed."""
+        ``u`` there (an event where a discrete one changes, or where a signal ``jump``s: FMPy's
+        input event, which a continuous input's jump may trigger through the FMU's event
+        indicators); whether any changed."""
         new = self.input_values.copy()
         new[fed] = np.asarray(u, dtype=float)[fed]
         if np.array_equal(new, self.input_values, equal_nan=True):
             return False
         self._step_start = t
-        self._take_inputs(new, t)
+        self._take_inputs(new, t, jump)
         return True
 
-    def _take_inputs(self, u: np.ndarray, t: float) -> None:
-        """Set the inputs that changed: in Event Mode (with an event iteration) where a discrete one did."""
+    def _take_inputs(self, u: np.ndarray, t: float, jump: bool = False) -> None:
+        """Set the inputs that changed: in Event Mode (with an event iteration) where a discrete one did
+        or a signal jumps."""
         moved = u != self.input_values
         if not self.inputs or not bool(np.any(moved)):
             return
-        if bool(np.any(self._discrete & moved)):  # a discrete input jumps: an event at t
+        if jump or bool(np.any(self._discrete & moved)):  # an input event at t
             self._mode("event", t)
             self.set_inputs(u, t)
             self._event_iteration(t)

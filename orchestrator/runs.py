@@ -38,7 +38,8 @@ def system_record(system: System) -> dict[str, Any]:
 #: The convention by which participants see input signals (sources), said in every run's record.
 INPUT_TIMING = ("every participant stepping from t to t + h sees each input signal (a source block: csv, step, "
                 "ramp, ...) at t, held over the step (FMPy's convention; at a repeated time, the later row); a Model "
-                "Exchange FMU takes a signal's jump at a communication point there, in Event Mode for discrete inputs")
+                "Exchange FMU takes a signal's change at a communication point there, in Event Mode where a discrete "
+                "input changes or a signal jumps (a repeated time, a step)")
 
 
 def sidecar(system: System, result: RunResult, command: str,

@@ -53,15 +53,16 @@ def test_record_names_locals_and_glob_patterns(integrator, tmp_path, capsys):
 def test_an_fmu_without_outputs_says_what_it_could_record(integrator, tmp_path, capsys):
     quiet = _variant(integrator, tmp_path, "Quiet", ('causality="output"', 'causality="local"'),
                      ('<Outputs>\n      <Unknown index="1"/>\n      <Unknown index="4" dependencies="3"/>\n'
-                      '      <Unknown index="6" dependencies="5"/>\n    </Outputs>\n', ""))
+                      '      <Unknown index="6" dependencies="5"/>\n      <Unknown index="7" dependencies=""/>\n'
+                      '    </Outputs>\n', ""))
     out = tmp_path / "q.csv"
     assert main(["run", str(quiet), "--validate", "off", "-o", str(out), "--quiet"]) == 0
     err = capsys.readouterr().err
     assert "no output that can be recorded: only time would be; name what to record with --record" in err
-    assert "it has x, der(x), u, y, k, m" in err
+    assert "it has x, der(x), u, y, k, m, r" in err
     assert main(["run", str(quiet), "--validate", "off", "--record", "*", "-o", str(out), "--quiet"]) == 0
     assert list(pd.read_csv(out).columns) == ["time", "model.x", "model.der(x)", "model.u", "model.y", "model.k",
-                                              "model.m"]
+                                              "model.m", "model.r"]
 
 
 def test_relative_tolerance_reaches_the_model_exchange_integrator(integrator, tmp_path, capsys):

@@ -5,11 +5,14 @@
  *          1 der(x)   local     = u
  *          2 u        input     continuous
  *          3 y        output    = u (direct feedthrough)
+ *          4 r        output    discrete: a relay, 1 where u > 0.5 else 0, taken at events only
  * Integer  0 k        input     discrete
  *          1 m        output    = k (direct feedthrough)
  *
- * Co-Simulation: fmi2DoStep integrates x exactly with u held over the step (x += u h); Model
- * Exchange: the importer integrates x' = u. No events; the FMU state can be saved and restored.
+ * Co-Simulation: fmi2DoStep integrates x exactly with u held over the step (x += u h) and sets r
+ * from u; Model Exchange: the importer integrates x' = u; one event indicator, u - 0.5: r changes
+ * in Event Mode only, so an importer that sets a jumping continuous u without an event iteration
+ * leaves r where it was. The FMU state can be saved and restored.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +21,7 @@
 #include "fmi2Functions.h"
 
 typedef struct {
-    double time, x, u;
+    double time, x, u, r;
     int k;
     fmi2Type type;
     fmi2CallbackFunctions callbacks;
@@ -59,11 +62,16 @@ fmi2Status fmi2SetupExperiment(fmi2Component component, fmi2Boolean tol, fmi2Rea
     return fmi2OK;
 }
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
-fmi2Status fmi2ExitInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
+static double relay(double u) { return u > 0.5 ? 1.0 : 0.0; }
+fmi2Status fmi2ExitInitializationMode(fmi2Component component) {
+    Instance *c = (Instance *)component;
+    c->r = relay(c->u);
+    return fmi2OK;
+}
 fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
 fmi2Status fmi2Reset(fmi2Component component) {
     Instance *c = (Instance *)component;
-    c->time = c->x = c->u = 0.0;
+    c->time = c->x = c->u = c->r = 0.0;
     c->k = 0;
     return fmi2OK;
 }
@@ -76,6 +84,7 @@ fmi2Status fmi2GetReal(fmi2Component component, const fmi2ValueReference vr[], s
         case 1: value[i] = c->u; break;
         case 2: value[i] = c->u; break;
         case 3: value[i] = c->u; break;
+        case 4: value[i] = c->r; break;
         default: return refuse(component, "fmi2GetReal: unknown value reference");
         }
     }
@@ -132,6 +141,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h, fmi2Boolean no_prior) {
     Instance *c = (Instance *)component;
     (void)no_prior;
+    c->r = relay(c->u);
     c->x += c->u * h;
     c->time = t + h;
     return fmi2OK;
@@ -139,8 +149,9 @@ fmi2Status fmi2DoStep(fmi2Component component, fmi2Real t, fmi2Real h, fmi2Boole
 
 /* --- Model Exchange ------------------------------------------------------------------------ */
 fmi2Status fmi2EnterEventMode(fmi2Component c) { (void)c; return fmi2OK; }
-fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
-    (void)c;
+fmi2Status fmi2NewDiscreteStates(fmi2Component component, fmi2EventInfo *info) {
+    Instance *c = (Instance *)component;
+    c->r = relay(c->u);
     info->newDiscreteStatesNeeded = fmi2False;
     info->terminateSimulation = fmi2False;
     info->nominalsOfContinuousStatesChanged = fmi2False;
@@ -169,8 +180,9 @@ fmi2Status fmi2GetDerivatives(fmi2Component component, fmi2Real dx[], size_t n) 
     return fmi2OK;
 }
 fmi2Status fmi2GetEventIndicators(fmi2Component component, fmi2Real z[], size_t n) {
-    (void)z;
-    return n ? refuse(component, "no event indicators") : fmi2OK;
+    if (n != 1) return refuse(component, "one event indicator");
+    z[0] = ((Instance *)component)->u - 0.5;
+    return fmi2OK;
 }
 fmi2Status fmi2GetContinuousStates(fmi2Component component, fmi2Real x[], size_t n) {
     if (n != 1) return refuse(component, "one state");
