@@ -59,13 +59,15 @@ def single_fmu_system(path: Path, settings: Mapping[str, Any] | None = None, *, 
 
 
 def _matching(path: Path, variables: Mapping[str, Any], patterns: Sequence[str]) -> list[str]:
-    """The FMU's variables that ``patterns`` (names or glob patterns) name, each once, in the order
-    of the patterns; SystemFileError for a pattern that names none."""
+    """The FMU's variables that ``patterns`` (names or glob patterns; an FMI 3.0 array's name: its
+    elements) name, each once, in the order of the patterns; SystemFileError for a pattern that
+    names none."""
     from fnmatch import fnmatchcase
 
     found: list[str] = []
     for pattern in patterns:
-        names = [pattern] if pattern in variables and recordable(variables[pattern]) else [
+        elements = [e.name for e in elements_of(variables[pattern])] if pattern in variables else []
+        names = [pattern] if pattern in variables and recordable(variables[pattern]) else elements or [
             name for name, v in variables.items() if fnmatchcase(name, pattern) and recordable(v)]
         if not names:
             raise SystemFileError(f"{path.name}: --record {pattern!r}: names no variable of the FMU that can be "

@@ -72,3 +72,7 @@ def test_record_patterns_reach_array_elements(arrays, tmp_path):
     out = tmp_path / "m.csv"
     assert main(["run", str(arrays), "--record", "m[[]2,*", "--record", "k[1]", "-o", str(out), "--quiet"]) == 0
     assert list(pd.read_csv(out).columns) == ["time", "model.m[2,1]", "model.m[2,2]", "model.k[1]"]
+    # an array's own name records its elements (as FMPy's output= does)
+    assert main(["run", str(arrays), "--record", "m", "-o", str(out), "--quiet", "--overwrite"]) == 0
+    assert [c for c in pd.read_csv(out).columns if c != "time"] == ["model.m[1,1]", "model.m[1,2]", "model.m[2,1]",
+                                                                   "model.m[2,2]"]
