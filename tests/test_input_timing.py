@@ -124,18 +124,25 @@ def _last_row_per_time(result: np.ndarray) -> np.ndarray:
     return result[keep]
 
 
+def _model_exchange_as_fmpy(integrator: Path, folder: Path, master: str, rows: list[tuple[float, float, int]],
+                            exact: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Our Model Exchange run of ``rows`` against FMPy's (its last row per time): the same times, the
+    ``exact`` outputs equal, x to CVode's tolerance; ours."""
+    ours = _ours(integrator, _csv(folder, rows), master, "model-exchange", ("x", *exact))
+    theirs = _last_row_per_time(_fmpy(integrator, rows, ("u", "k"), "ModelExchange"))
+    np.testing.assert_allclose(ours["time"], theirs["time"], rtol=0, atol=1e-12)
+    for name in exact:
+        np.testing.assert_array_equal(ours[name], theirs[name], err_msg=name)
+    np.testing.assert_allclose(ours["x"], theirs["x"], rtol=1e-6, atol=1e-9)
+    return ours
+
+
 @pytest.mark.parametrize("master", MASTERS)
 def test_model_exchange_takes_an_input_event_at_its_time_and_records_the_new_value(integrator, tmp_path, master):
     """Model Exchange, FMI 2.0: the step of u and k at 0.5 s is an event there; the row at 0.5 s
     shows the new values (y = u = 1, m = k = 1, x still 0), as FMPy's last row at that time; every
     row equals FMPy's to CVode's tolerance."""
-    rows = STEP_INPUT
-    ours = _ours(integrator, _csv(tmp_path, rows), master, "model-exchange", ("x", "y", "m"))
-    theirs = _last_row_per_time(_fmpy(integrator, rows, ("u", "k"), "ModelExchange"))
-    np.testing.assert_allclose(ours["time"], theirs["time"], rtol=0, atol=1e-12)
-    for name in ("y", "m"):
-        np.testing.assert_array_equal(ours[name], theirs[name], err_msg=name)
-    np.testing.assert_allclose(ours["x"], theirs["x"], rtol=1e-6, atol=1e-9)
+    ours = _model_exchange_as_fmpy(integrator, tmp_path, master, STEP_INPUT, ("y", "m"))
     at = int(np.argmin(np.abs(ours["time"] - 0.5)))
     assert (ours["x"][at], ours["y"][at], ours["m"][at]) == (0.0, 1.0, 1)
     assert ours["x"][-1] == pytest.approx(0.5, abs=1e-9)
@@ -149,12 +156,7 @@ def test_a_jump_of_a_continuous_input_is_an_event_as_fmpy_takes_it(integrator, t
     FMPy's (an importer that set u in Continuous-Time Mode would leave r at 0: found on MapleSim's
     CoupledClutches, 0.9 % off)."""
     rows = [(0.0, 0.0, 0), (0.5, 0.0, 0), (0.5, 1.0, 0), (1.0, 1.0, 0)]
-    ours = _ours(integrator, _csv(tmp_path, rows), master, "model-exchange", ("x", "y", "r"))
-    theirs = _last_row_per_time(_fmpy(integrator, rows, ("u", "k"), "ModelExchange"))
-    np.testing.assert_allclose(ours["time"], theirs["time"], rtol=0, atol=1e-12)
-    for name in ("y", "r"):
-        np.testing.assert_array_equal(ours[name], theirs[name], err_msg=name)
-    np.testing.assert_allclose(ours["x"], theirs["x"], rtol=1e-6, atol=1e-9)
+    ours = _model_exchange_as_fmpy(integrator, tmp_path, master, rows, ("y", "r"))
     at = int(np.argmin(np.abs(ours["time"] - 0.5)))
     assert (ours["r"][at - 1], ours["r"][at]) == (0.0, 1.0)
 
