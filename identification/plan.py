@@ -236,7 +236,8 @@ def plan_for(choice: Choice) -> IdentificationPlan:
                           f"loads around the static load {load:.1f} N")
     torques, fit_max, added = _torque_levels(choice, scale, loads)
     basis = (f"the paper's plan scaled to {choice.rover_name} rover on {choice.soil_name} with the {choice.wheel_name} "
-             f"wheel: loads x {factor:.4g} (static wheel load {load:.1f} N against the paper's "
+             f"wheel{' (' + ', '.join(choice.overrides) + ')' if choice.overrides else ''}: loads x {factor:.4g} "
+             f"(static wheel load {load:.1f} N against the paper's "
              f"{STATIC_WHEEL_LOAD:.1f} N), torques x {scale:.4g} (Tx at {SCALE_SLIP:g} slip against the paper's)"
              + (f"; added {sorted(set(added))} N·m where a load had fewer than {POINTS_NEEDED} levels in the window"
                 if added else ""))
