@@ -1,6 +1,7 @@
 """Grousers, slip-sinkage and multi-pass ruts in Wheel.fmu against the numpy reference (issue 48):
 the FMU's contact at chosen states (load, spin, hub speed, slip angle, rut) equals
-terramechanics.wheel_state with the FMU's quadrature (16 Gauss-Legendre nodes a piece) to 1e-6."""
+terramechanics.wheel_state with the FMU's quadrature (the Gauss-Legendre nodes a piece of the Modelica
+RigidWheel's nNodes) to 1e-6."""
 
 from __future__ import annotations
 
@@ -12,11 +13,11 @@ import fmpy
 import numpy as np
 import pytest
 from fmpy.fmi2 import FMU2Model
+from modelica_defaults import FMU_NODES
 
 from rover_cosim.terramechanics import Soil, Wheel, wheel_state
 from rover_cosim.terramechanics.library import fmu_parameters
 
-FMU_NODES = 16
 EFFECTS = {
     "smooth": (Wheel(), Soil(), 0.0),
     "grousers": (Wheel(grouser_height=0.015, grouser_count=24), Soil(), 0.0),
