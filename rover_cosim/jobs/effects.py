@@ -108,13 +108,14 @@ def _same_plant(a: Choice, b: Choice) -> bool:
     return a.wheel == b.wheel and a.soil == b.soil
 
 
-def reidentified(single_wheel: Path, models: ModelSet, choice: Choice, variant: str) -> ModelSet:
+def reidentified(single_wheel: Path, models: ModelSet, choice: Choice, plan: IdentificationPlan,
+                 variant: str) -> ModelSet:
     """``models`` with the longitudinal model identified again by the sweep on ``single_wheel`` with
-    ``choice``'s soil and wheel (the variant's), by the identification plan for it; the lateral model
-    kept (the straight run does not steer)."""
+    ``choice``'s soil and wheel (the variant's), by ``plan`` (the identification plan for it); the
+    lateral model kept (the straight run does not steer)."""
     import tempfile
 
-    plan, label = plan_for(choice), models.recommended
+    label = models.recommended
     with tempfile.TemporaryDirectory(prefix="rover-cosim-effects-") as cache:
         model, _ = identify_on_soil(single_wheel, choice.soil, choice.wheel, Path(cache), models.model().degree,
                                     SweepPlan(loads=plan.loads, torques=plan.torques), plan.fit_torque_max)
@@ -124,10 +125,10 @@ def reidentified(single_wheel: Path, models: ModelSet, choice: Choice, variant: 
         **describe(choice)}, source=f"effects_model_{variant}.json")
 
 
-def table1(single_wheel: Path, choice: Choice, models: dict[str, ModelSet]) -> pd.DataFrame:
+def table1(single_wheel: Path, choice: Choice, plan: IdentificationPlan, models: dict[str, ModelSet]) -> pd.DataFrame:
     """Table 1 on ``choice``'s test bed (SingleWheel.fmu with its soil and wheel): the Fit [%] of
-    Eq. (15) of each of ``models`` (by label) on the validation staircase of the plan for ``choice``."""
-    plan: IdentificationPlan = plan_for(choice)
+    Eq. (15) of each of ``models`` (by label) on the validation staircase of ``plan`` (the
+    identification plan for ``choice``)."""
     bed = shared_test_bed(single_wheel)
     bed.parameters = SweepPlan(soil=choice.soil, wheel=choice.wheel).parameters
     fits = validate(bed, {label: m.model() for label, m in models.items()}, plan.validation_loads,
@@ -243,14 +244,15 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     chosen = {v: variant_choice(choice, v) for v in VARIANTS}
     # the variant's own models: the given ones where its wheel and soil are the choice's
-    own = {v: models if _same_plant(chosen[v], choice) else reidentified(single_wheel, models, chosen[v], v)
+    plans = {v: plan_for(chosen[v]) for v in IDENTIFIABLE}
+    own = {v: models if _same_plant(chosen[v], choice) else reidentified(single_wheel, models, chosen[v], plans[v], v)
            for v in IDENTIFIABLE}
-    own["multi_pass"] = own["smooth"]
+    own["multi_pass"], plans["multi_pass"] = own["smooth"], plans["smooth"]  # the same wheel and soil
     runs = sum(1 if own[v] is models else 2 for v in VARIANTS) + 2
     campaign = Campaign("rover-cosim simulate --only effects", runs, progress)
     fits = []
     for variant in IDENTIFIABLE:
-        fit = table1(single_wheel, chosen[variant], {GIVEN_MODEL: models, OWN_MODEL: own[variant]})
+        fit = table1(single_wheel, chosen[variant], plans[variant], {GIVEN_MODEL: models, OWN_MODEL: own[variant]})
         fit.insert(0, "variant", variant)
         fits.append(fit)
     rows, sinkage = [], {}
@@ -280,7 +282,7 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
     table_1 = pd.concat(fits, ignore_index=True)
     sinkage_table = pd.DataFrame({"wheel": rows[0]["wheel"], **sinkage})
     variants = {v: {"wheel": asdict(c.wheel), "soil_n_slip": c.soil.n_slip, "what": VARIANTS[v],
-                    "identification_plan": plan_for(c).to_dict() if own[v] is not models else None}
+                    "identification_plan": plans[v].to_dict() if own[v] is not models else None}
                 for v, c in chosen.items()}
     trend = trends(choice)
     record = campaign.record({"stop_time_s": 20.0, "step_s": STEP, "cruise_from_s": CRUISE_FROM, "model": str(model),
