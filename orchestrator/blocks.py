@@ -136,9 +136,16 @@ class Table(Source):
         if np.any(np.diff(times) < 0):
             raise ValueError(f"block {name!r}: time must not decrease")
         self.times, self.data = times, data
+        #: s: where the table jumps (a repeated time), for a Model Exchange FMU an input event there
+        self.jump_times = repeated_times(times)
 
     def value(self, t: float) -> float:
         return float(np.interp(t, self.times, self.data))
+
+
+def repeated_times(times: np.ndarray) -> np.ndarray:
+    """The times [s] a non-decreasing time column holds twice or more: where a signal jumps."""
+    return np.unique(times[1:][np.diff(times) == 0])
 
 
 def _header(path: Path) -> list[str]:
@@ -197,7 +204,7 @@ class CsvInput:
         self.types = dict(types or {})
         self.units: dict[str, str] = {}
         #: s: where the signals jump (a repeated time), for a Model Exchange FMU an input event there
-        self.jump_times = np.unique(self.times[1:][np.diff(self.times) == 0])
+        self.jump_times = repeated_times(self.times)
 
     def values_at(self, t: float) -> np.ndarray:
         """Every output at ``t`` [s]."""

@@ -187,3 +187,14 @@ def test_fmi3_model_exchange_takes_the_input_event_as_fmpy(ball3, tmp_path):
                                                   output_interval=STEP, start_values={"g": 0.0}))["v"]
     np.testing.assert_allclose(ours, theirs, rtol=1e-6, atol=1e-9)
     assert ours[-1] == pytest.approx(1.0, abs=1e-9)
+
+
+def test_the_sources_name_where_they_jump(tmp_path):
+    """The times a Model Exchange FMU takes as input events: a csv input's and a table's repeated
+    times, a step's time (none for a step of height 0)."""
+    from rover_cosim.orchestrator.blocks import Table
+
+    csv = _csv(tmp_path, [(0.0, 0.0, 0), (0.5, 0.0, 0), (0.5, 1.0, 0), (0.8, 1.0, 0), (0.8, 2.0, 0)])
+    assert CsvInput("input", csv).jump_times.tolist() == [0.5, 0.8]
+    assert Table("t", [0.0, 0.5, 0.5, 1.0], [0.0, 0.0, 1.0, 1.0]).jump_times.tolist() == [0.5]
+    assert Step("s", 1.0, 0.3).jump_times.tolist() == [0.3] and Step("s", 0.0, 0.3).jump_times.size == 0
