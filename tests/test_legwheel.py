@@ -19,6 +19,7 @@ from rover_cosim.control.posture import JOINT_INPUTS, Posture, PostureController
 from rover_cosim.limbs import athlete_limbs, attitude, forward, holding_torques, static_loads
 
 LIMBS = athlete_limbs()
+PAPER = [(1.5, 1.5), (0.0, 1.5), (-1.5, 1.5), (1.5, -1.5), (0.0, -1.5), (-1.5, -1.5)]  # the paper's footprint [m]
 MASS, G = 1570.0, 1.62
 
 
@@ -64,19 +65,82 @@ def test_the_posture_block_levels_the_body_across_a_slope_and_shares_the_load():
     loads = np.array([300.0, 280.0, 300.0, 560.0, 600.0, 560.0])
     u = np.concatenate([[1.0, 0.0, 0.0, 0.0], loads, np.zeros(6)])
     block.start(0.0, u, 1e-3)
-    for k in range(1, 121):  # 12 s; the body at its commanded roll, the loads held
-        u[1] = block.loops.roll
+    for k in range(1, 121):  # 12 s; the body at its commanded height and roll, the loads held
+        u[0], u[1] = block.loops.height, block.loops.roll
         block.step((k - 1) * 0.1, 0.1, u)
     report = block.report()
     assert report["roll_cmd_rad"] == pytest.approx(-slope, abs=1e-6)     # levelled
     assert report["shift_m"][1] > 0.1                                      # the centre of gravity uphill
     lift = np.array(report["lift_m"])
     assert lift[3:].mean() > lift[:3].mean() and abs(lift.sum()) < 1e-12  # the loaded hubs raised, mean 0
+    np.testing.assert_allclose(np.array(report["footprint_m"]), PAPER, atol=1e-12)  # front and rear balanced
     rotation = attitude(block.loops.roll, 0.0, 0.0)
     for limb, q in zip(LIMBS, block.loops.joints):
         pose = forward(limb, q)
         axle = rotation @ pose.axle
         assert abs(axle[2]) < 1e-9 and abs(axle[0]) < 1e-9             # upright, rolling along x
+
+
+def test_the_posture_block_pitches_the_body_level_up_a_slope_keeping_the_middle_hubs_under_their_hips():
+    """Climbing a 10 deg slope (uphill ahead), fed a body that follows its commands, the block
+    pitches the body to -10 deg against the ground at its rate limit, carries the centre of gravity
+    uphill by height tan(10 deg) so that the weight's line passes through the middle hubs, keeps
+    the middle limbs' hubs where they were in the body frame (their singular wrist cannot tilt the
+    link along the body: no hip yaw, the steer at 90 deg) and every wheel upright, rolling along x
+    up the slope; going down the same slope mirrors it."""
+    slope = math.radians(10.0)
+    for downhill, sign in ((math.pi, 1.0), (0.0, -1.0)):  # climbing; descending
+        block = PostureController("posture", control=True, slope=slope, downhill=downhill, height=1.2)
+        u = np.concatenate([[1.2, 0.0, 0.0, 0.0], np.full(6, 424.0), np.zeros(6)])
+        block.start(0.0, u, 1e-3)
+        rates = []
+        for k in range(1, 81):  # 8 s; the body at its commanded pitch
+            before = block.loops.pitch
+            u[2] = block.loops.pitch
+            block.step((k - 1) * 0.1, 0.1, u)
+            rates.append(abs(block.loops.pitch - before) / 0.1)
+        report = block.report()
+        assert report["pitch_cmd_rad"] == pytest.approx(-sign * slope, abs=1e-6)    # levelled
+        assert max(rates) <= math.radians(3.0) + 1e-12                             # at its rate limit
+        assert report["shift_m"][0] == pytest.approx(-report["height_cmd_m"] * math.tan(report["pitch_cmd_rad"]),
+                                                     rel=1e-12)
+        assert abs(report["roll_cmd_rad"]) < 1e-12
+        paper = joints_of(posture_joints())
+        rotation = attitude(0.0, block.loops.pitch, 0.0)
+        for i, (limb, q) in enumerate(zip(LIMBS, block.loops.joints)):
+            pose = forward(limb, q)
+            axle = rotation @ pose.axle
+            assert abs(axle[2]) < 1e-9 and abs(axle[0]) < 1e-9                   # upright, rolling along x
+            if i in (1, 4):  # the middle limbs: the hub under the hip as before, hip yaw 0, steer 90 deg
+                assert pose.hub[0] == pytest.approx(forward(limb, paper[i]).hub[0], abs=1e-9)
+                assert q[0] == pytest.approx(0.0, abs=1e-9) and abs(q[4]) == pytest.approx(math.pi / 2, abs=1e-9)
+        ground = np.array([rotation @ forward(limb, q).hub for limb, q in zip(LIMBS, block.loops.joints)]).T
+        # in the ground's frame (x along the slope): the footprint kept, the hubs on the ground plane
+        np.testing.assert_allclose(ground[2], ground[2].mean(), atol=1e-9)
+        np.testing.assert_allclose(ground[0, [0, 1, 2]] - ground[0, [3, 4, 5]], 0.0, atol=1e-9)
+        np.testing.assert_allclose(np.diff(ground[0, :3]), [-1.5, -1.5], atol=1e-9)
+
+
+def test_the_posture_block_moves_its_corner_hubs_towards_the_loads_centre_along_the_heading():
+    """Loads heavier at the rear (as on a climb, where the contacts lie uphill of the hubs): the front
+    and rear hubs move back together at the shift's rate limit, the middle hubs stay under their
+    hips; a balanced load moves nothing."""
+    for loads, moves in (((380.0, 420.0, 460.0) * 2, True), ((420.0,) * 6, False)):
+        block = PostureController("posture", control=True)
+        u = np.concatenate([[1.0, 0.0, 0.0, 0.0], loads, np.zeros(6)])
+        block.start(0.0, u, 1e-3)
+        for k in range(1, 11):  # 1 s
+            u[0] = block.loops.height
+            block.step((k - 1) * 0.1, 0.1, u)
+        foot = np.array(block.report()["footprint_m"])
+        moved = foot[:, 0] - np.array(PAPER)[:, 0]
+        np.testing.assert_allclose(moved[[1, 4]], 0.0, atol=1e-15)          # the middle hubs stay
+        np.testing.assert_allclose(foot[:, 1], np.array(PAPER)[:, 1], atol=1e-15)
+        if moves:
+            assert np.all(moved[[0, 2, 3, 5]] < 0) and np.ptp(moved[[0, 2, 3, 5]]) < 1e-15
+            assert moved[0] >= -0.15 * 1.0 - 1e-12                               # the rate limit, 0.15 m/s
+        else:
+            np.testing.assert_allclose(moved, 0.0, atol=1e-12)
 
 
 def test_the_posture_block_steps_a_sunk_wheel_out_and_holds_its_motor_meanwhile():
@@ -243,8 +307,13 @@ def test_the_leg_wheel_scenarios_write_their_files_and_posture_control_spreads_t
             "legwheel_slope_posture.csv"} <= names
     assert set(result.record["fmus"]) >= {"LegWheelRover", "LegWheelRoverBody", "Wheel", "Rover"}
     assert result.record["posture"]["posture"]["control"] and result.record["posture"]["posture"]["updates"] > 0
-    metrics = result.metrics.set_index("run")
-    assert metrics.loc["posture", "load_spread"] < metrics.loc["fixed", "load_spread"]
+    metrics = result.metrics.set_index(["scenario", "run"])
+    assert metrics.loc[("slope", "posture"), "load_spread"] < metrics.loc[("slope", "fixed"), "load_spread"]
+    # the climb: the body pitches towards level (3 deg/s) and the front-rear load spread shrinks already
+    assert metrics.loc[("climb", "posture"), "load_spread"] < metrics.loc[("climb", "fixed"), "load_spread"]
+    assert metrics.loc[("climb", "posture"), "pitch_end_deg"] < -5.0
+    assert abs(metrics.loc[("climb", "fixed"), "pitch_end_deg"]) < 1.0
+    assert {"legwheel_climb_fixed.csv", "legwheel_climb_posture.csv", "legwheel_limbs_climb.png"} <= names
     # the soft patch: the sunk front-left wheel stepped out; in the air it carries no load and makes
     # no force; set down on firm soil it sinks as the others do
     assert [s["limb"] for s in result.record["posture"]["patch_step"]["steps"]] == [1]
@@ -292,8 +361,11 @@ def test_a_rover_too_heavy_for_its_joints_is_refused_before_any_run_with_the_num
 def test_the_stance_figure_draws_both_stances():
     from rover_cosim.jobs import legwheel_figures
 
-    png = legwheel_figures.stance({"paper's posture": (posture_joints(), 0.0, 0.0),
-                                   "levelled": (posture_joints(Posture(1.2, (0.0, 0.3), -0.3)), -0.3, 0.0)}, 20.0)
+    side, climb = math.radians(20.0), math.radians(10.0)
+    png = legwheel_figures.stance({
+        "paper's posture": (posture_joints(), 0.0, 0.0, (side, 0.0)),
+        "levelled": (posture_joints(Posture(1.2, (0.0, 0.3), -0.3)), -0.3, 0.0, (side, 0.0)),
+        "climb": (posture_joints(Posture(1.2, (1.2 * math.tan(climb), 0.0), 0.0, -climb)), 0.0, -climb, (0.0, climb))})
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
 
 

@@ -9,7 +9,7 @@ The joints are :func:`rover_cosim.limbs.stance_inverse`'s for it (numpy), the st
 follower asks for turns the ankle steer joints (about the ankle link: a heading change of ``δ``
 is ``-δ`` on the joint).
 
-With ``control`` the block closes three slow loops every ``period`` [s] (0.1 s; the inverse kinematics
+With ``control`` the block closes its slow loops every ``period`` [s] (0.1 s; the inverse kinematics
 is Newton on a tilted body, warm-started from the last posture):
 
 1. height: ``height_cmd`` integrates the error of the measured height ``z`` (ground frame) so
@@ -18,28 +18,38 @@ is Newton on a tilted body, warm-started from the last posture):
    ``limbs.static_heave`` below it); a levelled body on a side slope stands higher than the
    paper's posture so that the uphill middle limb does not fold shut (at 1.0 m and 20 deg its knee
    is at 170 deg);
-2. attitude: the roll command integrates the error of the measured roll against the level roll
+2. roll: the roll command integrates the error of the measured roll against the level roll
    (the ground's slope seen from the body's heading: on a side slope of θ with the valley to the
    right, roll = -θ levels the body), so that the body ends level however the limbs give;
-3. load balance: the lateral shift of the centre of gravity integrates the lateral offset of the
+3. pitch: the pitch command integrates the error of the measured pitch against the level pitch
+   (on a slope of θ along the heading, uphill ahead, pitch = -θ levels the body), and the centre
+   of gravity moves along the ground with it, ``shift_x`` = -height tan(pitch): so the middle
+   limbs' hubs stay under their hips in the body frame. Those limbs, steered 90 deg in the
+   paper's posture, have their ankle roll axis along the pitch axes (a wrist singularity): they
+   cannot tilt their links along the body, and their hub moves fore and aft only by the hip yaw,
+   whose lever is the 0.125 m from the hip to the hub (a hub 10 mm off would take a 5 deg yaw,
+   and a few mm more the hip yaw and the steer trade places). The same rule is the load balance
+   along the heading: a level body's middle hubs are under its centre of gravity, so the weight's
+   line of action passes through the middle hubs (the lifts keep zero mean, so the middle hubs'
+   mean stays put);
+4. load balance: the lateral shift of the centre of gravity integrates the lateral offset of the
    loads' centre from the footprint's centre (Σ y_i W_i / Σ W_i), so that the weight's line of
-   action passes through the footprint's centre;
-4. load sharing: six limbs carry the body with more contacts than it needs, so how the load
+   action passes through the footprint's centre; along the heading the centre of gravity is the
+   pitch's (3.), so there the corner hubs (front and rear) move fore and aft together until the
+   footprint's centre is the loads' (on a climb the contacts lie r sin θ uphill of the hubs and the
+   pull acts at the ground: the loads' centre falls behind the middle hubs);
+5. load sharing: six limbs carry the body with more contacts than it needs, so how the load
    spreads among them is the limbs' to choose: each hub's ``lift`` integrates its load's excess
    over the mean (over a nominal limb stiffness), the lifts kept at zero mean (the height loop
    owns the mean), until every wheel carries the same load and, on one soil, sinks alike. Without
-   it a stiffer limb (the downhill middle one, stretched) carries most.
+   it a stiffer limb (the downhill middle one, stretched) carries most. (A lift pattern along a
+   plane tilts the body, which the attitude loops tilt back; the shift loops take the plane's
+   part of the loads away first, so the two do not drift against each other.)
 
 With ``step_over`` (``StepOver``) it also steps a stuck wheel out: a wheel that sinks past the
 trigger has its hub lifted (the wheel leaves the ground: no load, no force; the block passes the
 path follower's torques through and holds that wheel's at 0), carried ahead and set down, the
 other five carrying the body; each limb once, one at a time.
-
-Pitch and the longitudinal shift are held at the posture's: the middle limbs, steered 90 deg in
-the paper's posture, have their ankle roll axis along the pitch axes (a wrist singularity) and
-cannot tilt their links along the body; a slope along the heading is left to a later version
-(``limbs.inverse`` stands such a wheel upright, but its hip yaw and steer then trade places over
-small pitch changes).
 
 Every command moves at a bounded rate (``rate_*``), so a posture is reached smoothly from where
 the run starts, and the set-points move linearly from one update's joints to the next over the
@@ -94,7 +104,7 @@ class PostureGains:
     """The loops' integral gains and the commands' rate limits (SI)."""
 
     height: float = 2.0          # 1/s: height command per metre of height error, per second
-    attitude: float = 2.0        # 1/s: roll command per radian of roll error, per second
+    attitude: float = 2.0        # 1/s: roll (pitch) command per radian of roll (pitch) error, per second
     balance: float = 1.0         # 1/s: shift per metre of the loads' offset, per second
     sharing: float = 2.0         # 1/s: lift per metre of load excess (over sharing_stiffness), per second
     sharing_stiffness: float = 2.6e4  # N/m: the nominal limb stiffness the load excess is divided by
@@ -172,7 +182,7 @@ class PostureController:
     """Orchestrator block: inputs ``z``, ``roll``, ``pitch``, ``yaw`` (m, rad), the loads
     ``W[1..6]`` (N) and the steering ``steer[1..6]`` (rad) the path follower asks for; outputs the 36
     joint set-points (``hipYaw[i]`` ... ``ankleRoll[i]``, rad) and the commanded posture
-    (``height_cmd``, ``shift_y`` in m, ``roll_cmd``, ``pitch_cmd`` in rad). See the module docstring."""
+    (``height_cmd``, ``shift_x``, ``shift_y`` in m, ``roll_cmd``, ``pitch_cmd`` in rad). See the module docstring."""
 
     def __init__(self, name: str, *, posture: Posture = Posture(), control: bool = False,
                  slope: float = 0.0, downhill: float = 0.0, height: float | None = None,
@@ -192,6 +202,9 @@ class PostureController:
         self.posture, self.control = posture, bool(control)
         self.slope, self.downhill = float(slope), float(downhill)
         self.footprint = tuple((float(x), float(y)) for x, y in footprint)
+        # the corner limbs: not mounted within 15 deg of straight out sideways (the middle ones, whose
+        # hubs stay under their hips: see the module docstring)
+        self.corner = np.array([abs(math.cos(limb.mount_yaw)) > math.sin(math.radians(15.0)) for limb in self.limbs])
         self.period = float(period)
         self.gains = gains or PostureGains()
         self.step_over = step_over
@@ -204,10 +217,10 @@ class PostureController:
                        *([f"sinkage[{i}]" for i in range(1, n + 1)] + [f"tau_cmd[{i}]" for i in range(1, n + 1)]
                          if stepping else []))
         self.outputs = (*[f"{joint}[{i}]" for joint in JOINT_INPUTS for i in range(1, n + 1)],
-                        "height_cmd", "shift_y", "roll_cmd", "pitch_cmd",
+                        "height_cmd", "shift_x", "shift_y", "roll_cmd", "pitch_cmd",
                         *([f"tau[{i}]" for i in range(1, n + 1)] if stepping else []))
-        self.units = {"z": "m", "roll": "rad", "pitch": "rad", "yaw": "rad", "height_cmd": "m", "shift_y": "m",
-                      "roll_cmd": "rad", "pitch_cmd": "rad",
+        self.units = {"z": "m", "roll": "rad", "pitch": "rad", "yaw": "rad", "height_cmd": "m", "shift_x": "m",
+                      "shift_y": "m", "roll_cmd": "rad", "pitch_cmd": "rad",
                       **{f"W[{i}]": "N" for i in range(1, n + 1)}, **{f"steer[{i}]": "rad" for i in range(1, n + 1)},
                       **{f"{joint}[{i}]": "rad" for joint in JOINT_INPUTS for i in range(1, n + 1)},
                       **{f"sinkage[{i}]": "m" for i in range(1, n + 1)},
@@ -242,20 +255,26 @@ class PostureController:
         """The slow loops, every ``period`` (see the module docstring)."""
         loops, gains, dt = self.loops, self.gains, self.period
         n = len(self.limbs)
-        z, roll, yaw = float(u[0]), float(u[1]), float(u[3])
+        z, roll, pitch, yaw = float(u[0]), float(u[1]), float(u[2]), float(u[3])
         loads = np.asarray(u[4:4 + n], float)
         roll_level, pitch_level = self.level_attitude(yaw)
         loops.height = _toward(loops.height, loops.height + gains.height * (self.height - z) * dt,
                                gains.rate_height * dt)
         loops.roll = _toward(loops.roll, loops.roll + gains.attitude * (roll_level - roll) * dt,
                              gains.rate_attitude * dt)
-        del pitch_level  # held: see the module docstring
+        loops.pitch = _toward(loops.pitch, loops.pitch + gains.attitude * (pitch_level - pitch) * dt,
+                              gains.rate_attitude * dt)
+        loops.shift[0] = -loops.height * math.tan(loops.pitch)  # the middle hubs under their hips (3.)
         total = float(loads.sum())
         if total > 0:
-            foot = np.array(self.footprint)
-            offset = (foot[:, 1] - foot[:, 1].mean()) @ loads / total  # the loads' centre from the footprint's
-            wanted = float(np.clip(loops.shift[1] - gains.balance * offset * dt, -gains.max_shift, gains.max_shift))
+            foot = loops.footprint
+            offset = (foot - foot.mean(axis=0)).T @ loads / total  # the loads' centre from the footprint's (x, y)
+            wanted = float(np.clip(loops.shift[1] - gains.balance * offset[1] * dt, -gains.max_shift, gains.max_shift))
             loops.shift[1] = _toward(float(loops.shift[1]), wanted, gains.rate_shift * dt)
+            if loops.step is None:  # along the heading: the corner hubs move (4.), not while a limb steps
+                reach = float(foot[self.corner, 0].mean() - np.array(self.footprint)[self.corner, 0].mean())
+                wanted = float(np.clip(reach + gains.balance * offset[0] * dt, -gains.max_shift, gains.max_shift))
+                foot[self.corner, 0] += _toward(reach, wanted, gains.rate_shift * dt) - reach
             carrying = np.ones(n, bool)
             if loops.step is not None:
                 carrying[loops.step.limb] = False  # the stepping limb carries nothing and shares nothing
@@ -301,7 +320,7 @@ class PostureController:
         fraction = min(max((now - (loops.next_update - self.period)) / self.period, 0.0), 1.0)
         joints = loops.previous + fraction * (loops.joints - loops.previous)
         joints[:, 4] -= np.asarray(u[4 + n:4 + 2 * n], float)  # a heading change of d is -d on the steer joint
-        commands = [loops.height, loops.shift[1], loops.roll, loops.pitch]
+        commands = [loops.height, loops.shift[0], loops.shift[1], loops.roll, loops.pitch]
         if self.step_over is None:
             return np.concatenate([joints.T.reshape(-1), commands])
         torques = np.asarray(u[4 + 3 * n:4 + 4 * n], float).copy()

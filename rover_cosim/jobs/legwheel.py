@@ -15,6 +15,10 @@ run ``fixed`` (the paper's posture, the body parallel to the slope) and ``postur
 controller levels the body and shifts the centre of gravity uphill until the wheels' loads
 balance).
 
+Scenario ``climb``: the same 6 m at 0.3 m/s straight up a 10 deg slope, ``fixed`` against
+``posture`` (the body pitched level, nose down against the slope, its centre of gravity carried
+uphill with the pitch so that the middle hubs stay under their hips: ``control.posture``).
+
 Scenario ``patch``: the front-left wheel starts in a soft patch (``PATCH``, ``soft_soil``: it sinks
 about 115 mm against 24 mm), the soil under each wheel from its hub's place (``LimbSoilBlock``);
 the rover creeps 0.8 m at 0.1 m/s; run ``roll`` (posture control, the wheel rolls out) and ``step``
@@ -27,15 +31,17 @@ results/simulation/
   legwheel_rms.csv          limb, RMS(Fx - Fx_des) [N] on the leg-wheel rover, on Rover.fmu, the paper's
   legwheel_slope_<run>.csv  the columns of path_*.csv, z, roll, pitch, the posture's commands and
                             per limb the joint torques
+  legwheel_climb_<run>.csv  the same columns for the climb
   legwheel_patch_<run>.csv  time, x, v; per wheel the applied torque, load, sinkage, slip, Fx, the
                             soft soil's share, the hub's x, spin and the joint torques
-  legwheel_metrics.csv      per scenario and run: slope: load spread (max/min of the mean loads over the
+  legwheel_metrics.csv      per scenario and run: slope and climb: load spread (max/min of the mean loads over the
                             second half), sinkage spread (max - min) [m], cross-track RMS and max [m],
                             the motors' energy per metre [J/m], RMS(Fx - Fx_des) per limb [N]; patch:
                             distance [m], mean speed [m/s], energy per metre [J/m], the front-left
                             wheel's deepest sinkage [m] and time in the patch [s]
-  legwheel_stance.png       side and top views of the stances (paper's posture, levelled on the slope)
-  legwheel_limbs_<scenario>.png  per limb: joint torques, load, sinkage, slip (straight, slope, patch)
+  legwheel_stance.png       side, front and top views of the stances (paper's posture, levelled on the
+                            side slope, levelled on the climb)
+  legwheel_limbs_<scenario>.png  per limb: joint torques, load, sinkage, slip (straight, slope, climb, patch)
   legwheel.json             parameters, FMU hashes, versions, wall times, metrics, the posture's report
 """
 
@@ -75,11 +81,13 @@ from .terrain import motor_energy, stop_time, traverse_path
 
 FMUS = ("LegWheelRover", "LegWheelRoverBody", "Wheel", "Rover")
 SLOPE_DEG = 20.0      # deg, the side slope (the valley to the right)
+CLIMB_DEG = 10.0      # deg, the slope climbed straight up
 SPEED = 0.3           # m/s
 TRAVERSE = 6.0        # m
 RUNS = ("fixed", "posture")
 LEVEL_HEIGHT = 1.2    # m, the centre of gravity over the hubs the posture controller holds (see control.posture)
 LABELS = {"fixed": "paper's posture, parallel to the slope", "posture": "posture control (level, load balanced)"}
+CLIMB_LABELS = {"fixed": "paper's posture, parallel to the slope", "posture": "posture control (pitched level)"}
 TORQUES = tuple(f"{joint}Torque" for joint in JOINT_INPUTS)
 
 
@@ -207,11 +215,25 @@ def _add_path_and_posture(builder: SystemBuilder, model: ModelSet | Path, choice
 def slope_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choice | None = None, *,
                  slope_deg: float = SLOPE_DEG, length: float = TRAVERSE, speed: float = SPEED) -> System:
     """The side-slope traverse on LegWheelRover.fmu, run ``run_`` "fixed" or "posture" (see the module)."""
+    return _plane_system(fmu_dir, model, run_, choice, PlaneTerrain.side_slope(slope_deg, valley="right"),
+                         f"leg-wheel traverse, {slope_deg:g} deg side slope ({run_})", length, speed)
+
+
+def climb_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choice | None = None, *,
+                 slope_deg: float = CLIMB_DEG, length: float = TRAVERSE, speed: float = SPEED) -> System:
+    """The climb straight up a slope on LegWheelRover.fmu, run ``run_`` "fixed" or "posture" (see the module)."""
+    return _plane_system(fmu_dir, model, run_, choice, PlaneTerrain(math.radians(slope_deg), math.pi),
+                         f"leg-wheel climb, {slope_deg:g} deg slope ({run_})", length, speed)
+
+
+def _plane_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choice | None, terrain: PlaneTerrain,
+                  title: str, length: float, speed: float) -> System:
+    """A straight of ``length`` [m] along +x at ``speed`` [m/s] over ``terrain`` on LegWheelRover.fmu,
+    in the paper's posture ("fixed") or under posture control ("posture")."""
     if run_ not in RUNS:
         raise ValueError(f"run {run_!r}: expected one of {', '.join(RUNS)}")
     choice = as_choice(choice)
-    terrain = PlaneTerrain.side_slope(slope_deg, valley="right")
-    builder = SystemBuilder(f"leg-wheel traverse, {slope_deg:g} deg side slope ({run_})").simulation(
+    builder = SystemBuilder(title).simulation(
         stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
     radius = choice.wheel.r
     start = {"v": speed, "height0": settled_height(choice), **{f"omega[{i}]": speed / radius for i in range(1, 7)}}
@@ -310,7 +332,8 @@ def slope_table(data: pd.DataFrame) -> pd.DataFrame:
 
     table = trajectories(data, cosim=False)
     extra = {name: data[f"rover.{name}"] for name in ("z", "roll", "pitch")}
-    extra.update({name: data[f"posture.{name}"] for name in ("height_cmd", "shift_y", "roll_cmd", "pitch_cmd")})
+    extra.update({name: data[f"posture.{name}"] for name in ("height_cmd", "shift_x", "shift_y", "roll_cmd",
+                                                             "pitch_cmd")})
     return pd.concat([table, pd.DataFrame({**extra, **_joint_torques(data)})], axis=1)
 
 
@@ -325,14 +348,18 @@ def slope_metrics(table: pd.DataFrame, length: float = TRAVERSE, speed: float = 
     row["sinkage_spread_m"] = float(sinkages.max() - sinkages.min())
     row["energy_per_metre_J_m"] = motor_energy(table) / max(float(table["x"].iloc[-1] - table["x"].iloc[0]), 1e-9)
     row["roll_end_deg"] = float(np.degrees(table["roll"].iloc[-1]))
+    row["pitch_end_deg"] = float(np.degrees(table["pitch"].iloc[-1]))
+    row["shift_x_end_m"] = float(table["shift_x"].iloc[-1])
     row["shift_y_end_m"] = float(table["shift_y"].iloc[-1])
+    row["mean_speed_m_s"] = float(table["v"][table["time"] >= table["time"].iloc[-1] / 2].mean())
     return row
 
 
 def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soil | Wheel | None = None, *,
                  allow_model_mismatch: bool = False, progress: Callable[[float], None] | None = None,
                  record_interval: float = RECORD_INTERVAL, stop: float = STOP_TIME, length: float = TRAVERSE,
-                 slope_deg: float = SLOPE_DEG, patch_stop: float = math.inf) -> LegWheelResult:
+                 slope_deg: float = SLOPE_DEG, climb_deg: float = CLIMB_DEG,
+                 patch_stop: float = math.inf) -> LegWheelResult:
     """The leg-wheel scenarios (see the module); writes every file (all or none). The rover is the
     paper's (the leg-wheel limbs are its); ``choice`` gives the soil and wheel (and the rover's mass
     and inertias); ``stop`` [s], ``length`` [m] and ``patch_stop`` [s] shorten the runs (tests)."""
@@ -343,7 +370,7 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     check_carryable(choice)
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
-    campaign = Campaign("rover-cosim simulate --only legwheel", 3 + len(RUNS) + len(PATCH_RUNS), progress)
+    campaign = Campaign("rover-cosim simulate --only legwheel", 3 + 2 * len(RUNS) + len(PATCH_RUNS), progress)
     tables = {"straight": straight_table(campaign.run("straight", straight_system(fmu_dir, models, choice,
                                                                                    stop)).data),
               "straight_cosim": straight_table(campaign.run("straight_cosim", straight_cosim_system(
@@ -352,32 +379,32 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     tables["straight_spring_damper"] = straight_trajectories(campaign.run("straight_spring_damper", spring).data,
                                                              "monolithic")
     reports = {}
-    for run_ in RUNS:
-        system = slope_system(fmu_dir, models, run_, choice, slope_deg=slope_deg, length=length)
-        tables[f"slope_{run_}"] = slope_table(campaign.run(f"slope_{run_}", system).data)
-        reports[run_] = next(b.block for b in system.blocks if b.name == "posture").report()  # type: ignore[attr-defined]
+    for scenario, make, degrees in (("slope", slope_system, slope_deg), ("climb", climb_system, climb_deg)):
+        for run_ in RUNS:
+            system = make(fmu_dir, models, run_, choice, slope_deg=degrees, length=length)
+            tables[f"{scenario}_{run_}"] = slope_table(campaign.run(f"{scenario}_{run_}", system).data)
+            reports[run_ if scenario == "slope" else f"{scenario}_{run_}"] = _posture_report(system)
     for run_ in PATCH_RUNS:
         system = dataclasses.replace(patch_system(fmu_dir, models, run_, choice),
                                      stop_time=min(stop_time(float(PATCH["length"]), float(PATCH["speed"])),  # type: ignore[arg-type]
                                                    patch_stop))
         tables[f"patch_{run_}"] = patch_table(campaign.run(f"patch_{run_}", system).data)
-        reports[f"patch_{run_}"] = next(b.block for b in system.blocks if b.name == "posture").report()  # type: ignore[attr-defined]
+        reports[f"patch_{run_}"] = _posture_report(system)
     legs, spring_rms = rms(tables["straight"]), rms(tables["straight_spring_damper"])
     rms_table = pd.DataFrame({"limb": legs["limb"], "rms_legwheel_N": legs["rms_N"],
                               "rms_legwheel_cosim_N": rms(tables["straight_cosim"])["rms_N"],
                               "rms_spring_damper_N": spring_rms["rms_N"],
                               "rms_paper_N": [TABLE_3_RMS.get(int(i), TABLE_3_RMS.get(int(i) - 3, math.nan))
                                               for i in legs["limb"]]})
-    rows = []
-    for run_ in RUNS:
-        rows.append({"scenario": "slope", "run": run_, **slope_metrics(tables[f"slope_{run_}"], length)})
-    for run_ in PATCH_RUNS:
-        rows.append({"scenario": "patch", "run": run_, **patch_metrics(tables[f"patch_{run_}"])})
+    rows = [{"scenario": scenario, "run": run_, **slope_metrics(tables[f"{scenario}_{run_}"], length)}
+            for scenario in ("slope", "climb") for run_ in RUNS]
+    rows += [{"scenario": "patch", "run": run_, **patch_metrics(tables[f"patch_{run_}"])} for run_ in PATCH_RUNS]
     metrics = pd.DataFrame(rows)
     agreement = {"spring_damper": _straight_agreement(tables["straight"], tables["straight_spring_damper"]),
                  "cosim": _straight_agreement(tables["straight"], tables["straight_cosim"])}
     record = campaign.record({"stop_time_s": stop, "model": str(model), "record_interval_s": record_interval,
-                              "slope_deg": slope_deg, "traverse_m": length, "speed_m_s": SPEED,
+                              "slope_deg": slope_deg, "climb_deg": climb_deg, "traverse_m": length,
+                              "speed_m_s": SPEED,
                               "posture": "paper's: hubs at x = 1.5, 0, -1.5 m, y = +-1.5 m, 1.0 m below the "
                                          "centre of gravity"},
                              fmu_dir=fmu_dir, fmus=FMUS, model=model, choice=choice, mismatch=mismatch,
@@ -385,24 +412,29 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
                              straight_agreement=agreement, metrics=metrics.to_dict(orient="records"),
                              posture=reports)
     out = Path(out_dir)
-    last = tables["slope_posture"].iloc[-1]
-    stance = {"paper's posture, parallel to the slope": (posture_joints(), 0.0, 0.0),
-              "posture control (its end)": (_end_joints(tables["slope_posture"]),
-                                                         float(last["roll_cmd"]), float(last["pitch_cmd"]))}
+    side, climb = math.radians(slope_deg), math.radians(climb_deg)
+    stance = {f"paper's posture on the {slope_deg:g} deg side slope": (posture_joints(), 0.0, 0.0, (side, 0.0)),
+              "posture control, side slope (its end)": (*_end_posture(tables["slope_posture"], reports["posture"]),
+                                                        (side, 0.0)),
+              f"posture control, {climb_deg:g} deg climb (its end)": (
+                  *_end_posture(tables["climb_posture"], reports["climb_posture"]), (0.0, climb))}
     files = {
         out / "legwheel_straight.csv": csv_bytes(every(tables["straight"], record_interval, STEP), "%.8g"),
         out / "legwheel_rms.csv": rms_table.to_csv(index=False, float_format="%.4f").encode(),
         out / "legwheel_metrics.csv": metrics.to_csv(index=False, float_format="%.6g").encode(),
-        out / "legwheel_stance.png": legwheel_figures.stance(stance, slope_deg),
+        out / "legwheel_stance.png": legwheel_figures.stance(stance),
         out / "legwheel_limbs_straight.png": legwheel_figures.limbs({"leg-wheel rover": tables["straight"]},
                                                                     "straight run, paper's posture"),
         out / "legwheel_limbs_slope.png": legwheel_figures.limbs(
             {LABELS[r]: tables[f"slope_{r}"] for r in RUNS}, f"{slope_deg:g} deg side slope at {SPEED:g} m/s"),
+        out / "legwheel_limbs_climb.png": legwheel_figures.limbs(
+            {CLIMB_LABELS[r]: tables[f"climb_{r}"] for r in RUNS}, f"{climb_deg:g} deg climb at {SPEED:g} m/s"),
         out / "legwheel.json": json_bytes(record),
     }
-    for run_ in RUNS:
-        files[out / f"legwheel_slope_{run_}.csv"] = csv_bytes(every(tables[f"slope_{run_}"], record_interval, STEP),
-                                                              "%.8g")
+    for scenario in ("slope", "climb"):
+        for run_ in RUNS:
+            files[out / f"legwheel_{scenario}_{run_}.csv"] = csv_bytes(
+                every(tables[f"{scenario}_{run_}"], record_interval, STEP), "%.8g")
     for run_ in PATCH_RUNS:
         files[out / f"legwheel_patch_{run_}.csv"] = csv_bytes(every(tables[f"patch_{run_}"], record_interval, STEP),
                                                               "%.8g")
@@ -413,12 +445,18 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     return LegWheelResult(written, tables, rms_table, metrics, record)
 
 
-def _end_joints(table: pd.DataFrame) -> dict[str, float]:
-    """The set-points of the posture at the end of a traverse (its commanded posture, wheels straight)."""
+def _posture_report(system: System) -> dict[str, Any]:
+    return next(b.block for b in system.blocks if b.name == "posture").report()  # type: ignore[attr-defined]
+
+
+def _end_posture(table: pd.DataFrame, report: dict[str, Any]) -> tuple[dict[str, float], float, float]:
+    """The set-points of the posture at the end of a traverse (its commanded posture over the
+    footprint of the block's ``report``, wheels straight), its roll and pitch [rad] against the ground."""
     last = table.iloc[-1]
-    posture = Posture(float(last["height_cmd"]), (0.0, float(last["shift_y"])), float(last["roll_cmd"]),
-                      float(last["pitch_cmd"]))
-    return posture_joints(posture)
+    posture = Posture(float(last["height_cmd"]), (float(last["shift_x"]), float(last["shift_y"])),
+                      float(last["roll_cmd"]), float(last["pitch_cmd"]), tuple(report["lift_m"]))
+    footprint = [(float(x), float(y)) for x, y in report["footprint_m"]]
+    return posture_joints(posture, footprint=footprint), posture.roll, posture.pitch
 
 
 def _straight_agreement(legs: pd.DataFrame, other: pd.DataFrame) -> dict[str, float]:

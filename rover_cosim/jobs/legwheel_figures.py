@@ -17,11 +17,11 @@ JOINT_LABELS = ("hip yaw", "hip pitch", "knee pitch", "ankle pitch", "ankle stee
 LIMB_NAMES = ("front left", "middle left", "rear left", "front right", "middle right", "rear right")
 
 
-def _chains(joints: dict[str, float], roll: float, pitch: float, ground_roll: float) -> list[np.ndarray]:
+def _chains(joints: dict[str, float], roll: float, pitch: float, ground: tuple[float, float]) -> list[np.ndarray]:
     """Per limb, the points mount, knee, ankle pitch joint, ankle joint, hub in the world [m] (origin
     at the centre of gravity, x along the heading) for the set-points ``joints``, the body turned by
-    ``roll``, ``pitch`` [rad] against the ground and the ground rolled by ``ground_roll`` [rad]."""
-    rotation = attitude(ground_roll, 0.0, 0.0) @ attitude(roll, pitch, 0.0)
+    ``roll``, ``pitch`` [rad] against the ground and the ground by ``ground`` (roll, pitch) [rad]."""
+    rotation = attitude(ground[0], ground[1], 0.0) @ attitude(roll, pitch, 0.0)
     chains = []
     for i, limb in enumerate(athlete_limbs()):
         pose = forward(limb, [joints[f"{name}[{i + 1}]"] for name in JOINT_INPUTS])
@@ -30,15 +30,15 @@ def _chains(joints: dict[str, float], roll: float, pitch: float, ground_roll: fl
     return chains
 
 
-def stance(stances: dict[str, tuple[dict[str, float], float, float]], slope_deg: float) -> bytes:
-    """Side, front and top views (left limbs solid, right dashed) of each stance on a side slope of
-    ``slope_deg`` (the valley to the right), in the world: the body's hexagonal frame, each limb's
-    links from hip to hub, the ground through the hubs. ``stances``: label -> (set-points, roll,
-    pitch [rad] of the body against the ground)."""
-    ground_roll = np.radians(slope_deg)  # the valley to the right: the ground's left side up
+def stance(stances: dict[str, tuple[dict[str, float], float, float, tuple[float, float]]]) -> bytes:
+    """Side, front and top views (left limbs solid, right dashed) of each stance in the world: the
+    body's hexagonal frame, each limb's links from hip to hub, the ground through the hubs.
+    ``stances``: label -> (set-points, roll, pitch [rad] of the body against the ground, the ground's
+    (roll, pitch) [rad]: a side slope with the valley to the right rolls it by the slope, a slope
+    climbed along the heading pitches it)."""
     fig, axes = plt.subplots(len(stances), 3, figsize=(16, 4.8 * len(stances)), squeeze=False)
-    for row, (label, (joints, roll, pitch)) in enumerate(stances.items()):
-        chains = _chains(joints, roll, pitch, ground_roll)
+    for row, (label, (joints, roll, pitch, ground)) in enumerate(stances.items()):
+        chains = _chains(joints, roll, pitch, ground)
         mounts = np.array([c[0] for c in chains])
         frame = mounts[[0, 1, 2, 5, 4, 3, 0]]
         for column, (a, b, title) in enumerate(((0, 2, "side view (from the left)"), (1, 2, "front view"),
@@ -51,11 +51,12 @@ def stance(stances: dict[str, tuple[dict[str, float], float, float]], slope_deg:
                         label=LIMB_NAMES[i] if column == 0 else None)
             ax.plot(0, 0, "k+", ms=12, mew=2, label="centre of gravity" if column == 0 else None)
             hubs = np.array([c[-1] for c in chains])
-            if (a, b) == (1, 2):  # the slope's line through the hubs
-                across = np.linspace(hubs[:, 1].min() - 0.3, hubs[:, 1].max() + 0.3, 2)
+            if b == 2:  # the ground's line through the hubs (side view: its pitch; front view: its roll)
+                along = np.linspace(hubs[:, a].min() - 0.3, hubs[:, a].max() + 0.3, 2)
                 middle = hubs.mean(axis=0)
-                ax.plot(across, middle[2] + np.tan(ground_roll) * (across - middle[1]), color="saddlebrown", lw=1,
-                        alpha=0.6, label="ground (through the hubs)")
+                gradient = np.tan(ground[1]) if a == 0 else np.tan(ground[0])
+                ax.plot(along, middle[2] + gradient * (along - middle[a]), color="saddlebrown", lw=1,
+                        alpha=0.6, label="ground (through the hubs)" if column == 0 else None)
             names = "xyz"
             ax.set_xlabel(f"{names[a]} [m] (world, x along the heading)")
             ax.set_ylabel(f"{names[b]} [m]")
@@ -63,10 +64,8 @@ def stance(stances: dict[str, tuple[dict[str, float], float, float]], slope_deg:
             ax.grid(alpha=0.3)
             ax.set_title(f"{label}: {title}", fontsize=10)
     handles, labels = axes[0][0].get_legend_handles_labels()
-    more = axes[0][1].get_legend_handles_labels()
-    handles, labels = handles + more[0][-1:], labels + more[1][-1:]
     fig.legend(handles, labels, loc="lower center", ncol=5, fontsize=9)
-    fig.suptitle(f"Leg-wheel rover stances on a {slope_deg:g} deg side slope (the valley to the right)")
+    fig.suptitle("Leg-wheel rover stances (side slopes: the valley to the right; climbs: uphill ahead)")
     fig.tight_layout(rect=(0, 0.08, 1, 0.97))
     return png_bytes(fig)
 

@@ -515,7 +515,11 @@ def legwheel_section(simulation: Path) -> list[str]:
                  "steering through the ankle steer joints; <b>fixed</b>: the paper's posture, the body parallel "
                  "to the slope; <b>posture control</b>: the body levelled (rolled against the slope), raised to "
                  "1.2 m, its centre of gravity moved uphill until the weight's line passes through the "
-                 "footprint's centre, and each hub raised or lowered until the six wheels share the load.</p>")]
+                 "footprint's centre, and each hub raised or lowered until the six wheels share the load. "
+                 "<b>Climb</b>: the same 6 m straight up a 10&deg; slope; posture control pitches the body level "
+                 "(nose down against the slope) and carries its centre of gravity uphill with the pitch, so that "
+                 "the middle hubs stay under their hips (their wrist cannot tilt the link along the body) and "
+                 "the weight's line passes through the footprint's centre.</p>")]
     rms_path, metrics_path = simulation / "legwheel_rms.csv", simulation / "legwheel_metrics.csv"
     if not rms_path.exists() or not metrics_path.exists():
         return [*sections, "<p>Not run: the leg-wheel scenarios are the paper's rover's "
@@ -526,6 +530,7 @@ def legwheel_section(simulation: Path) -> list[str]:
         "rms_paper_N": "paper, Table 3 [N]"})
     metrics = pd.read_csv(metrics_path)
     patch = metrics[metrics["scenario"] == "patch"]
+    climb = metrics[metrics["scenario"] == "climb"]
     metrics = metrics[metrics["scenario"] == "slope"]
     shown = pd.DataFrame({
         "run": metrics["run"].map({"fixed": "paper's posture (fixed)", "posture": "posture control"}),
@@ -539,6 +544,7 @@ def legwheel_section(simulation: Path) -> list[str]:
                  "<h3>20&deg; side slope</h3>",
                  "<p>Load and sinkage spreads: over the six wheels' means in the run's second half.</p>",
                  table(shown, default="{:.3g}"),
+                 *_climb_table(climb),
                  "<h3>A wheel in a soft patch</h3>",
                  ("<p>The front-left wheel starts in a patch of loose dust (ours: the paper's soil with a tenth of "
                   "its pressure-sinkage moduli, a quarter of its cohesion, 30&deg; friction: it sinks about 115 mm "
@@ -553,14 +559,29 @@ def legwheel_section(simulation: Path) -> list[str]:
                      "front-left sinkage max [mm]": 1000 * patch["sinkage_1_max_m"],
                      "in the patch [s]": patch["in_patch_s"]}), default="{:.3g}"),
                  image(simulation / "legwheel_stance.png", "the stances: the paper's posture and the posture "
-                       "control's on the slope (side, front and top views)"),
+                       "control's on the side slope and on the climb (side, front and top views)"),
                  image(simulation / "legwheel_limbs_slope.png", "side slope, per limb: joint torques, load, "
+                       "sinkage, slip (solid: fixed posture; dashed: posture control)"),
+                 image(simulation / "legwheel_limbs_climb.png", "climb, per limb: joint torques, load, "
                        "sinkage, slip (solid: fixed posture; dashed: posture control)"),
                  image(simulation / "legwheel_limbs_patch.png", "soft patch, per limb: joint torques, load, "
                        "sinkage, slip (solid: rolls through; dashed: steps the wheel out)"),
                  image(simulation / "legwheel_limbs_straight.png", "straight run, per limb: joint torques, load, "
                        "sinkage, slip")]
     return sections
+
+
+def _climb_table(climb: pd.DataFrame) -> list[str]:
+    """The climb's rows of legwheel_metrics.csv as a table (none: a run from before the climb)."""
+    if climb.empty or "pitch_end_deg" not in climb.columns:
+        return []
+    return ["<h3>10&deg; climb</h3>",
+            table(pd.DataFrame({
+                "run": climb["run"].map({"fixed": "paper's posture (fixed)", "posture": "posture control"}),
+                "load max/min": climb["load_spread"], "sinkage max - min [mm]": 1000 * climb["sinkage_spread_m"],
+                "mean speed [m/s]": climb["mean_speed_m_s"], "energy [J/m]": climb["energy_per_metre_J_m"],
+                "pitch at the end [°]": climb["pitch_end_deg"], "CoG shift uphill [m]": climb["shift_x_end_m"]}),
+                default="{:.3g}")]
 
 
 def effects_section(simulation: Path) -> list[str]:
