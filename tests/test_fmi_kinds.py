@@ -44,7 +44,7 @@ def _ball(path: Path, algorithm: str = "jacobi", interface: str | None = None, s
             .add_fmu("ball", path, interface=interface).record("ball.h", "ball.count").build())
 
 
-@pytest.mark.parametrize("algorithm", ["jacobi", "gauss-seidel", "iterative"])
+@pytest.mark.parametrize("algorithm", ["jacobi", "gauss-seidel", "iterative", "gauss-seidel-interpolated"])
 def test_a_model_exchange_fmu_is_integrated_to_the_exact_bounces(ball2, algorithm):
     data = run(_ball(ball2, algorithm)).data
     height, bounces = _exact(data["time"])
@@ -93,7 +93,7 @@ def test_an_fmu_ending_the_simulation_in_an_event_ends_the_run_cleanly(ball2):
     assert abs(result.data["time"].iloc[-1] - third) < 1e-4 and result.data["ball.h"].iloc[-1] == 0.0
 
 
-@pytest.mark.parametrize("algorithm", ["jacobi", "gauss-seidel", "iterative"])
+@pytest.mark.parametrize("algorithm", ["jacobi", "gauss-seidel", "iterative", "gauss-seidel-interpolated"])
 def test_discrete_inputs_of_a_model_exchange_fmu_are_set_in_event_mode(ball2, tmp_path, algorithm):
     """The ball is frozen (a discrete Boolean input, which the FMU accepts only in Event Mode) from
     0.2 s to 0.3 s while a continuous input is also connected: its height stands still for 0.1 s

@@ -24,7 +24,7 @@ STEP_INPUT = [(0.0, 0.0, 0), (0.5, 0.0, 0), (0.5, 1.0, 1), (1.0, 1.0, 1)]
 #: u = t, k rising 0 -> 3 (held between the rows)
 RAMP_INPUT = [(0.0, 0.0, 0), (1.0, 1.0, 3)]
 INPUTS = {"step": STEP_INPUT, "ramp": RAMP_INPUT}
-MASTERS = ("gauss-seidel", "jacobi", "iterative")
+MASTERS = ("gauss-seidel", "jacobi", "iterative", "gauss-seidel-interpolated")
 
 
 @pytest.fixture(scope="module")

@@ -88,7 +88,7 @@ def figure_png(table: pd.DataFrame) -> bytes:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
-    for algorithm, marker in zip(ALGORITHMS, ("o", "s", "^")):
+    for algorithm, marker in zip(ALGORITHMS, ("o", "s", "D", "^")):
         part = table[table["algorithm"] == algorithm]
         axes[0].loglog(part["step_s"] * 1e3, part["max_abs_v_error_m_s"], marker=marker, label=algorithm)
         axes[1].loglog(part["step_s"] * 1e3, part["max_abs_Fz_error_N"], marker=marker, label=algorithm)

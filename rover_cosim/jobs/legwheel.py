@@ -169,10 +169,13 @@ def straight_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
 def straight_cosim_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None = None,
                           stop: float = STOP_TIME) -> System:
     """:func:`straight_system` on LegWheelRoverBody + 6 Wheel, cut at the hubs as the steerable rover
-    is (W, v_hub, v_lat to each wheel; its Fx, Fy back), the controller first in the Gauss-Seidel order."""
+    is (W, v_hub, v_lat to each wheel; its Fx, Fy back), the controller first in the Gauss-Seidel order;
+    the wheels take the body's hub values as a ramp over each step (``gauss-seidel-interpolated``: with
+    them held at their end value, half a step ahead of an accelerating body, the rover was 33 mm
+    ahead of the monolithic one after 18 m; ramped, under 1 mm)."""
     choice = as_choice(choice)
     builder = SystemBuilder("leg-wheel straight run (co-simulated)").simulation(stop_time=stop, step=STEP,
-                                                                                algorithm="gauss-seidel")
+                                                                                algorithm="gauss-seidel-interpolated")
     wheels = add_rover(builder, Path(fmu_dir) / "LegWheelRoverBody.fmu", Path(fmu_dir) / "Wheel.fmu", 6, None,
                        lateral=True, body_start={"height0": settled_height(choice)})
     builder.set_parameters("body", leg_parameters(choice), only_known=True)
