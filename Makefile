@@ -146,6 +146,8 @@ lint: $(STAMP)
 	$(VENV)/bin/mypy
 
 ## bench: benchmarks (not tests) -> results/bench/*.json (installs the bench extra: ecospy)
+## BASELINE=REV: the commit the commands are timed against side by side (default the previous one; empty: none)
+BASELINE ?= HEAD~1
 BENCH_STAMP := $(VENV)/.installed-bench
 $(BENCH_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet -e '.[bench]'
@@ -163,7 +165,7 @@ bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_closed_loop.py --out $(RESULTS)/bench/closed_loop.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_path_following.py --out $(RESULTS)/bench/path_following.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_legwheel.py --out $(RESULTS)/bench/legwheel.json --model $(RESULTS)/identification/model.json
-	$(PY) -P benchmarks/bench_pipeline.py --out $(RESULTS)/bench/pipeline.json
+	$(PY) -P benchmarks/bench_pipeline.py --out $(RESULTS)/bench/pipeline.json $(if $(BASELINE),--baseline-rev $(BASELINE))
 
 clean:
 	rm -rf $(VENV) $(RESULTS) .pytest_cache fmus/*.fmu fmus/.*.partial

@@ -9,6 +9,12 @@ Reported per stage: wall seconds, exit code and the command line; for the Monte 
 per minute (its runs counted from its runs.csv), and for the simulated stages the seconds of
 simulated time per wall second where the stage's record says how much it simulated. Not a test:
 nothing asserts a time.
+
+``--baseline-rev REV`` (``make bench``: the previous commit) checks REV out into the scratch folder
+(a git worktree, removed at the end) and runs every stage with its code right after ours, into a
+folder of its own: each stage's ratio to it, measured side by side in one run. ``goals`` in the
+output: issue 49's goals, each with what this run measured, the baseline's, the goal and whether
+it is met (the benchmarks page shows them as a table).
 """
 
 from __future__ import annotations
@@ -45,7 +51,35 @@ def stages(folder: Path, runs: int) -> list[tuple[str, list[str]]]:
                                   "--fmu-dir", str(fmus), "--model", str(model)]),
         ("montecarlo, 2 workers", ["montecarlo", "--runs", str(runs), "--workers", "2", "--out", str(folder / "mc2"),
                                    "--fmu-dir", str(fmus), "--model", str(model)]),
+        ("montecarlo --adapt, 2 workers", ["montecarlo", "--adapt", "--runs", str(max(2, runs // 4)), "--workers", "2",
+                                           "--out", str(folder / "mca"), "--fmu-dir", str(fmus),
+                                           "--model", str(model)]),
     ]
+
+
+#: Issue 49's goals: (name, stage, quantity in the stage's entry, the goal, True: at least it).
+GOALS = (
+    ("closed loop, 20 s on Rover.fmu: real-time factor", "simulate", "closed_loop_real_time_factor", 50.0, True),
+    ("Monte Carlo, 2 workers: runs per minute", "montecarlo, 2 workers", "runs_per_minute", 300.0, True),
+    ("Monte Carlo --adapt, 2 workers: runs per minute", "montecarlo --adapt, 2 workers", "runs_per_minute", 120.0,
+     True),
+    ("simulate --only path, whole command: real-time factor", "simulate --only path", "real_time_factor", 20.0, True),
+    ("six FMUs built (host only): seconds", "build-fmus", "wall_seconds", 20.0, False),
+)
+
+
+def goals(results: dict[str, Any]) -> list[dict[str, Any]]:
+    """Each goal of ``GOALS`` with what the stages measured (and their baselines'), the goal and
+    whether it is met; a stage not run or without the quantity: None."""
+    rows = []
+    for name, stage, quantity, goal, at_least in GOALS:
+        entry = results.get(stage, {})
+        value = entry.get(quantity)
+        baseline = entry.get("baseline", {}).get(quantity)
+        met = None if value is None else (value >= goal if at_least else value <= goal)
+        rows.append({"goal": name, "measured": value, "baseline": baseline,
+                     "target": f"{'>=' if at_least else '<='} {goal:g}", "met": met})
+    return rows
 
 
 def simulated_seconds(folder: Path, name: str) -> float | None:
@@ -96,7 +130,29 @@ def time_stage(name: str, arguments: list[str], folder: Path, code: Path | None 
     if simulated:
         entry["simulated_seconds"] = simulated
         entry["real_time_factor"] = simulated / wall
+    straight = folder / "results" / "simulation" / "simulation.json"
+    if name == "simulate" and straight.is_file():  # the closed loop on Rover.fmu inside the command
+        record = json.loads(straight.read_text())
+        inside = record["run_wall_seconds"].get("monolithic")
+        if inside:
+            entry["closed_loop_real_time_factor"] = record["parameters"]["stop_time_s"] / inside
     return entry
+
+
+def checkout(revision: str, folder: Path) -> Path:
+    """``revision`` of this repository checked out into ``folder`` (a detached git worktree)."""
+    root = Path(__file__).resolve().parent.parent
+    done = subprocess.run(["git", "-C", str(root), "worktree", "add", "--detach", "--quiet", str(folder), revision],
+                          capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise SystemExit(f"--baseline-rev {revision}: git worktree add failed: {done.stderr.strip()}")
+    return folder
+
+
+def remove_checkout(folder: Path) -> None:
+    root = Path(__file__).resolve().parent.parent
+    subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(folder)], capture_output=True,
+                   check=False)
 
 
 def main() -> None:
@@ -107,40 +163,61 @@ def main() -> None:
                         "runs, since each may need what the ones before it wrote)")
     parser.add_argument("--baseline", type=Path, default=None, help="a checkout of another commit: every stage also "
                         "runs with its code, right after ours, into a folder of its own (ratios side by side)")
+    parser.add_argument("--baseline-rev", default=None, metavar="REV",
+                        help="as --baseline, the commit REV checked out for the run (e.g. HEAD~1)")
     args = parser.parse_args()
     if args.runs < 2:
         parser.error(f"--runs={args.runs}: expected an integer >= 2")
+    if args.baseline is not None and args.baseline_rev is not None:
+        parser.error("--baseline and --baseline-rev: expected one of them")
     results: dict[str, Any] = {}
-    with tempfile.TemporaryDirectory(prefix="bench-pipeline-") as scratch:
-        folder, other = Path(scratch) / "ours", Path(scratch) / "baseline"
-        pairs = zip(stages(folder, args.runs), stages(other, args.runs))
-        for (name, arguments), (_, baseline_arguments) in pairs:
-            entry = time_stage(name, arguments, folder)
-            if args.baseline is not None:
-                entry["baseline"] = time_stage(name, baseline_arguments, other, args.baseline)
-                entry["ratio_to_baseline"] = entry["wall_seconds"] / entry["baseline"]["wall_seconds"]
-            timed = args.only is None or name in args.only
-            print(f"{name:24s} {entry['wall_seconds']:8.1f} s  exit {entry['exit_code']}"
-                  + (f"  {entry['runs_per_minute']:.0f} runs/min" if "runs_per_minute" in entry else "")
-                  + (f"  {entry['real_time_factor']:.1f}x real time" if "real_time_factor" in entry else "")
-                  + (f"  (baseline {entry['baseline']['wall_seconds']:.1f} s: {entry['ratio_to_baseline']:.2f}x)"
-                     if "baseline" in entry else "")
-                  + ("" if timed else "  (not recorded)"))
-            for run in (entry, entry.get("baseline", {})):
-                if run.get("exit_code", 0) != 0:
-                    print(run["stderr"], file=sys.stderr)
-            if timed:
-                results[name] = entry
     baseline = None
-    if args.baseline is not None:
-        done = subprocess.run(["git", "-C", str(args.baseline), "rev-parse", "HEAD"], capture_output=True, text=True,
-                              check=False)
-        baseline = {"path": str(args.baseline), "git_commit": done.stdout.strip() or None}
+    with tempfile.TemporaryDirectory(prefix="bench-pipeline-") as scratch:
+        if args.baseline_rev is not None:
+            args.baseline = checkout(args.baseline_rev, Path(scratch) / "code")
+        if args.baseline is not None:
+            done = subprocess.run(["git", "-C", str(args.baseline), "rev-parse", "HEAD"], capture_output=True,
+                                  text=True, check=False)
+            baseline = {"path": str(args.baseline), "revision": args.baseline_rev,
+                        "git_commit": done.stdout.strip() or None}
+        try:
+            run_stages(args, Path(scratch), results)
+        finally:
+            if args.baseline_rev is not None:
+                remove_checkout(Path(scratch) / "code")
     record = run_record("make bench", {"monte_carlo_runs": args.runs, "cpus": os.cpu_count(), "baseline": baseline})
-    write_all({args.out: json_bytes({**record, "results": results,
+    table = goals(results)
+    for row in table:
+        shown = "-" if row["measured"] is None else f"{row['measured']:.3g}"
+        print(f"goal: {row['goal']}: {shown} (baseline {row['baseline']}), goal {row['target']}: "
+              f"{'met' if row['met'] else 'not met' if row['met'] is not None else 'not measured'}")
+    write_all({args.out: json_bytes({**record, "results": results, "goals": table,
                                      "note": "each stage a whole rover-cosim process, one after the other, into "
                                              "a fresh scratch folder (no caches from earlier runs)"})})
     print(f"wrote {args.out}")
+
+
+def run_stages(args: argparse.Namespace, scratch: Path, results: dict[str, Any]) -> None:
+    """Every stage, ours then (with ``args.baseline``) the baseline's, into ``results``."""
+    folder, other = scratch / "ours", scratch / "baseline"
+    pairs = zip(stages(folder, args.runs), stages(other, args.runs))
+    for (name, arguments), (_, baseline_arguments) in pairs:
+        entry = time_stage(name, arguments, folder)
+        if args.baseline is not None:
+            entry["baseline"] = time_stage(name, baseline_arguments, other, args.baseline)
+            entry["ratio_to_baseline"] = entry["wall_seconds"] / entry["baseline"]["wall_seconds"]
+        timed = args.only is None or name in args.only
+        print(f"{name:24s} {entry['wall_seconds']:8.1f} s  exit {entry['exit_code']}"
+              + (f"  {entry['runs_per_minute']:.0f} runs/min" if "runs_per_minute" in entry else "")
+              + (f"  {entry['real_time_factor']:.1f}x real time" if "real_time_factor" in entry else "")
+              + (f"  (baseline {entry['baseline']['wall_seconds']:.1f} s: {entry['ratio_to_baseline']:.2f}x)"
+                 if "baseline" in entry else "")
+              + ("" if timed else "  (not recorded)"))
+        for run in (entry, entry.get("baseline", {})):
+            if run.get("exit_code", 0) != 0:
+                print(run["stderr"], file=sys.stderr)
+        if timed:
+            results[name] = entry
 
 
 if __name__ == "__main__":

@@ -218,6 +218,19 @@ def _number(value: Any) -> str:
     return _cell(value)
 
 
+def _goals_table(goals: Any) -> list[str]:
+    """The goals a benchmark file measured (``bench_pipeline``'s ``goals``) as a table; none: no lines."""
+    if not isinstance(goals, list) or not goals:
+        return []
+    verdicts = {True: "met", False: "not met", None: "not measured"}
+    def shown(value: Any) -> str:
+        return "-" if value is None else _number(value)
+
+    rows = [f"| {_cell(g.get('goal'))} | {shown(g.get('measured'))} | {shown(g.get('baseline'))} | "
+            f"{_cell(g.get('target'))} | {verdicts.get(g.get('met'), '?')} |" for g in goals if isinstance(g, dict)]
+    return ["| goal | measured | baseline (the commit before) | goal | |", "|---|---|---|---|---|", *rows, ""]
+
+
 def benchmarks_page() -> str:
     """The figures of the last ``make bench``, with the machine and date of each file."""
     folder = _folder("ROVER_COSIM_DOCS_RESULTS", "results") / "bench"
@@ -232,7 +245,7 @@ def benchmarks_page() -> str:
         lines += [f"## {path.stem}", "", f"Measured {record.get('created_utc', '?')} at commit "
                   f"`{str(record.get('git_commit', '?'))[:12]}` on {record.get('platform', '?')}, Python "
                   f"{record.get('python', '?')}; parameters: `{_cell(json.dumps(record.get('parameters', {})))}`.", "",
-                  "| quantity | value |", "|---|---|"]
+                  *_goals_table(record.get("goals")), "| quantity | value |", "|---|---|"]
         lines += [f"| {_cell(key)} | {_number(value)} |" for key, value in _flat(record.get("results", {}))]
         lines.append("")
     return "\n".join(lines)
