@@ -121,6 +121,27 @@ def test_the_posture_block_pitches_the_body_level_up_a_slope_keeping_the_middle_
         np.testing.assert_allclose(np.diff(ground[0, :3]), [-1.5, -1.5], atol=1e-9)
 
 
+def test_a_posture_out_of_the_limbs_reach_is_held_not_commanded():
+    """Up a 35 deg slope the level posture (pitched -35 deg, the centre of gravity carried uphill) is out of
+    the rear limbs' reach: the block does not fail; it holds the last posture the limbs reach, says
+    when, and its set-points stay those of that posture (forward kinematics: the hubs on the ground)."""
+    slope = math.radians(35.0)
+    block = PostureController("posture", control=True, slope=slope, downhill=math.pi, height=1.2)
+    u = np.concatenate([[1.0, 0.0, 0.0, 0.0], np.full(6, 424.0), np.zeros(6)])
+    block.start(0.0, u, 1e-3)
+    for k in range(1, 201):  # 20 s; the body at its commanded height and pitch
+        u[0], u[2] = block.loops.height, block.loops.pitch
+        block.step((k - 1) * 0.1, 0.1, u)
+    report = block.report()
+    assert report["held_unreachable_s"], "expected the level posture to be out of reach"
+    assert -slope < report["pitch_cmd_rad"] < -math.radians(15.0)   # as far as the limbs go
+    held = block.loops.joints
+    assert np.all(np.isfinite(held))
+    rotation = attitude(0.0, block.loops.pitch, 0.0)
+    hubs = np.array([rotation @ forward(limb, q).hub for limb, q in zip(LIMBS, held)])
+    np.testing.assert_allclose(hubs[:, 2], hubs[:, 2].mean(), atol=1e-9)  # still on the ground plane
+
+
 def test_the_posture_block_moves_its_corner_hubs_towards_the_loads_centre_along_the_heading():
     """Loads heavier at the rear (as on a climb, where the contacts lie uphill of the hubs): the front
     and rear hubs move back together at the shift's rate limit, the middle hubs stay under their

@@ -51,6 +51,10 @@ trigger has its hub lifted (the wheel leaves the ground: no load, no force; the 
 path follower's torques through and holds that wheel's at 0), carried ahead and set down, the
 other five carrying the body; each limb once, one at a time.
 
+A posture out of the limbs' reach (a steep climb's level pitch, with the corner hubs moved back,
+can ask the rear limbs for more than their 2 m) is not commanded: that update is undone and the
+block holds the last posture the limbs reach (``report()["held_unreachable_s"]``: when).
+
 Every command moves at a bounded rate (``rate_*``), so a posture is reached smoothly from where
 the run starts, and the set-points move linearly from one update's joints to the next over the
 period (a first-order hold: a step of a few millimetres at a hub would load a stiff limb with
@@ -70,7 +74,7 @@ from typing import Any
 
 import numpy as np
 
-from rover_cosim.limbs import JOINTS, LimbGeometry, athlete_limbs, stance_inverse
+from rover_cosim.limbs import JOINTS, LimbGeometry, Unreachable, athlete_limbs, stance_inverse
 
 #: The joints' variable names in the leg-wheel FMUs, in a limb's joint order.
 JOINT_INPUTS = ("hipYaw", "hipPitch", "kneePitch", "anklePitch", "ankleSteer", "ankleRoll")
@@ -176,6 +180,7 @@ class _Loops:
     stepped: list[tuple[int, float, float]] = field(default_factory=list)  # (limb 1-based, began, ended) [s]
     next_update: float = 0.0
     history: list[tuple[float, ...]] = field(default_factory=list)
+    held: list[float] = field(default_factory=list)  # the updates [s] whose posture the limbs could not reach
 
 
 class PostureController:
@@ -252,7 +257,18 @@ class PostureController:
         return math.atan(slope_tan * lateral), math.atan(slope_tan * along)
 
     def _update(self, t: float, u: np.ndarray) -> None:
-        """The slow loops, every ``period`` (see the module docstring)."""
+        """The slow loops, every ``period`` (see the module docstring); a posture the limbs cannot
+        reach is not commanded: the update is undone and the last reachable posture held."""
+        before = self.get_state()
+        try:
+            self._move(t, u)
+        except Unreachable:
+            self.set_state(before)
+            self.loops.previous = self.loops.joints
+            self.loops.held.append(t)
+
+    def _move(self, t: float, u: np.ndarray) -> None:
+        """One update of the loops and the joints that realise them (Unreachable: out of the limbs' reach)."""
         loops, gains, dt = self.loops, self.gains, self.period
         n = len(self.limbs)
         z, roll, pitch, yaw = float(u[0]), float(u[1]), float(u[2]), float(u[3])
@@ -346,13 +362,13 @@ class PostureController:
         return _Loops(loops.height, loops.shift.copy(), loops.roll, loops.pitch, loops.lift.copy(),
                       loops.joints.copy(), loops.previous.copy(), loops.footprint.copy(),
                       dataclasses.replace(loops.step) if loops.step else None, list(loops.stepped),
-                      loops.next_update, list(loops.history))
+                      loops.next_update, list(loops.history), list(loops.held))
 
     def set_state(self, state: _Loops) -> None:
         self.loops = _Loops(state.height, state.shift.copy(), state.roll, state.pitch, state.lift.copy(),
                             state.joints.copy(), state.previous.copy(), state.footprint.copy(),
                             dataclasses.replace(state.step) if state.step else None, list(state.stepped),
-                            state.next_update, list(state.history))
+                            state.next_update, list(state.history), list(state.held))
 
     def report(self) -> dict[str, Any]:
         """The commanded posture at the end and how it got there (every ``period``)."""
@@ -361,7 +377,7 @@ class PostureController:
                 "shift_m": loops.shift.tolist(), "roll_cmd_rad": loops.roll, "pitch_cmd_rad": loops.pitch,
                 "lift_m": loops.lift.tolist(), "footprint_m": loops.footprint.tolist(),
                 "steps": [{"limb": limb, "began_s": began, "ended_s": ended} for limb, began, ended in loops.stepped],
-                "updates": len(loops.history)}
+                "updates": len(loops.history), "held_unreachable_s": list(loops.held)}
 
 
 def _toward(value: float, target: float, limit: float) -> float:
