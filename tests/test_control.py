@@ -35,6 +35,26 @@ def test_inverse_model_round_trips(controller):
     np.testing.assert_allclose(settled, slips, atol=1e-9)
 
 
+def test_a_force_beyond_the_models_peak_asks_for_the_peaks_slip(controller):
+    """More pull than the quadratic model gives at that load (its peak): the inverse asks for the
+    slip of the peak, the most the model knows to give, in the per-step law, in the whole-array
+    inverse and in the C twin alike (before: the linear model's slip, below the peak's, and a
+    rover climbing 20 deg on evenly loaded wheels stalled); below the peak, the root as before."""
+    inverse = type(controller.inverse)(controller.model, 6, 342.0, 1e-3)
+    loads = np.array([200.0, 424.0, 600.0])
+    c = controller.model.fx_coefficients @ np.vstack([np.ones_like(loads), loads, loads**2])
+    assert np.all(c[2] < 0)  # the paper's quadratic model: a peak at each load
+    peak_slip = -c[1] / (2 * c[2])
+    peak = controller.model.fx(loads, peak_slip)
+    beyond = peak + 20.0
+    np.testing.assert_allclose(inverse.slips_for_forces(loads, beyond), peak_slip, rtol=1e-12)
+    for load, force, slip in zip(loads, beyond, peak_slip):
+        assert inverse.slip_for_force(float(load), float(force)) == pytest.approx(float(slip), rel=1e-12)
+    below = 0.8 * peak
+    np.testing.assert_allclose(controller.model.fx(loads, inverse.slips_for_forces(loads, below)), below, rtol=1e-9)
+    assert np.all(inverse.slips_for_forces(loads, below) < peak_slip)
+
+
 def test_controller_filter_has_unit_gain_and_rejects_another_step(controller):
     u = np.array([0.0, 0.5, *[424.0] * 6])
     start = controller.start(0.0, u)

@@ -58,7 +58,7 @@ static int bisect_right(const double *a, int n, double x) {
 static int clamp(int j, int low, int high) { return j < low ? low : j > high ? high : j; }
 
 /* _slip_for_force: the slip at which the Fx(W, slip) model gives ``force`` (the quadratic's root
- * nearest the linear solution). */
+ * nearest the linear solution; a force beyond its extremum: the extremum's slip). */
 static int slip_for_force(Law *c, double load, double force, double *slip) {
     double k[3] = {0.0, 0.0, 0.0};
     for (int i = 0; i <= c->degree && i < 3; i++) {
@@ -68,7 +68,8 @@ static int slip_for_force(Law *c, double load, double force, double *slip) {
     double linear = (force - k[0]) / k[1];
     if (c->degree == 1) { *slip = linear; return OK; }
     double discriminant = k[1] * k[1] - 4.0 * k[2] * (k[0] - force);
-    if (k[2] == 0 || discriminant < 0) { *slip = linear; return OK; }
+    if (k[2] == 0) { *slip = linear; return OK; }
+    if (discriminant < 0) { *slip = -k[1] / (2.0 * k[2]); return OK; }
     double root = sqrt(discriminant);
     double plus = (-k[1] + root) / (2.0 * k[2]), minus = (-k[1] - root) / (2.0 * k[2]);
     *slip = fabs(plus - linear) <= fabs(minus - linear) ? plus : minus;

@@ -83,10 +83,11 @@ class LongitudinalInverse:
 
     def slips_for_forces(self, loads: np.ndarray, forces: np.ndarray) -> np.ndarray:
         """The slip at which the Fx(W, slip) block gives each force (for the quadratic model, the
-        root nearest the linear solution), for whole arrays at once: the path controller's force
-        allocation uses it. The same inverse as the law's first step up to round-off (the law
-        evaluates c_k(W) term by term, this a matrix product); moving the path controller onto
-        the law changes its results in the last printed digit, so that waits for its C twin."""
+        root nearest the linear solution; beyond its extremum, the extremum's slip), for whole
+        arrays at once: the path controller's force allocation uses it. The same inverse as the
+        law's first step up to round-off (the law evaluates c_k(W) term by term, this a matrix
+        product); moving the path controller onto the law changes its results in the last printed
+        digit, so that waits for its C twin."""
         powers = np.vstack([np.ones_like(loads), loads, loads**2])
         c = self.model.fx_coefficients @ powers  # (degree + 1, wheels): c_k(W)
         linear = (forces - c[0]) / c[1]
@@ -100,7 +101,9 @@ class LongitudinalInverse:
         denominator = np.where(safe, 2.0 * c[2], 1.0)
         plus, minus = (-c[1] + root) / denominator, (-c[1] - root) / denominator
         nearest = np.where(np.abs(plus - linear) <= np.abs(minus - linear), plus, minus)
-        return np.where(safe, nearest, linear)
+        # a force beyond the model's extremum: the extremum's slip (see _slip_for_force)
+        vertex = -c[1] / np.where(c[2] != 0, 2.0 * c[2], 1.0)
+        return np.where(safe, nearest, np.where(c[2] != 0, vertex, linear))
 
     def torques_for_slips(self, loads: np.ndarray, slips: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(torque whose settled slip K(W, tau) tau is each slip, T there [s]): the exact inverse
@@ -148,7 +151,11 @@ class LongitudinalInverse:
         return self._slip_for_force(load, force)
 
     def _slip_for_force(self, load: float, force: float) -> float:
-        """The slip at which the Fx(W, slip) model gives ``force`` at ``load``."""
+        """The slip at which the Fx(W, slip) model gives ``force`` at ``load``; a force beyond the
+        quadratic model's extremum (more pull than its peak at that load: a steep climb on evenly
+        loaded wheels) gets the slip of the extremum, the most the model knows to give (before: the
+        linear model's slip, which on the paper's model at 400 N asks 0.175 for 171 N where the
+        peak, 152 N, is at 0.31: a rover that could climb stalled)."""
         c = [row[0] + row[1] * load + row[2] * load * load for row in self._coefficients]
         linear = (force - c[0]) / c[1]
         if self.model.degree == 1:
@@ -156,8 +163,10 @@ class LongitudinalInverse:
         if self.model.degree != 2:
             raise ValueError(f"block {self.name!r}: inverse of a degree-{self.model.degree} Fx model not implemented")
         discriminant = c[1] * c[1] - 4.0 * c[2] * (c[0] - force)
-        if c[2] == 0 or discriminant < 0:
+        if c[2] == 0:
             return linear
+        if discriminant < 0:
+            return -c[1] / (2.0 * c[2])
         root = math.sqrt(discriminant)
         plus, minus = (-c[1] + root) / (2.0 * c[2]), (-c[1] - root) / (2.0 * c[2])
         return plus if abs(plus - linear) <= abs(minus - linear) else minus
