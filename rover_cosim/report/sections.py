@@ -543,7 +543,7 @@ def legwheel_section(simulation: Path) -> list[str]:
                  table(rms_table, {"limb": "{:.0f}"}, default="{:.3f}"),
                  "<h3>20&deg; side slope</h3>",
                  "<p>Load and sinkage spreads: over the six wheels' means in the run's second half.</p>",
-                 table(shown, default="{:.3g}"),
+                 table(shown, {"load max/min": "{:.3f}"}, default="{:.3g}"),
                  *_climb_table(climb),
                  "<h3>A wheel in a soft patch</h3>",
                  ("<p>The front-left wheel starts in a patch of loose dust (ours: the paper's soil with a tenth of "
@@ -581,7 +581,7 @@ def _climb_table(climb: pd.DataFrame) -> list[str]:
                 "load max/min": climb["load_spread"], "sinkage max - min [mm]": 1000 * climb["sinkage_spread_m"],
                 "mean speed [m/s]": climb["mean_speed_m_s"], "energy [J/m]": climb["energy_per_metre_J_m"],
                 "pitch at the end [°]": climb["pitch_end_deg"], "CoG shift uphill [m]": climb["shift_x_end_m"]}),
-                default="{:.3g}")]
+                {"load max/min": "{:.3f}"}, default="{:.3g}")]
 
 
 def effects_section(simulation: Path) -> list[str]:
