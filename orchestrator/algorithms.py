@@ -79,6 +79,11 @@ class Algorithm:
     def prepare(self, execution: Stepping) -> None:
         """Called once the execution is set up (before the first step)."""
 
+    def stepped_in_python(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+                          outputs: Sequence[np.ndarray]) -> frozenset[int]:
+        """Participants this algorithm steps itself, in Python, whatever the native stepper could do."""
+        return frozenset()
+
     def step(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         """Advance every participant from ``t`` to ``t + h``; ``values`` then holds the outputs at ``t + h``."""
         for stage in execution.stages:
@@ -120,40 +125,50 @@ class GaussSeidelInterpolated(Algorithm):
     step, as in the monolithic model, not half a step ahead. A block's outputs are held (a
     controller's output is a sample and hold); inputs from participants after it (the values at
     ``t``), discrete inputs and every input of a block or of an FMU that cannot interpolate are as
-    in Gauss-Seidel. Steps in Python."""
+    in Gauss-Seidel. The FMUs with ramped inputs step in Python (the native stepper sets no input
+    derivatives); the others, and blocks with a C twin, natively as under Gauss-Seidel."""
 
     name = "gauss-seidel-interpolated"
-    explicit = False
 
     def __init__(self) -> None:
-        self.order: list[int] = []
         self.ramped: list[np.ndarray] = []  # per participant, which of its inputs ramp (bool per input)
 
-    def prepare(self, execution: Stepping) -> None:
-        participants, inputs, outputs = execution.participants, execution.inputs, execution.outputs
+    def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+               outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
         last = sources(participants, inputs)
-        self.order = [i for i in range(len(participants)) if i not in last] + last
+        return [[i] for i in range(len(participants)) if i not in last] + [[i] for i in last]
+
+    def stepped_in_python(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+                          outputs: Sequence[np.ndarray]) -> frozenset[int]:
+        last = sources(participants, inputs)
         self.ramped = [np.zeros(len(slots), bool) for slots in inputs]
         moved: list[np.ndarray] = []
-        for i in self.order:
+        for [i] in self.stages(participants, inputs, outputs, 1):
             participant = participants[i]
             if getattr(participant, "can_interpolate", False) and moved and i not in last:
                 discrete = getattr(participant, "discrete_inputs", np.zeros(len(inputs[i]), dtype=bool))
                 self.ramped[i] = np.isin(inputs[i], np.concatenate(moved)) & ~discrete
             if not isinstance(participant, BlockParticipant):
                 moved.append(np.asarray(outputs[i]))
+        return frozenset(i for i, ramped in enumerate(self.ramped) if ramped.any())
+
+    def prepare(self, execution: Stepping) -> None:
+        if not self.ramped:  # the execution stepped nothing natively and did not ask
+            self.stepped_in_python(execution.participants, execution.inputs, execution.outputs)
 
     def step(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         clock = time.perf_counter
         start = values.copy()
-        for i in self.order:
-            participant, slots, ramped = execution.participants[i], execution.inputs[i], self.ramped[i]
+        for stage in execution.stages:
+            i = stage[0]
+            ramped = self.ramped[i]
+            if not ramped.any():
+                execution.run_stage(stage, values, t, h)
+                continue
+            participant, slots = execution.participants[i], execution.inputs[i]
             begin = clock()
-            if ramped.any():
-                participant.do_step(t, h, np.where(ramped, start[slots], values[slots]),
-                                    np.where(ramped, (values[slots] - start[slots]) / h, 0.0))
-            else:
-                participant.do_step(t, h, values[slots])
+            participant.do_step(t, h, np.where(ramped, start[slots], values[slots]),
+                                np.where(ramped, (values[slots] - start[slots]) / h, 0.0))
             values[execution.outputs[i]] = participant.get_outputs(t + h)
             execution.step_seconds[participant.name] += clock() - begin
 
