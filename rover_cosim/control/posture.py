@@ -259,13 +259,18 @@ class PostureController:
     def _update(self, t: float, u: np.ndarray) -> None:
         """The slow loops, every ``period`` (see the module docstring); a posture the limbs cannot
         reach is not commanded: the update is undone and the last reachable posture held."""
-        before = self.get_state()
+        loops = self.loops
+        # what _move changes before it can fail (its history entry comes after the joints)
+        before = (loops.height, loops.shift.copy(), loops.roll, loops.pitch, loops.lift.copy(), loops.footprint.copy(),
+                  dataclasses.replace(loops.step) if loops.step else None, len(loops.stepped))
         try:
             self._move(t, u)
         except Unreachable:
-            self.set_state(before)
-            self.loops.previous = self.loops.joints
-            self.loops.held.append(t)
+            (loops.height, loops.shift, loops.roll, loops.pitch, loops.lift, loops.footprint, loops.step,
+             stepped) = before
+            del loops.stepped[stepped:]
+            loops.previous = loops.joints
+            loops.held.append(t)
 
     def _move(self, t: float, u: np.ndarray) -> None:
         """One update of the loops and the joints that realise them (Unreachable: out of the limbs' reach)."""
