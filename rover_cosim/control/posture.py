@@ -210,6 +210,7 @@ class PostureController:
         # the corner limbs: not mounted within 15 deg of straight out sideways (the middle ones, whose
         # hubs stay under their hips: see the module docstring)
         self.corner = np.array([abs(math.cos(limb.mount_yaw)) > math.sin(math.radians(15.0)) for limb in self.limbs])
+        self.corner_x = float(np.mean([x for (x, _), corner in zip(self.footprint, self.corner) if corner]))
         self.period = float(period)
         self.gains = gains or PostureGains()
         self.step_over = step_over
@@ -293,7 +294,7 @@ class PostureController:
             wanted = float(np.clip(loops.shift[1] - gains.balance * offset[1] * dt, -gains.max_shift, gains.max_shift))
             loops.shift[1] = _toward(float(loops.shift[1]), wanted, gains.rate_shift * dt)
             if loops.step is None:  # along the heading: the corner hubs move (4.), not while a limb steps
-                reach = float(foot[self.corner, 0].mean() - np.array(self.footprint)[self.corner, 0].mean())
+                reach = float(foot[self.corner, 0].mean()) - self.corner_x
                 wanted = float(np.clip(reach + gains.balance * offset[0] * dt, -gains.max_shift, gains.max_shift))
                 foot[self.corner, 0] += _toward(reach, wanted, gains.rate_shift * dt) - reach
             carrying = np.ones(n, bool)
