@@ -60,8 +60,19 @@ def test_a_study_reads_its_calibration_table_and_names_bad_keys():
             parse_study({**base, "calibration": table}, "s")
 
 
+#: The calibration of the module's short adaptive runs: the runs of a scenario on TRUTH estimate the
+#: same soil from the same telemetry, so their sweeps are computed once (sweep_cache).
+SHORT_CALIBRATION = Calibration(duration=1.5, segment=0.25)
+
+
 @pytest.fixture(scope="module")
-def adaptive_run(fmu_dir, identified, tmp_path_factory):
+def sweep_cache(tmp_path_factory) -> Path:
+    """One sweep cache for the module's adaptive runs (the re-identification is not what they test)."""
+    return tmp_path_factory.mktemp("adapt")
+
+
+@pytest.fixture(scope="module")
+def adaptive_run(fmu_dir, identified, sweep_cache):
     """The adaptive closed loop on TRUTH for 2 s, calibrating for 1.5 s (the adapter spied on)."""
     model = identified.files[0].parent / "model.json"
     nominal = library.choose()
@@ -72,8 +83,7 @@ def adaptive_run(fmu_dir, identified, tmp_path_factory):
         seen["data"] = data
         return online.adapt_model(data, *args)  # type: ignore[arg-type]
 
-    system = simulate.adaptive_system(fmu_dir, model, truth, calibration=Calibration(duration=1.5, segment=0.25),
-                                      cache_dir=tmp_path_factory.mktemp("adapt"))
+    system = simulate.adaptive_system(fmu_dir, model, truth, calibration=SHORT_CALIBRATION, cache_dir=sweep_cache)
     system = SystemBuilder.from_system(system, "adaptive, short").simulation(stop_time=2.0).build()
     original, simulate.adapt_model = simulate.adapt_model, spy  # type: ignore[assignment] # the adapter calls it
     try:
@@ -212,12 +222,12 @@ def test_simulate_refuses_a_bad_calibration_length(tmp_path):
     assert "--calibration: calibration 25.0 s: expected a length in (0, 20) s" in done.stderr
 
 
-def test_the_path_controller_learns_the_soil_on_the_first_straight(fmu_dir, identified, tmp_path):
+def test_the_path_controller_learns_the_soil_on_the_first_straight(fmu_dir, identified, sweep_cache):
     from rover_cosim.jobs import path_following
 
     truth = library.vary(library.choose(), TRUTH, {})
     system = path_following.adaptive_system(fmu_dir, identified.files[0].parent / "model.json", "lane_change", truth,
-                                            calibration=Calibration(duration=1.5), cache_dir=tmp_path, straight=3.0)
+                                            calibration=SHORT_CALIBRATION, cache_dir=sweep_cache, straight=3.0)
     system = SystemBuilder.from_system(system, "adaptive path, short").simulation(stop_time=2.0).build()
     outcome = run(system)
     block: Any = next(b.block for b in system.blocks if b.name == "ctrl")
@@ -234,7 +244,8 @@ def test_the_path_controller_learns_the_soil_on_the_first_straight(fmu_dir, iden
 
 
 @pytest.mark.parametrize("scenario", ["straight", "path"])
-def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identified, tmp_path, monkeypatch, scenario):
+def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identified, sweep_cache, monkeypatch,
+                                                                  scenario):
     """Once calibrated, an adaptive block steps its law alone and offers that law's C twin: the
     engine hands the block over to the native stepper at that step (once), and the run equals
     the one stepped in Python throughout, to the bit."""
@@ -246,11 +257,10 @@ def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identi
     truth = library.vary(library.choose(), TRUTH, {})
 
     def system(native: bool) -> Any:
-        made = (simulate.adaptive_system(fmu_dir, model, truth, calibration=Calibration(duration=1.0, segment=0.25),
-                                         cache_dir=tmp_path) if scenario == "straight" else
-                path_following.adaptive_system(fmu_dir, model, "lane_change", truth,
-                                               calibration=Calibration(duration=1.0, segment=0.25), cache_dir=tmp_path,
-                                               straight=3.0))
+        made = (simulate.adaptive_system(fmu_dir, model, truth, calibration=SHORT_CALIBRATION, cache_dir=sweep_cache)
+                if scenario == "straight" else
+                path_following.adaptive_system(fmu_dir, model, "lane_change", truth, calibration=SHORT_CALIBRATION,
+                                               cache_dir=sweep_cache, straight=3.0))
         return replace_settings(made, stop_time=2.0, native=native)
 
     handovers: list[float] = []
