@@ -37,6 +37,70 @@ def test_the_block_gives_the_rear_wheels_the_front_wheels_rut_one_step_late():
     assert np.all(block.step(1.6, 1e-3, np.array([1.6, *sinkage]))[[1, 4]] == 0.0)
     block.set_state(state)
     assert np.all(block.step(1.6, 1e-3, np.array([1.6, *sinkage]))[[1, 4]] > 0.0)
+    # a new run starts on virgin soil (the block of a system run twice forgets the first run's ruts)
+    assert np.all(block.start(0.0, np.array([1.6, *sinkage]), 1e-3) == 0.0) and len(block.map.get_state()) > 0
+
+
+@pytest.mark.parametrize(("planar", "x_limb"), [(False, (1.5, 0.0, -1.5)), (True, (1.5, 0.0, -1.5)),
+                                               (True, (0.6, -0.6)), (False, (0.0,))])
+def test_the_rut_blocks_c_twin_gives_its_outputs_bit_for_bit(planar, x_limb):
+    """From a map the Python block already marked, random walks of the rover with random sinkages (some
+    zero, some NaN: not marked) over more cells than the twin's first table holds: the same rut
+    depths at every step; a pose on no cell (NaN) is an error in both, the twin's naming the wheel."""
+    from test_native_blocks import Twin
+
+    rng = np.random.default_rng(48)
+    block = RutBlock("ruts", x_limb, 0.4, 0.175, planar=planar)
+    wheels = block.wheels
+
+    def inputs(k: int) -> np.ndarray:
+        pose = [0.004 * k, 0.3 * np.sin(0.002 * k), 0.002 * k] if planar else [0.004 * k]
+        sinkage = rng.uniform(-0.005, 0.05, wheels)
+        sinkage[rng.uniform(size=wheels) < 0.05] = np.nan
+        return np.array([*pose, *sinkage])
+
+    block.start(0.0, inputs(0))
+    for k in range(1, 200):
+        block.step(0.0, 1e-3, inputs(k))
+    twin = Twin(block, "rut")  # type: ignore[arg-type]
+    for k in range(200, 3200):
+        u = inputs(k)
+        assert np.array_equal(block.step(0.0, 1e-3, u), twin.step(0.0, 1e-3, u)), f"step {k}"
+    assert len(block.map.get_state()) > 1024  # the twin's table grew
+    bad = inputs(0)
+    bad[0] = np.nan
+    with pytest.raises(ValueError):
+        block.step(0.0, 1e-3, bad)
+    with pytest.raises(ValueError, match="wheel 1's hub at .* is on no cell"):
+        twin.step(0.0, 1e-3, bad)
+    twin.made.close()
+
+
+def test_a_run_with_ruts_steps_natively_and_gives_the_python_runs_numbers_bit_for_bit(fmus, identified,
+                                                                                      results_root, monkeypatch):
+    """``simulate --ruts``'s monolithic run: with the rut block's C twin every participant steps
+    natively, and the trajectories are those of the run stepped in Python, to the bit (6 s: 1.6 m on, the
+    middle wheels in the front ones' rut). The same system runs twice: the second starts on virgin soil."""
+    import pandas as pd
+
+    from rover_cosim.jobs.simulate import monolithic_system
+    from rover_cosim.orchestrator import master
+    from rover_cosim.orchestrator.builder import replace_settings
+
+    stepped_natively: list[bool] = []
+    made = master.make_execution
+
+    def execution(*args: object) -> object:
+        made_now = made(*args)  # type: ignore[arg-type]
+        stepped_natively.append(made_now.all_native)
+        return made_now
+
+    monkeypatch.setattr(master, "make_execution", execution)
+    system = monolithic_system(fmus["Rover"].parent, results_root / "identification" / "model.json", ruts=True)
+    runs = {native: master.run(replace_settings(system, stop_time=6.0, native=native)) for native in (False, True)}
+    assert stepped_natively == [False, True]
+    assert runs[True].data["ruts.rutDepth[2]"].iloc[-1] > 0.02  # the middle wheels in the front ones' rut
+    pd.testing.assert_frame_equal(runs[False].data, runs[True].data, check_exact=True)
 
 
 def test_the_effects_ablation_runs_and_the_rear_wheels_sink_deeper_in_the_ruts(fmus, identified, results_root,

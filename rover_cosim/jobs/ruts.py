@@ -7,19 +7,30 @@ the plane) and ``sinkage[i]`` of each wheel. Outputs: ``rutDepth[i]`` [m]. The w
 depends on their rut, so the block has no direct feedthrough (``feedthrough = False``): a step
 marks the ruts with the sinkages and poses it receives and gives the ruts under the hubs there,
 one communication step late (1 mm at 1 m/s and 1 ms), which closes no algebraic loop.
+
+C twin: ``rut_block.c`` (the same stamps and depths, bit for bit; its map in a hash table), so that a
+run with ruts steps natively; it starts from the block's map at the hand-over and keeps its own from
+then on (the block's map stays as it was then, as the controllers' twins leave their blocks).
 """
 
 from __future__ import annotations
 
+import ctypes
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from rover_cosim.orchestrator import native as native_code
 from rover_cosim.orchestrator.builder import SystemBuilder
 from rover_cosim.terramechanics.library import Choice
 from rover_cosim.terramechanics.multipass import RutMap
 from rover_cosim.terramechanics.terrain import hub_positions
+
+RUT_C_SOURCE = Path(__file__).with_name("rut_block.c")
+#: The most wheels the C twin takes (a rover with more steps its rut block in Python).
+TWIN_WHEELS = 64
 
 
 class RutBlock:
@@ -61,10 +72,38 @@ class RutBlock:
         return self.map.depths(x, y)
 
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
-        return self._advance(u0)
+        """A run starts on virgin soil (a system run again does not meet the ruts of its last run)."""
+        self.map = RutMap(self.wheels, self.map.cell)
+        self.last = self._advance(u0)
+        return self.last
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
-        return self._advance(u)
+        self.last = self._advance(u)
+        return self.last
+
+    def native(self) -> native_code.NativeBlock | None:
+        """The block's C twin (rut_block.c) from its map and outputs now, for the native stepper;
+        None where it cannot be compiled or the rover has more than TWIN_WHEELS wheels (the block
+        then steps in Python)."""
+        if self.wheels > TWIN_WHEELS:
+            return None
+        library = native_code.load_library(RUT_C_SOURCE)
+        if isinstance(library, str):
+            return None
+        pointer = ctypes.c_void_p
+        library.rut_new.restype = pointer
+        library.rut_new.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_double, ctypes.c_double, pointer,
+                                    ctypes.c_int, pointer, pointer, pointer]
+        cells = self.map.get_state()
+        keys = (ctypes.c_longlong * max(1, 2 * len(cells)))(*[k for key in cells for k in key])
+        depths = native_code.doubles([cells[key] for key in cells] if cells else [0.0])
+        now = getattr(self, "last", None)
+        component = library.rut_new(self.wheels, int(self.planar), self.map.cell, self.half_width,
+                                    native_code.doubles([self.x_hub, self.y_hub]), len(cells), keys, depths,
+                                    native_code.doubles(now if now is not None else np.zeros(self.wheels)))
+        if not component:
+            raise MemoryError(f"block {self.name!r}: its C twin could not be made ({len(cells)} cells: out of memory)")
+        return native_code.NativeBlock(library, component, "rut")
 
     def get_state(self) -> Any:
         return self.map.get_state()
