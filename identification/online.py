@@ -93,14 +93,16 @@ def sweep_loads(loads: FloatArray) -> tuple[float, ...]:
 
 
 def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path, degree: int,
-                     plan: SweepPlan | None = None,
-                     torque_max: float = ADAPTED_FIT_TORQUE_MAX) -> tuple[IdentifiedModel, int]:
+                     plan: SweepPlan | None = None, torque_max: float = ADAPTED_FIT_TORQUE_MAX,
+                     workers: int | None = 1) -> tuple[IdentifiedModel, int]:
     """The paper's longitudinal model (LUTs and the Fx fit of ``degree``) identified by the sweep on
-    ``fmu_path`` (SingleWheel.fmu) with ``soil`` and ``wheel`` as its parameters, in this process,
-    the Fx fit through the points up to ``torque_max`` [N·m] (ADAPTED_FIT_TORQUE_MAX for the
-    paper's wheel; a plan scaled to another wheel scales it too); (the model, the runs computed)."""
+    ``fmu_path`` (SingleWheel.fmu) with ``soil`` and ``wheel`` as its parameters, the Fx fit through
+    the points up to ``torque_max`` [N·m] (ADAPTED_FIT_TORQUE_MAX for the paper's wheel; a plan
+    scaled to another wheel scales it too); the sweep in this process (``workers`` 1: an adaptive
+    run inside a Monte Carlo worker) or on ``workers`` processes (None: every core; a command's own
+    identification); (the model, the runs computed)."""
     plan = replace(plan or SweepPlan(), soil=soil, wheel=wheel)
-    sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=1)
+    sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=workers)
     if not sweep.runs:
         raise RuntimeError(f"every run of the sweep on the estimated soil failed; first error: "
                            f"{next(iter(sweep.failures.values()))}")
@@ -109,15 +111,16 @@ def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path, 
 
 def identify_lateral_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path,
                              loads: tuple[float, ...], torques: tuple[float, ...] | None = None,
-                             torque_max: float = FIT_TORQUE_MAX) -> tuple[LateralModel, int]:
+                             torque_max: float = FIT_TORQUE_MAX, workers: int | None = 1) -> tuple[LateralModel, int]:
     """The lateral model (the recommended form) identified by the lateral sweep on ``fmu_path``
     with ``soil`` and ``wheel`` at ``loads`` [N] and ``torques`` [N·m] (None: the paper's), fitted
-    up to ``torque_max`` [N·m]; (the model, the runs computed)."""
+    up to ``torque_max`` [N·m], the sweep on ``workers`` as ``identify_on_soil``'s; (the model, the
+    runs computed)."""
     plan = SweepPlan(loads=loads, slip_angles_deg=LATERAL_SLIP_ANGLES_DEG, sample_time=LATERAL_SAMPLE_TIME,
                      soil=soil, wheel=wheel)
     if torques is not None:
         plan = replace(plan, torques=tuple(torques))
-    sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=1)
+    sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=workers)
     if not sweep.runs:
         raise RuntimeError(f"every run of the lateral sweep on the estimated soil failed; first error: "
                            f"{next(iter(sweep.failures.values()))}")

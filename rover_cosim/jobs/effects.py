@@ -110,15 +110,16 @@ def _same_plant(a: Choice, b: Choice) -> bool:
 
 def reidentified(single_wheel: Path, models: ModelSet, choice: Choice, plan: IdentificationPlan,
                  variant: str) -> ModelSet:
-    """``models`` with the longitudinal model identified again by the sweep on ``single_wheel`` with
-    ``choice``'s soil and wheel (the variant's), by ``plan`` (the identification plan for it); the
-    lateral model kept (the straight run does not steer)."""
+    """``models`` with the longitudinal model identified again by the sweep on ``single_wheel`` (on every
+    core) with ``choice``'s soil and wheel (the variant's), by ``plan`` (the identification plan for
+    it); the lateral model kept (the straight run does not steer)."""
     import tempfile
 
     label = models.recommended
     with tempfile.TemporaryDirectory(prefix="rover-cosim-effects-") as cache:
         model, _ = identify_on_soil(single_wheel, choice.soil, choice.wheel, Path(cache), models.model().degree,
-                                    SweepPlan(loads=plan.loads, torques=plan.torques), plan.fit_torque_max)
+                                    SweepPlan(loads=plan.loads, torques=plan.torques), plan.fit_torque_max,
+                                    workers=None)
     return ModelSet(label, {label: model}, models.lateral, {
         "identified_for": f"the wheel effects' ablation, variant {variant} (rover-cosim simulate --only effects)",
         "identification_plan": plan.to_dict(), "fmu": {"path": str(single_wheel), "sha256": file_sha256(single_wheel)},

@@ -274,7 +274,7 @@ def identify_second_soil(fmu_path: Path, soil: Soil, wheel: Wheel, degree: int,
     """The longitudinal (of ``degree``) and lateral models of ``soil`` (the second soil the controller
     believes in) and ``wheel``, identified by the sweeps on ``fmu_path`` (SingleWheel.fmu) around
     CROSSING_LOADS, as the adaptive controller identifies them on an estimated soil
-    (``identification.online``), in this process. For a rover or wheel other than the paper's
+    (``identification.online``), the sweeps on every core. For a rover or wheel other than the paper's
     (``choice``), the loads scaled by its static wheel load and the torques and fit range of the
     identification plan for it on ``soil`` (``identification.plan``)."""
     import tempfile
@@ -290,8 +290,9 @@ def identify_second_soil(fmu_path: Path, soil: Soil, wheel: Wheel, degree: int,
         torque_max = ADAPTED_FIT_TORQUE_MAX / FIT_TORQUE_MAX * scaled.fit_torque_max
         lateral_max = scaled.fit_torque_max
     with tempfile.TemporaryDirectory(prefix="rover-cosim-soil-b-") as cache:
-        model, _ = identify_on_soil(fmu_path, soil, wheel, Path(cache), degree, plan, torque_max)
-        lateral, _ = identify_lateral_on_soil(fmu_path, soil, wheel, Path(cache), loads, torques, lateral_max)
+        model, _ = identify_on_soil(fmu_path, soil, wheel, Path(cache), degree, plan, torque_max, workers=None)
+        lateral, _ = identify_lateral_on_soil(fmu_path, soil, wheel, Path(cache), loads, torques, lateral_max,
+                                              workers=None)
     label = f"degree {degree}"
     return ModelSet(label, {label: model}, lateral, {
         "identified_for": "the soil crossing's second soil (rover-cosim simulate, terrain)",
