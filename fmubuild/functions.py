@@ -39,7 +39,7 @@ EXPAND_LIMIT = 8000
 #: colours calls it ceil(n / 8) times, each recomputing the function's value once. The rovers'
 #: Jacobians have 6-8 colours (six wheels' spins in one), so one call. One direction at a time
 #: (``max_num_dir`` 1, the leaner C of issue 31: Rover 1.05 MB of C, 0.41 MB library) recomputed the
-#: contacts' values once per colour, and the integrator's Jacobian, refreshed every 20 steps, took
+#: contacts' values once per colour, and the integrator's Jacobian, refreshed every 20 steps then, took
 #: 57 % of Rover.fmu's time (perf). With 8: 1.98 MB of C, 0.74 MB library; SteerableRover.fmu steps
 #: a path twice as fast, Rover.fmu 1.2-1.8x (measured side by side); results within 6e-13 of each
 #: signal's largest value (the same derivatives, rounded in another order); Wheel and SingleWheel

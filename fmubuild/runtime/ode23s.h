@@ -2,7 +2,9 @@
  * Rosenbrock (W-)method of order 2(3) of Shampine and Reichelt (the formula of MATLAB's ode23s,
  * SIAM J. Sci. Comput. 18(1), 1997). It stays second order with an approximate Jacobian (a
  * W-method), so the Jacobian is kept across steps and calls and refreshed after a rejected step
- * or when it is jacobian_max_age steps old. */
+ * or when it is jacobian_max_age steps old (100: on the paper's closed loop as accurate against a
+ * reference with the Jacobian at every step and tolerance 1e-10 as 20 was, 1.5x faster; a refresh
+ * when an accepted step's error passed half the tolerance bought no accuracy). */
 #ifndef ROVER_COSIM_ODE23S_H
 #define ROVER_COSIM_ODE23S_H
 
