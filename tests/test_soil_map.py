@@ -114,6 +114,21 @@ def test_the_wheel_fmu_on_a_share_is_the_wheel_fmu_on_the_blended_soil(fmus):
         np.testing.assert_array_equal(on_b[name], soft[name], err_msg=name)
 
 
+def test_a_wheel_entering_a_soil_whose_destructive_angle_is_given_blends_it_as_the_reference_does(fmus):
+    """The FMU's own soil with its destructive angle from phi (xc = 0, the default) and the second
+    soil's given: a wheel that has just entered the second soil (shares 1e-12 .. 1e-3) gives what it
+    gives on Soil.blend alone, whose xc blends the two resolved angles. The FMU blended the raw
+    parameters: xc = s xc_B, an angle of almost 0 taken as given, and the sidewall force grew as
+    1/s^3 (1.7e34 N at s = 1e-12): a SteerableRover driving onto HIT-LSS1 then failed its step."""
+    soil_b = soil_parameters(SOFT, "soilB")
+    assert soil_b["soilB.xc"] > 0
+    for share in (1e-12, 1e-6, 1e-3):
+        entering = _wheel_run(fmus["Wheel"], soil_b, share)
+        alone = _wheel_run(fmus["Wheel"], soil_parameters(PAPER.blend(SOFT, share)), 0.0)
+        for name in ("Fx", "Fy", "Fz", "Tx", "slip", "sinkage", "omega"):
+            np.testing.assert_allclose(entering[name], alone[name], rtol=1e-12, atol=1e-12, err_msg=f"{name}, {share}")
+
+
 def test_the_reference_wheel_on_the_blended_soil_gives_the_wheel_fmus_forces(fmus):
     """Cross-check against the numpy reference: Wheel.fmu on a share s of HIT-LSS1 gives, at its own
     spin and the hub's velocity, terramechanics.wheel_forces on Soil.blend(paper, HIT-LSS1, s):

@@ -17,14 +17,17 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   Real slopeStart(unit="1") = 0 "0: cold start of the sinkage solve (Bekker's sinkage); rover-cosim FMUs hold the contactSlope of the previous step here (warm start)"
     annotation (__RoverCosim(previous="contactSlope"));
 equation
-  // The soil under the wheel: each parameter (1 - soilShare) soil + soilShare soilB (exact at 0 and 1)
+  // The soil under the wheel: each parameter (1 - soilShare) soil + soilShare soilB (exact at 0 and 1);
+  // xc blends each soil's own angle (its 0 stands for 45 deg - phi/2 of that soil), as Soil.blend does:
+  // blending the raw 0 with a given angle made an angle of almost 0 near soilShare 0 (sidewall force ~ 1/xc^3)
   (slip, sinkage, Fx, Fz, Tx, entryAngle, Fy, slipAngle, contactEvaluations, logSinkage, contactSlope) = RoverTerramechanics.Functions.wheelForces(W, omega, v_hub,
     RoverTerramechanics.Parameters.SoilParameters(
       c=(1 - soilShare)*soil.c + soilShare*soilB.c, phi=(1 - soilShare)*soil.phi + soilShare*soilB.phi, kc=(1 - soilShare)*soil.kc + soilShare*soilB.kc,
       kphi=(1 - soilShare)*soil.kphi + soilShare*soilB.kphi, n=(1 - soilShare)*soil.n + soilShare*soilB.n, kx=(1 - soilShare)*soil.kx + soilShare*soilB.kx,
       a0=(1 - soilShare)*soil.a0 + soilShare*soilB.a0, a1=(1 - soilShare)*soil.a1 + soilShare*soilB.a1, lam=(1 - soilShare)*soil.lam + soilShare*soilB.lam,
       kxBeta=(1 - soilShare)*soil.kxBeta + soilShare*soilB.kxBeta, ky=(1 - soilShare)*soil.ky + soilShare*soilB.ky, kyBeta=(1 - soilShare)*soil.kyBeta + soilShare*soilB.kyBeta,
-      rho=(1 - soilShare)*soil.rho + soilShare*soilB.rho, gravity=(1 - soilShare)*soil.gravity + soilShare*soilB.gravity, xc=(1 - soilShare)*soil.xc + soilShare*soilB.xc,
+      rho=(1 - soilShare)*soil.rho + soilShare*soilB.rho, gravity=(1 - soilShare)*soil.gravity + soilShare*soilB.gravity, xc=(1 - soilShare)*(if noEvent(soil.xc > 0) then soil.xc else 0.7853981633974483 - soil.phi/2)
+        + soilShare*(if noEvent(soilB.xc > 0) then soilB.xc else 0.7853981633974483 - soilB.phi/2),
       nSlip=(1 - soilShare)*soil.nSlip + soilShare*soilB.nSlip),
     wheel, vEps, vHold, vStick, nNodes, nIterations, v_lat, logSinkageStart, slopeStart, rutDepth);
   wheel.J*der(omega) = tau - Tx;
@@ -89,9 +92,12 @@ Other tools ignore the annotation.</p>
 (1 - s) <code>soil</code> + s <code>soilB</code> with s = <code>soilShare</code> (an input, start 0:
 the first soil, bit for bit). A soil map gives s from the wheel's position: 0 on the first soil, 1
 on the second, a smooth ramp across their boundary, where the contact patch lies on both. The
-blend of two valid soils is a valid soil (every range below is convex). X<sub>c</sub> = 0 (45&deg;
-- &phi;/2 of the blended &phi;) stays 0 when both soils leave it at 0. The reference
-<code>terramechanics.Soil.blend</code> blends the same way.</p>
+blend of two valid soils is a valid soil (every range below is convex). X<sub>c</sub> blends each
+soil's own angle, a soil's 0 standing for 45&deg; - &phi;/2 of its own &phi; (when both leave it at
+0 that is 45&deg; - &phi;/2 of the blended &phi;: the angle is affine in &phi;); blending the raw 0
+with a given angle would give an angle near 0 just inside the second soil, and a sidewall force
+growing as 1/X<sub>c</sub><sup>3</sup>. The reference <code>terramechanics.Soil.blend</code> blends
+the same way.</p>
 <p>Parameter checks (asserts, reported by the FMUs at initialization with the value): the
 ranges of <code>terramechanics.Soil</code> for both soils, soilShare in [0, 1], and <code>Wheel</code>, speeds &gt; 0, and a load
 the soil carries with a sinkage below r.</p>
