@@ -25,7 +25,7 @@ int ode23s_alloc(Ode23s *s, int n, void *(*alloc)(size_t, size_t)) {
     s->h = 0.0;
     s->f0_valid = 0;
     s->jac_valid = s->jac_current = s->jac_age = 0;
-    s->jacobian_max_age = 50;
+    s->jacobian_max_age = 100;
     s->steps = s->rejected = s->jacobians = s->rhs_calls = 0;
     return (s->J && s->W && s->T && s->F0 && s->F1 && s->F2 && s->k1 && s->k2 && s->k3 && s->xn &&
             s->tmp && s->pivot) ? 0 : -1;

