@@ -87,7 +87,8 @@ def test_the_modelica_records_declare_the_ranges_of_the_python_table():
 def test_the_soil_record_is_the_python_soil_and_the_wheel_blends_every_field():
     """One table of soil fields: terramechanics.Soil. The Modelica record SoilParameters declares the
     same fields in the same order, with the units of parameters.UNITS, and RigidWheel blends each of
-    them, once, as (1 - soilShare) soil.F + soilShare soilB.F (the exporter cannot yet translate a
+    them, once, as (1 - soilShare) soil.F + soilShare soilB.F, xc as each soil's own angle (its 0: 45 deg -
+    phi/2 of that soil) (the exporter cannot yet translate a
     function returning a record, so the blend is written field by field there: this test is what
     keeps it whole when a field is added)."""
     import re
@@ -108,4 +109,9 @@ def test_the_soil_record_is_the_python_soil_and_the_wheel_blends_every_field():
         assert modelica_units.get(UNITS[field.name], UNITS[field.name]) == unit, name
     wheel = (package / "Components" / "RigidWheel.mo").read_text()
     blended = re.findall(r"(\w+)=\(1 - soilShare\)\*soil\.(\w+) \+ soilShare\*soilB\.(\w+)", wheel)
-    assert sorted(blended) == sorted((name, name, name) for name in python)
+    # xc blends each soil's own angle (0: 45 deg - phi/2 of that soil's phi), as Soil.blend does
+    resolved = r"\(if noEvent\({0}\.xc > 0\) then {0}\.xc else 0\.7853981633974483 - {0}\.phi/2\)"
+    angle = re.findall(r"(xc)=\(1 - soilShare\)\*" + resolved.format("soil") + r"\s*\+ soilShare\*"
+                       + resolved.format("soilB"), wheel)
+    assert math.isclose(0.7853981633974483, math.pi / 4, rel_tol=0, abs_tol=0)
+    assert sorted(blended + [(name, name, name) for name in angle]) == sorted((name, name, name) for name in python)
