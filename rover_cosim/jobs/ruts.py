@@ -53,6 +53,7 @@ class RutBlock:
         self.half_width = 0.5 * float(width)
         self.planar = planar
         self.map = RutMap(self.wheels, cell)
+        self.last: np.ndarray | None = None  # the outputs of the last start or step
         numbers = range(1, self.wheels + 1)
         pose = ("x", "y", "yaw") if planar else ("x",)
         self.inputs: tuple[str, ...] = (*pose, *[f"sinkage[{i}]" for i in numbers])
@@ -97,10 +98,10 @@ class RutBlock:
         cells = self.map.get_state()
         keys = (ctypes.c_longlong * max(1, 2 * len(cells)))(*[k for key in cells for k in key])
         depths = native_code.doubles([cells[key] for key in cells] if cells else [0.0])
-        now = getattr(self, "last", None)
+        now = self.last if self.last is not None else np.zeros(self.wheels)
         component = library.rut_new(self.wheels, int(self.planar), self.map.cell, self.half_width,
                                     native_code.doubles([self.x_hub, self.y_hub]), len(cells), keys, depths,
-                                    native_code.doubles(now if now is not None else np.zeros(self.wheels)))
+                                    native_code.doubles(now))
         if not component:
             raise MemoryError(f"block {self.name!r}: its C twin could not be made ({len(cells)} cells: out of memory)")
         return native_code.NativeBlock(library, component, "rut")
