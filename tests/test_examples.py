@@ -111,15 +111,19 @@ def test_the_wheel_fmu_in_an_own_fmpy_loop_agrees_with_the_numpy_wheel(fmus, tmp
     np.testing.assert_allclose(settled["Tx"], settled["tau"], atol=1e-3)
     assert np.all(np.diff(settled["Fx"]) > 0) and np.all(np.abs(settled["slip"]) < 0.2)
     # The numpy reference at the FMU's load and slip with its nodes, computed here. Measured with the
-    # FMUs of `make fmus`: Fx within 2.2e-5 N (at the negative slip of 5 N·m, where the reference splits
-    # the patch at the shear's kink and the FMU does not; 4e-9 N elsewhere), Tx within 7.7e-6 N·m, Fz
-    # within 4.3e-8 N, sinkage within 7.6e-11 m.
+    # FMUs of `make fmus` (10 nodes): Fx within 4e-9 N while driving; at the negative slip of 5 N·m,
+    # where the reference splits the patch at the shear's kink and the FMU does not, 2.3e-4 N (5.5e-7
+    # of the load; the stated bound of that error up to 0.1 m of sinkage is 2.2e-5 of it, 0.009 N);
+    # Tx within 7.7e-6 N·m, Fz within 4.3e-8 N, sinkage within 7.6e-11 m (1.7e-9 m at the kink).
     soil = choose("lunar_nominal").soil
     reference = wheel_state(424.0, settled["slip"].to_numpy(), soil=soil, nodes=FMU_NODES)
-    np.testing.assert_allclose(settled["Fx"], reference.Fx, rtol=0, atol=2e-4)
+    driving = settled["slip"].to_numpy() > 0
+    np.testing.assert_allclose(settled["Fx"][driving], reference.Fx[driving], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(settled["Fx"][~driving], reference.Fx[~driving], rtol=0, atol=2e-3)
     np.testing.assert_allclose(settled["Tx"], reference.Tx, rtol=0, atol=1e-4)
     np.testing.assert_allclose(settled["Fz"], 424.0, rtol=0, atol=1e-6)
-    np.testing.assert_allclose(settled["sinkage"], reference.sinkage, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(settled["sinkage"][driving], reference.sinkage[driving], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(settled["sinkage"][~driving], reference.sinkage[~driving], rtol=0, atol=1e-7)
     record = json.loads((out / "wheel_fmu_loop.json").read_text())
     assert record["soil"] == "lunar_nominal" and len(record["levels"]) == 5
 

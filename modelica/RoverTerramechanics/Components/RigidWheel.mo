@@ -4,7 +4,7 @@ model RigidWheel "Terramechanics rigid wheel: spin dynamics with inertia J, driv
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2): the soil under the wheel where soilShare = 0";
   parameter RoverTerramechanics.Parameters.SoilParameters soilB "Second soil: the soil under the wheel where soilShare = 1 (default Table 2's)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
-  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
+  parameter Integer nNodes = 10 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";

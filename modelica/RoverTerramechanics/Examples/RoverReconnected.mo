@@ -4,7 +4,7 @@ model RoverReconnected "RoverBody and six Wheel models reconnected at the hubs: 
   parameter RoverTerramechanics.Parameters.SoilParameters soil "Soil (Table 2)";
   parameter RoverTerramechanics.Parameters.WheelParameters wheel "Wheel (Table 2)";
   parameter RoverTerramechanics.Parameters.RoverParameters rover "Rover mass, geometry and limbs";
-  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
+  parameter Integer nNodes = 10 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";

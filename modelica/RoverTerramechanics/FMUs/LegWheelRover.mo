@@ -8,7 +8,7 @@ model LegWheelRover "Leg-wheel rover: the body on six limbs of six joint servos 
   parameter RoverTerramechanics.Parameters.LegWheelParameters legs "Limb mounts, link lengths and joint servos";
   parameter RoverTerramechanics.Parameters.TerrainParameters terrain "Ground plane: slope and downhill direction (default level)";
   parameter Real height0(unit="m") = 1.0 "Start height of the centre of gravity above the ground plane";
-  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
+  parameter Integer nNodes = 10 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";

@@ -6,7 +6,7 @@ model SingleWheel "Single-wheel test bed: one terramechanics wheel on a carriage
   parameter Real g(unit="m/s2") = 1.62 "Gravity (lunar)";
   parameter Real slope(unit="rad") = 0 "Slope of the ground along x, positive uphill";
   parameter Real slipAngle(unit="rad") = 0 "Angle of the carriage's track to the wheel plane (Ishigami's test bed), positive: the hub slides to the wheel's left";
-  parameter Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
+  parameter Integer nNodes = 10 "Gauss-Legendre nodes per piece of the contact patch";
   parameter Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   parameter Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   parameter Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";

@@ -5,7 +5,7 @@ function contactResidual "Residual log(Fz/W) of the sinkage equation at a given 
   input Real slip(unit="1") "Slip ratio";
   input RoverTerramechanics.Parameters.SoilParameters soil "Soil";
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
-  input Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
+  input Integer nNodes = 10 "Gauss-Legendre nodes per piece of the contact patch";
   input Real WMin(unit="N") = 1e-3 "Smallest load considered (a lifted wheel)";
   input Real slipAngle(unit="rad") = 0 "Slip angle of the hub velocity (Ishigami et al. 2007)";
   input Real rutDepth(unit="m") = 0 "Depth of the rut a previous wheel left (multi-pass); h below its floor";

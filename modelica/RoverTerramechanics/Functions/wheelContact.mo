@@ -4,7 +4,7 @@ function wheelContact "Sinkage at which the soil carries the wheel load, Fz(h, s
   input Real slip(unit="1") "Slip ratio";
   input RoverTerramechanics.Parameters.SoilParameters soil "Soil";
   input RoverTerramechanics.Parameters.WheelParameters wheel "Wheel";
-  input Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
+  input Integer nNodes = 10 "Gauss-Legendre nodes per piece of the contact patch";
   input Integer nIterations = 12 "Bound on the number of force evaluations";
   input Real tolerance(unit="1") = 1e-10 "Relative tolerance on Fz/W - 1";
   input Real WMin(unit="N") = 1e-3 "Smallest load considered (a lifted wheel)";

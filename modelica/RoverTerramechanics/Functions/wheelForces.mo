@@ -8,7 +8,7 @@ function wheelForces "Contact of the wheel in every motion regime: driving, brak
   input Real vEps(unit="m/s") = 1e-3 "Regularising speed of the slip ratio";
   input Real vHold(unit="m/s") = 1e-3 "Transition speed: below it the steady forces blend into the static regime";
   input Real vStick(unit="m/s") = 1e-4 "Slip speed at which the static shear reaches tanh(1) of its limit";
-  input Integer nNodes = 16 "Gauss-Legendre nodes per piece of the contact patch";
+  input Integer nNodes = 10 "Gauss-Legendre nodes per piece of the contact patch";
   input Integer nIterations = 12 "Bound on the force evaluations of the sinkage solve";
   input Real vLat(unit="m/s") = 0 "Speed of the hub to the wheel's left (lateral, in the wheel frame)";
   input Real logSinkageStart(unit="1") = 0 "Start of the sinkage solve, log(h / 1 m) (warm start: the previous logSinkage)";
