@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rover_cosim.control.adaptive import Calibration
+from rover_cosim.control.calibration import Calibration
 from rover_cosim.identification import online
 from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.jobs import simulate

@@ -281,3 +281,23 @@ def test_help_and_version_import_no_numerical_library(argv):
               "print('HEAVY', heavy, file=sys.stderr)\n")
     done = subprocess.run([sys.executable, "-P", "-c", script, *argv], capture_output=True, text=True, check=False)
     assert "HEAVY []" in done.stderr, done.stderr[-2000:]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["simulate", "--adapt", "--calibration", "25"], "calibration 25.0 s: expected a length in (0, 20) s"),
+    (["simulate", "--record-interval", "0.0015"], "record interval 0.0015 s: expected a whole number of steps"),
+    (["montecarlo", "--runs", "0"], "--runs 0: expected >= 1"),
+])
+def test_a_bad_option_is_refused_before_the_job_is_imported(argv, message, tmp_path):
+    """A refusal takes a fraction of a second: the command checks what it can before it imports its
+    job (pandas, SciPy, matplotlib and the identification take seconds to import)."""
+    script = ("import sys\nfrom rover_cosim.cli import main\n"
+              "code = main(sys.argv[1:])\n"
+              "heavy = [m for m in ('pandas', 'scipy', 'matplotlib', 'rover_cosim.jobs.simulate',\n"
+              "                     'rover_cosim.jobs.montecarlo.job') if m in sys.modules]\n"
+              "print('CODE', code, 'HEAVY', heavy, file=sys.stderr)\n")
+    done = subprocess.run([sys.executable, "-P", "-c", script, *argv, "--out", str(tmp_path / "out"),
+                           "--fmu-dir", str(tmp_path)],
+                          capture_output=True, text=True, check=False, cwd=tmp_path)
+    assert message in done.stderr and "CODE 2 HEAVY []" in done.stderr, done.stderr[-2000:]
+    assert not (tmp_path / "out").exists()

@@ -47,11 +47,11 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.montecarlo import StudyError, load_study, run_montecarlo
-
     if not workers_ok("montecarlo", args) or not at_least("montecarlo", ("--runs", args.runs, 1),
                                                             ("--seed", args.seed, 0)):
         return 2
+    from rover_cosim.jobs.montecarlo.study import StudyError, load_study
+
     try:
         study = load_study(args.study, runs=args.runs, seed=args.seed)
         study = study.adapted() if args.adapt else study
@@ -64,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
         return 2
     if not model_readable(args.model, "montecarlo"):
         return 2
+    from rover_cosim.jobs.montecarlo.job import run_montecarlo
+
     outcome = with_progress("montecarlo", "montecarlo", args.quiet, lambda bar: run_montecarlo(
         study, args.fmu_dir, args.model, args.out, workers=args.workers, scheduler=args.scheduler,
         cache_dir=args.cache, progress=bar, allow_model_mismatch=args.allow_model_mismatch,

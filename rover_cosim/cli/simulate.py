@@ -67,7 +67,7 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 def _calibration(args: argparse.Namespace) -> Any:
     """The adaptive run's Calibration of --calibration and --sinkage-sensor (None without --adapt)."""
-    from rover_cosim.control.adaptive import Calibration
+    from rover_cosim.control.calibration import Calibration
 
     return Calibration(duration=args.calibration, sinkage_sensor=args.sinkage_sensor) if args.adapt else None
 
@@ -87,7 +87,7 @@ def _crossing_soils_known(args: argparse.Namespace) -> bool:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.simulate import check_options
+    from rover_cosim.jobs.straight_run import check_options
     from rover_cosim.orchestrator.master import RunError
     from rover_cosim.orchestrator.system import SystemFileError
 

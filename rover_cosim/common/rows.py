@@ -8,9 +8,12 @@ import math
 import os
 import re
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:  # pandas is imported by whoever hands a table (the command line checks an interval without it)
+    import pandas as pd
 
 
 def steps_between_rows(interval: float, step: float) -> int:
@@ -36,6 +39,8 @@ def csv_bytes(table: pd.DataFrame, float_format: str) -> bytes:
     """``table.to_csv(index=False, float_format=float_format)``, byte for byte, formatted a row at a
     time where every column is float64 and no value is NaN (one % per row: pandas formats value by
     value, ~10x slower on the trajectories' ~80 columns); other tables through pandas."""
+    import pandas as pd
+
     values = table.to_numpy()
     if (table.empty or not all(dtype == np.float64 for dtype in table.dtypes) or np.isnan(values).any()
             or not isinstance(table.index, pd.RangeIndex)):

@@ -35,11 +35,10 @@ switched and what it cost.
 from __future__ import annotations
 
 import ctypes
-import itertools
 import math
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
@@ -50,6 +49,7 @@ from rover_cosim.identification.online import Adaptation
 from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.orchestrator import native as native_code
 
+from .calibration import Calibration
 from .controller import InverseModelController
 from .longitudinal import LongitudinalInverse
 from .path import Path as ReferencePath
@@ -63,48 +63,6 @@ MIN_SPEED = 0.05
 ENOUGH_LEVELS = 4
 FEWEST_LEVELS = 2
 LONGEST = 3.0
-#: Each side's excitation levels in turn: every order of (+1, 0, -1).
-ORDERS = tuple(itertools.permutations((1.0, 0.0, -1.0)))
-
-
-@dataclass(frozen=True)
-class Calibration:
-    """The calibration phase of an adaptive run (see the module docstring).
-
-    Attributes:
-        duration: length of the phase [s]; the model switches at its end.
-        segment: how long each excitation level is held [s].
-        amplitude: the excitation torque A [N·m] added to and taken from the law's.
-        sinkage_sensor: the rover measures each wheel's sinkage (else the estimate uses the torques only).
-    """
-
-    duration: float = 3.0
-    segment: float = 0.25
-    amplitude: float = 20.0
-    sinkage_sensor: bool = False
-
-    def __post_init__(self) -> None:
-        for key in ("duration", "segment", "amplitude"):
-            value = getattr(self, key)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"calibration {key} = {value!r}: expected a finite number > 0")
-        if self.segment > self.duration:
-            raise ValueError(f"calibration segment = {self.segment!r} s: expected at most its duration "
-                             f"{self.duration!r} s")
-
-    def segment_index(self, t: float) -> int:
-        """The excitation level's number at time ``t`` [s] (0 from the start)."""
-        return int(math.floor(t / self.segment + 1e-9))
-
-    def excitation(self, t: float) -> np.ndarray:
-        """The torques [N·m] added to the law's at time ``t`` [s] while the phase lasts: zero-sum
-        on each side."""
-        k = self.segment_index(t)
-        scale = self.amplitude * (1.0 if (k // len(ORDERS)) % 2 == 0 else 0.5)
-        left, right = ORDERS[k % len(ORDERS)], ORDERS[(k + 3) % len(ORDERS)]
-        return scale * np.array([*left, *right])
-
-
 class Calibrating:
     """The calibration phase of an adaptive block (see the module docstring): the samples, when the
     phase ends, the adaptation and its record. A block using it calls ``_calibrate`` at every step

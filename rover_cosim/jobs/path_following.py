@@ -37,7 +37,8 @@ import pandas as pd
 from rover_cosim.common.outputs import json_bytes, summary_repr
 from rover_cosim.common.rows import csv_bytes, every, indices, steps_between_rows
 from rover_cosim.control import path_figures
-from rover_cosim.control.adaptive import AdaptivePathController, Calibration
+from rover_cosim.control.adaptive import AdaptivePathController
+from rover_cosim.control.calibration import Calibration
 from rover_cosim.control.path import Path as ReferencePath
 from rover_cosim.control.path_controller import PATHS, PathFollowingController
 from rover_cosim.identification.model_set import ModelSet

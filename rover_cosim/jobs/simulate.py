@@ -23,8 +23,9 @@ import numpy as np
 import pandas as pd
 
 from rover_cosim.common.outputs import json_bytes, summary_repr
-from rover_cosim.common.rows import csv_bytes, every, indices, steps_between_rows
-from rover_cosim.control.adaptive import AdaptiveController, Calibration
+from rover_cosim.common.rows import csv_bytes, every, indices
+from rover_cosim.control.adaptive import AdaptiveController
+from rover_cosim.control.calibration import Calibration
 from rover_cosim.control.controller import InverseModelController
 from rover_cosim.control.figures import fig10, tracking
 from rover_cosim.identification.model_set import ModelMismatch, ModelSet
@@ -38,11 +39,7 @@ from rover_cosim.terramechanics.library import Choice, as_choice, choose
 from .campaign import Campaign
 from .plants import add_plant_fmu, add_rover, hubs, rover_fmu, wire_hub
 from .ruts import add_ruts
-
-STOP_TIME = 20.0  # s
-STEP = 1e-3       # s
-#: s, the rows the trajectory files keep by default (the runs step at STEP; metrics use every step)
-RECORD_INTERVAL = 1e-2
+from .straight_run import RECORD_INTERVAL, STEP, STOP_TIME, check_options
 
 
 @dataclass
@@ -243,15 +240,6 @@ def checks(table: pd.DataFrame) -> dict[str, Any]:
             "Fz1_min_while_accelerating_N": float(fz1.min()) if len(fz1) else None,
             "Fz3_max_while_accelerating_N": float(fz3.max()) if len(fz3) else None,
             "Fz_at_start_N": float(table["Fz_1"].iloc[0])}
-
-
-def check_options(record_interval: float, adapt: Calibration | None = None) -> None:
-    """ValueError naming what of the options the runs cannot take: a record interval that is not a
-    whole number of steps, a calibration that does not end before the run."""
-    steps_between_rows(record_interval, STEP)
-    if adapt is not None and not adapt.duration < STOP_TIME:
-        raise ValueError(f"calibration {adapt.duration!r} s: expected a length in (0, {STOP_TIME:g}) s, shorter than "
-                         f"the {STOP_TIME:g} s run")
 
 
 def checked_models(model: Path, choice: Choice | None, allow_mismatch: bool) -> tuple[ModelSet, str | None]:

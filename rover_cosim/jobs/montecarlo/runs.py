@@ -27,7 +27,7 @@ from typing import Any
 import fmpy
 import pandas as pd
 
-from rover_cosim.control.adaptive import Calibration
+from rover_cosim.control.calibration import Calibration
 from rover_cosim.identification.cache import read_run, write_run
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.builder import SystemBuilder

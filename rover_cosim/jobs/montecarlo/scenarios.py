@@ -14,7 +14,7 @@ from typing import Any
 
 import pandas as pd
 
-from rover_cosim.control.adaptive import Calibration
+from rover_cosim.control.calibration import Calibration
 from rover_cosim.identification.model_set import ModelSet
 from rover_cosim.orchestrator.model import System
 from rover_cosim.terramechanics.library import Choice

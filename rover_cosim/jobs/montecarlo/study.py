@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from rover_cosim.control.adaptive import Calibration
+from rover_cosim.control.calibration import Calibration
 from rover_cosim.terramechanics import Soil, Wheel, library
 from rover_cosim.terramechanics.library import DEGREES
 
