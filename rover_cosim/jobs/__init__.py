@@ -5,6 +5,8 @@
 runs, metrics, sensitivity, figures), ``estimate_soil`` (soil estimation and test-bed data).
 ``campaign`` is the skeleton the closed-loop jobs share (their runs, record and files); ``plants``
 builds the plants they run (the rover's hub wiring, written once) through the engine's
-SystemBuilder; ``ground`` holds the ground and soil participants. A job computes, refuses what it
-cannot run, writes all of its files or none, and returns a typed result; the command line
-(``rover_cosim.cli``) only parses arguments, calls the job and prints."""
+SystemBuilder; ``ground`` holds the ground and soil participants; ``straight_run`` the straight
+run's time grid and the check of its options, light enough for the command line to refuse a bad
+option before it imports a job. A job computes, refuses what it cannot run, writes all of its
+files or none, and returns a typed result; the command line (``rover_cosim.cli``) only parses
+arguments, calls the job and prints."""
