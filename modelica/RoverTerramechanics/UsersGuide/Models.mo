@@ -3,7 +3,7 @@ class Models "Models: inputs, outputs, states and parameters of every FMU model;
   annotation (Documentation(info="<html>
 <p>The classes of <code>FMUs</code>, each exported as the FMU of its name (<code>FMUs.Wheel</code>
 as <code>Wheel.fmu</code>) with these variables under these names, and
-<code>Examples.RoverReconnected</code>. Parameters <code>nNodes</code> (8),
+<code>Examples.RoverReconnected</code>. Parameters <code>nNodes</code> (10),
 <code>nIterations</code> (12), <code>vEps</code> [m/s] (1e-3), <code>vHold</code> [m/s] (1e-3)
 and <code>vStick</code> [m/s] (1e-4) of the wheels:
 <a href=\"modelica://RoverTerramechanics.UsersGuide.Physics\">Physics</a> and
@@ -30,7 +30,7 @@ speed), <code>x</code> [m] (carriage position)</li>
 <code>slope</code> [rad] = 0 (positive uphill), <code>slipAngle</code> [rad] = 0 (the wheel set
 at an angle to the carriage's track, as on Ishigami's test bed: the hub moves at v&middot;cos
 along the wheel and v&middot;sin to its left), <code>soil</code> (SoilParameters),
-<code>wheel</code> (WheelParameters), <code>nNodes</code> = 8, <code>nIterations</code> = 12,
+<code>wheel</code> (WheelParameters), <code>nNodes</code> = 10, <code>nIterations</code> = 12,
 <code>vEps</code> [m/s] = 1e-3, <code>vHold</code> [m/s] = 1e-3, <code>vStick</code> [m/s] =
 1e-4</li>
 <li>experiment: 10 s (the FMU's DefaultExperiment)</li>
