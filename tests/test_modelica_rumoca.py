@@ -372,3 +372,16 @@ def test_acceleration_unloads_the_front_limbs_and_loads_the_rear(rover_runs):
     total = sum(accelerating[f"rover.Fz[{i}]"] for i in range(1, 7))
     np.testing.assert_allclose(total, weight, rtol=0.01)
     assert df["rover.v"].iloc[-1] == pytest.approx(1.0, abs=0.1)
+
+
+def test_the_users_guide_states_the_wheels_structural_defaults_the_models_have():
+    """UsersGuide.Models states nNodes and nIterations in prose, "<code>nNodes</code> (10)" or
+    "<code>nNodes</code> = 10": each such number is the Modelica wheel's default."""
+    wheel = (MODELICA_ROOT / PACKAGE / "Components" / "RigidWheel.mo").read_text()
+    guide = (MODELICA_ROOT / PACKAGE / "UsersGuide" / "Models.mo").read_text()
+    for name in ("nNodes", "nIterations"):
+        default = re.search(rf"parameter Integer {name} = (\d+)", wheel)
+        assert default is not None, name
+        stated = re.findall(rf"<code>{name}</code> (?:\((\d+)\)|= (\d+))", guide)
+        assert stated, f"UsersGuide.Models does not state {name}"
+        assert {a or b for a, b in stated} == {default.group(1)}, (name, stated)
