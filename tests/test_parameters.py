@@ -110,8 +110,10 @@ def test_the_soil_record_is_the_python_soil_and_the_wheel_blends_every_field():
     wheel = (package / "Components" / "RigidWheel.mo").read_text()
     blended = re.findall(r"(\w+)=\(1 - soilShare\)\*soil\.(\w+) \+ soilShare\*soilB\.(\w+)", wheel)
     # xc blends each soil's own angle (0: 45 deg - phi/2 of that soil's phi), as Soil.blend does
-    resolved = r"\(if noEvent\({0}\.xc > 0\) then {0}\.xc else 0\.7853981633974483 - {0}\.phi/2\)"
+    resolved = r"RoverTerramechanics\.Functions\.destructiveAngle\({0}\.xc, {0}\.phi\)"
     angle = re.findall(r"(xc)=\(1 - soilShare\)\*" + resolved.format("soil") + r"\s*\+ soilShare\*"
                        + resolved.format("soilB"), wheel)
+    rule = (package / "Functions" / "destructiveAngle.mo").read_text()
+    assert "angle := if noEvent(xc > 0) then xc else 0.7853981633974483 - phi/2;" in rule
     assert math.isclose(0.7853981633974483, math.pi / 4, rel_tol=0, abs_tol=0)
     assert sorted(blended + [(name, name, name) for name in angle]) == sorted((name, name, name) for name in python)

@@ -26,8 +26,8 @@ equation
       kphi=(1 - soilShare)*soil.kphi + soilShare*soilB.kphi, n=(1 - soilShare)*soil.n + soilShare*soilB.n, kx=(1 - soilShare)*soil.kx + soilShare*soilB.kx,
       a0=(1 - soilShare)*soil.a0 + soilShare*soilB.a0, a1=(1 - soilShare)*soil.a1 + soilShare*soilB.a1, lam=(1 - soilShare)*soil.lam + soilShare*soilB.lam,
       kxBeta=(1 - soilShare)*soil.kxBeta + soilShare*soilB.kxBeta, ky=(1 - soilShare)*soil.ky + soilShare*soilB.ky, kyBeta=(1 - soilShare)*soil.kyBeta + soilShare*soilB.kyBeta,
-      rho=(1 - soilShare)*soil.rho + soilShare*soilB.rho, gravity=(1 - soilShare)*soil.gravity + soilShare*soilB.gravity, xc=(1 - soilShare)*(if noEvent(soil.xc > 0) then soil.xc else 0.7853981633974483 - soil.phi/2)
-        + soilShare*(if noEvent(soilB.xc > 0) then soilB.xc else 0.7853981633974483 - soilB.phi/2),
+      rho=(1 - soilShare)*soil.rho + soilShare*soilB.rho, gravity=(1 - soilShare)*soil.gravity + soilShare*soilB.gravity, xc=(1 - soilShare)*RoverTerramechanics.Functions.destructiveAngle(soil.xc, soil.phi)
+        + soilShare*RoverTerramechanics.Functions.destructiveAngle(soilB.xc, soilB.phi),
       nSlip=(1 - soilShare)*soil.nSlip + soilShare*soilB.nSlip),
     wheel, vEps, vHold, vStick, nNodes, nIterations, v_lat, logSinkageStart, slopeStart, rutDepth);
   wheel.J*der(omega) = tau - Tx;

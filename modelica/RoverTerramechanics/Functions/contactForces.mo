@@ -48,7 +48,7 @@ algorithm
   kx := soil.kx + soil.kxBeta*noEvent(abs(slipAngle));
   ky := soil.ky + soil.kyBeta*noEvent(abs(slipAngle));
   tanBeta := tan(slipAngle);
-  xc := if soil.xc > 0 then soil.xc else 0.7853981633974483 - soil.phi/2;
+  xc := destructiveAngle(soil.xc, soil.phi);
   d1 := 1/tan(xc) + tan(xc + soil.phi);
   d2 := 1/tan(xc) + tan(soil.phi)/tan(xc)^2;
   sumFy := 0;
