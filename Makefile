@@ -40,6 +40,9 @@ FMUS ?=
 # binaries/ folders of the FMUs: host (this machine's, by cc), all (linux64 for glibc 2.17, win64,
 # darwin64, aarch64-linux, aarch64-darwin; cross-compiled by zig from PyPI) or a comma-separated list.
 PLATFORMS ?= host
+# The FMUs' elementary functions (exp, log, pow, sin, cos, ...): libm (the C library's, the fastest on
+# each host) or own (fmubuild/runtime/elementary.h: the same bits on every host; see docs/guide/fmus.md).
+ELEMENTARY ?= libm
 comma := ,
 
 # The virtualenv is (re)installed when pyproject.toml changes; the stamp records success.
@@ -61,13 +64,14 @@ fig3: $(STAMP)
 	$(VENV)/bin/rover-cosim fig3 --out $(RESULTS) $(SOIL_OPTIONS)
 
 ## fmus: FMI 2.0 FMUs (ME + CS) of the Modelica models -> fmus/*.fmu (skipped when up to date);
-## PLATFORMS=all adds the binaries of every host (see PLATFORMS above)
+## PLATFORMS=all adds the binaries of every host (see PLATFORMS above); ELEMENTARY=own: FMUs that give
+## the same bits on every host (their own exp, log, sin, ...)
 fmus: $(STAMP)
-	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) --platforms $(PLATFORMS) $(subst $(comma), ,$(FMUS))
+	$(VENV)/bin/rover-cosim build-fmus --out fmus --backend $(BACKEND) --platforms $(PLATFORMS) --elementary $(ELEMENTARY) $(subst $(comma), ,$(FMUS))
 
 ## fmus3: the same models as FMI 3.0 FMUs (ME + CS) -> fmus/fmi3/*.fmu (PLATFORMS as for fmus)
 fmus3: $(STAMP)
-	$(VENV)/bin/rover-cosim build-fmus --out fmus/fmi3 --backend builtin --fmi-version 3 --platforms $(PLATFORMS) $(subst $(comma), ,$(FMUS))
+	$(VENV)/bin/rover-cosim build-fmus --out fmus/fmi3 --backend builtin --fmi-version 3 --platforms $(PLATFORMS) --elementary $(ELEMENTARY) $(subst $(comma), ,$(FMUS))
 
 ## identify: paper Sec. 3 (sweep on SingleWheel.fmu, LUT, Fx fits, Table 1) -> results/identification/
 identify: fmus
@@ -162,6 +166,7 @@ bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_controller.py --out $(RESULTS)/bench/controller.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_soil_estimation.py --out $(RESULTS)/bench/soil_estimation.json --markdown $(RESULTS)/bench/soil_estimation.md
 	$(PY) -P benchmarks/bench_quadrature.py --out $(RESULTS)/bench/quadrature.json --markdown $(RESULTS)/bench/quadrature.md
+	$(PY) -P benchmarks/bench_elementary.py --out $(RESULTS)/bench/elementary.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_closed_loop.py --out $(RESULTS)/bench/closed_loop.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_path_following.py --out $(RESULTS)/bench/path_following.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_legwheel.py --out $(RESULTS)/bench/legwheel.json --model $(RESULTS)/identification/model.json

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
 
-from . import catalog
+from . import catalog, elementary
 
 RUNTIME = Path(__file__).parent / "runtime"
 #: The runtime's files in an FMU: the core (core.h, instance.c, state.c, cosim.c, ode23s) and the API
@@ -38,7 +38,7 @@ def input_digest(name: str) -> str:
     """Digest of everything a built-in FMU of ``name`` is made from."""
     digest = hashlib.sha256(name.encode())
     files = sorted((catalog.MODELICA_ROOT / catalog.PACKAGE).rglob("*")) + sorted(Path(__file__).parent.glob("*.py"))
-    files += [RUNTIME / f for f in sorted({*RUNTIME_FILES, *RUNTIME_FILES_3})]
+    files += [RUNTIME / f for f in sorted({*RUNTIME_FILES, *RUNTIME_FILES_3, elementary.HEADER})]
     for path in files:
         if path.is_file():
             digest.update(str(path.relative_to(path.parents[1])).encode())

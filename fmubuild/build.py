@@ -42,6 +42,10 @@ from .artifact import (
     stored_digest,
 )
 from .catalog import fmu_models
+from .elementary import DEFAULT as ELEMENTARY_DEFAULT
+from .elementary import HEADER as ELEMENTARY_HEADER
+from .elementary import RUNTIME_CALLERS, use_own_elementary
+from .elementary import check as check_elementary
 from .omc import build_fmu_omc
 from .platforms import HOST, PLATFORMS, ZIG_FLAGS, host_compiler, host_folder, host_suffix, zig_command, zig_version
 from .platforms import parse as parse_platforms
@@ -262,22 +266,25 @@ def _one_build_at_a_time(lock: Path) -> Iterator[None]:
 
 def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Sequence[str] = (HOST,),
               compile_jobs: int | None = None, step: StepReport | None = None, fmi_version: int = 2,
-              axles: int | None = None) -> BuildResult:
+              axles: int | None = None, elementary: str = ELEMENTARY_DEFAULT) -> BuildResult:
     """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date) with binaries
     for ``platforms`` (``host``: this machine's, by its C compiler; other names: cross-compiled by
     zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time; ``step`` hears of
     each stage as it ends. ``fmi_version`` 3: an FMI 3.0 FMU of the same model code (the runtime's
     FMI 3.0 layer, the FMI 3.0 model description and platform folders). ``axles``: a rover FMU
     built for that many wheels per side (:func:`source.variant_source`; None: the package's own).
-    One process at a time builds a given FMU into a given folder (``_one_build_at_a_time``)."""
+    ``elementary``: ``libm`` (the C library's exp, log, sin, ...) or ``own`` (runtime/elementary.h's:
+    the same bits on every host; :mod:`fmubuild.elementary`). One process at a time builds a given
+    FMU into a given folder (``_one_build_at_a_time``)."""
     folder = hashlib.sha256(str(Path(out_dir).resolve()).encode()).hexdigest()[:16]
     with _one_build_at_a_time(Path(tempfile.gettempdir()) / "rover-cosim-build-locks" / f"{folder}-{name}.lock"):
         return _build_fmu(name, Path(out_dir), force=force, platforms=platforms, compile_jobs=compile_jobs,
-                          step=step, fmi_version=fmi_version, axles=axles)
+                          step=step, fmi_version=fmi_version, axles=axles,
+                          elementary=check_elementary(elementary))
 
 
 def _build_fmu(name: str, out_dir: Path, *, force: bool, platforms: Sequence[str], compile_jobs: int | None,
-               step: StepReport | None, fmi_version: int, axles: int | None) -> BuildResult:
+               step: StepReport | None, fmi_version: int, axles: int | None, elementary: str) -> BuildResult:
     """build_fmu, the lock held."""
     _check_version(fmi_version)
     if axles is not None:
@@ -287,7 +294,8 @@ def _build_fmu(name: str, out_dir: Path, *, force: bool, platforms: Sequence[str
     out_dir = Path(out_dir)
     target = out_dir / f"{name}.fmu"
     chosen = targets(platforms)
-    digest = platforms_digest(name, chosen) + ("" if fmi_version == 2 else f"-fmi{fmi_version}") + variant
+    digest = (platforms_digest(name, chosen) + ("" if fmi_version == 2 else f"-fmi{fmi_version}") + variant
+              + ("" if elementary == ELEMENTARY_DEFAULT else f"-elementary-{elementary}"))
     if not force and target.exists() and stored_digest(target) == digest:
         return BuildResult(name, target, False, time.perf_counter() - started)
     stages: dict[str, float] = {}
@@ -305,7 +313,7 @@ def _build_fmu(name: str, out_dir: Path, *, force: bool, platforms: Sequence[str
         root = tmp / "fmu"
         sources = root / "sources"
         version = metadata.version("rover-cosim")
-        guid = _generate(name, model, model_layout, root, fmi_version, version)
+        guid = _generate(name, model, model_layout, root, fmi_version, version, elementary)
         stages["generate"] = time.perf_counter() - t0
         if step:
             step(name, "generate")
@@ -330,6 +338,7 @@ def _build_fmu(name: str, out_dir: Path, *, force: bool, platforms: Sequence[str
                   "tools": {p: metadata.version(p) for p in ("rumoca", "casadi")},
                   "cflags": list(host[0].flags if host else CFLAGS),
                   "fmi_version": fmi_version,
+                  "elementary": elementary,
                   "platforms": {folder: {**t.record(), "library": f"binaries/{folder}/{name}{t.suffix}"}
                                 for t in chosen
                                 for folder in [t.folder if fmi_version == 2 else fmi3_folder(t.folder)]},
@@ -361,15 +370,22 @@ def _check_version(fmi_version: int, backend: str = "builtin") -> None:
 
 
 def _generate(name: str, model: ode.OdeModel, model_layout: codegen.ModelLayout, root: Path, fmi_version: int,
-              version: str) -> str:
+              version: str, elementary: str = ELEMENTARY_DEFAULT) -> str:
     """The FMU's sources (generated C, the runtime, the standard headers, the prefix header and the
     build description) and its modelDescription.xml in ``root``; returns the GUID (FMI 3.0: the
-    instantiation token)."""
+    instantiation token). ``elementary`` ``own``: the generated C and the runtime call
+    runtime/elementary.h's functions, which the sources then hold."""
     runtime_files, headers_wanted = FMI_VERSIONS[fmi_version]
     sources = root / "sources"
-    guid = codegen.write_sources(model, model_layout, sources)
+    own = elementary == "own"
+    guid = codegen.write_sources(model, model_layout, sources, own_elementary=own)
     for file in runtime_files:
-        shutil.copy2(RUNTIME / file, sources / file)
+        if own and file in RUNTIME_CALLERS:
+            (sources / file).write_text(use_own_elementary((RUNTIME / file).read_text()))
+        else:
+            shutil.copy2(RUNTIME / file, sources / file)
+    if own:
+        shutil.copy2(RUNTIME / ELEMENTARY_HEADER, sources / ELEMENTARY_HEADER)
     headers = fmi_headers()
     for file in headers_wanted:
         shutil.copy2(headers / file, sources / file)
@@ -393,14 +409,14 @@ def fmi3_folder(folder: str) -> str:
     return PLATFORMS[folder].fmi3 if folder in PLATFORMS else folder
 
 
-def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int, Any, int]) -> BuildResult:
+def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int, Any, int, str]) -> BuildResult:
     """One FMU (in a pool's worker): its stages go to ``steps`` (a queue of the parent's, or None)."""
-    name, out_dir, force, backend, platforms, compile_jobs, steps, fmi_version = args
+    name, out_dir, force, backend, platforms, compile_jobs, steps, fmi_version, elementary = args
     if backend == "omc":
         return build_fmu_omc(name, out_dir, force=force)
     step = (lambda fmu, stage: steps.put((fmu, stage))) if steps is not None else None
     return build_fmu(name, out_dir, force=force, platforms=platforms, compile_jobs=compile_jobs, step=step,
-                     fmi_version=fmi_version)
+                     fmi_version=fmi_version, elementary=elementary)
 
 
 class _LocalSteps:
@@ -450,21 +466,31 @@ def _check_platforms(backend: str, platforms: tuple[str, ...]) -> tuple[str, ...
     return platforms
 
 
-def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *, force: bool = False,
-              jobs: int | None = None, backend: str = "builtin", platforms: Sequence[str] = (HOST,),
-              report: Callable[[BuildResult], None] | None = None,
-              step: StepReport | None = None, fmi_version: int = 2) -> list[BuildResult]:
-    """Build several FMUs, ``jobs`` at a time (default: the number of CPUs), each with binaries for
-    ``platforms`` (see :func:`build_fmu`; the CPUs left to each build compile its platforms in
-    parallel). The first failure is raised after the other builds finished; FMUs already built stay.
-    ``report`` hears of each FMU built or up to date, ``step`` of each stage of a build as it ends
-    (from the workers, through a queue)."""
+def _check_request(names: Sequence[str], backend: str, platforms: tuple[str, ...], fmi_version: int,
+                   elementary: str) -> tuple[str, tuple[str, ...]]:
+    """build_all's backend (``auto`` resolved) and platforms, once every choice was checked."""
     unknown = [n for n in names if n not in FMU_MODELS]
     if unknown:
         raise ValueError(f"model {unknown[0]!r}: expected one of {', '.join(FMU_MODELS)}")
     backend = resolve_backend(backend)
     _check_version(fmi_version, backend)
-    platforms = _check_platforms(backend, tuple(platforms))
+    check_elementary(elementary)
+    if backend == "omc" and elementary != ELEMENTARY_DEFAULT:
+        raise ValueError(f"--elementary {elementary}: the built-in backend only (--backend builtin)")
+    return backend, _check_platforms(backend, platforms)
+
+
+def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *, force: bool = False,
+              jobs: int | None = None, backend: str = "builtin", platforms: Sequence[str] = (HOST,),
+              report: Callable[[BuildResult], None] | None = None,
+              step: StepReport | None = None, fmi_version: int = 2,
+              elementary: str = ELEMENTARY_DEFAULT) -> list[BuildResult]:
+    """Build several FMUs, ``jobs`` at a time (default: the number of CPUs), each with binaries for
+    ``platforms`` (see :func:`build_fmu`; the CPUs left to each build compile its platforms in
+    parallel). The first failure is raised after the other builds finished; FMUs already built stay.
+    ``report`` hears of each FMU built or up to date, ``step`` of each stage of a build as it ends
+    (from the workers, through a queue)."""
+    backend, platforms = _check_request(names, backend, tuple(platforms), fmi_version, elementary)
     cpus = os.cpu_count() or 1
     jobs = max(1, min(jobs or cpus, len(names)))
     compile_jobs = max(1, cpus // jobs)
@@ -472,7 +498,8 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
     errors: list[BaseException] = []
     if jobs == 1:
         local = _LocalSteps(step) if step else None
-        tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, local, fmi_version) for n in names]
+        tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, local, fmi_version, elementary)
+                 for n in names]
         for task in tasks:
             try:
                 results.append(_build_one(task))
@@ -486,7 +513,8 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
         with ExitStack() as stack:
             steps = _forward_steps(stack, context, step) if step else None
             pool = stack.enter_context(ProcessPoolExecutor(max_workers=jobs, mp_context=context))
-            tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, steps, fmi_version) for n in names]
+            tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, steps, fmi_version,
+                      elementary) for n in names]
             futures = [pool.submit(_build_one, task) for task in tasks]
             for future in futures:
                 try:

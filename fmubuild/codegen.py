@@ -25,6 +25,7 @@ from pathlib import Path
 
 import casadi as ca
 
+from .elementary import use_own_elementary
 from .guards import guard_generated_code
 from .ode import OdeModel
 
@@ -223,9 +224,11 @@ def _c_string(text: str) -> str:
     return json.dumps(text)  # a valid C string literal for printable text
 
 
-def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path) -> str:
+def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path, *,
+                  own_elementary: bool = False) -> str:
     """Write ``model_casadi.c`` and ``model_data.c`` to ``directory``; returns the GUID, a digest of
-    the generated code and the layout (same model, same GUID)."""
+    the generated code and the layout (same model, same GUID). ``own_elementary``: the generated
+    code calls ``runtime/elementary.h``'s functions (fmubuild.elementary)."""
     directory.mkdir(parents=True, exist_ok=True)
     generator = ca.CodeGenerator("model_casadi.c", {"with_export": False, "with_header": False,
                                                      "casadi_int": "long long int", "casadi_real": "double"})
@@ -233,6 +236,8 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path) -
         generator.add(function)
     # Each branch of a run-time if computed only when taken (fmubuild.guards).
     code, _ = guard_generated_code(generator.dump())
+    if own_elementary:  # the same elementary functions on every host (fmubuild.elementary)
+        code = use_own_elementary(code)
     digest = hashlib.sha256(code.encode())
     variables = [(v.name, v.kind, v.causality, v.start, v.unit) for v in model_layout.variables]
     assert_texts = [(a.message, a.level, a.names) for a in model.asserts]

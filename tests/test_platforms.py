@@ -239,6 +239,55 @@ def test_win64_under_wine_agrees_with_linux64(wheel_all: Path, linux64_run: np.n
     np.testing.assert_allclose(table, linux64_run, rtol=1e-12, atol=1e-12)
 
 
+# --- the FMUs' own elementary functions: the same bits on every host ------------------------------
+
+#: The targets an own-elementary Wheel is built for here (the ones that can run here).
+OWN_TARGETS = ("linux64", "win64", "aarch64-linux")
+
+
+@pytest.fixture(scope="module")
+def wheel_own(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Wheel.fmu built with --elementary own for OWN_TARGETS, unpacked."""
+    zig_or_skip()
+    out = tmp_path_factory.mktemp("own")
+    result = build.build_fmu("Wheel", out, platforms=OWN_TARGETS, elementary="own")
+    folder = out / "Wheel"
+    fmpy.extract(str(result.path), str(folder))
+    return folder
+
+
+def test_with_its_own_elementary_functions_every_host_gives_the_same_bits(wheel_own: Path, linux64_run: np.ndarray,
+                                                                          tmp_path: Path):
+    """--elementary own: linux64 (zig), the host's gcc build, aarch64 under qemu and win64 under wine
+    (whose C library rounds differently, see the test above) give equal tables; and the own
+    functions compute the same wheel as the C library's (1e-12)."""
+    wine, qemu = wine_or_skip(), qemu_or_skip()
+    md = json.loads((wheel_own / "documentation" / "build.json").read_text())
+    assert md["elementary"] == "own" and "-elementary-own" in md["input_sha256"]
+    linux = compile_importer("x86_64-linux-gnu.2.17", wheel_own, wheel_own / "sources")
+    own = run([str(linux), str(wheel_own / "binaries" / "linux64" / "Wheel.so"), *scenario(wheel_own)], wheel_own)
+    assert np.all(np.isfinite(own)) and own[-1, 1 + OUTPUTS.index("Fx")] > 100
+    np.testing.assert_allclose(own, linux64_run, rtol=1e-12, atol=1e-12)
+    # the own functions round differently from glibc's somewhere in the run
+    assert not np.array_equal(own, linux64_run)
+    arm = compile_importer("aarch64-linux-gnu.2.17", wheel_own, wheel_own / "sources")
+    np.testing.assert_array_equal(
+        run([qemu, "-L", str(AARCH64_SYSROOT), str(arm), str(wheel_own / "binaries" / "aarch64-linux" / "Wheel.so"),
+             *scenario(wheel_own)], wheel_own), own)
+    folder = tmp_path / "win64"
+    folder.mkdir()
+    shutil.copy2(wheel_own / "binaries" / "win64" / "Wheel.dll", folder / "Wheel.dll")
+    windows = compile_importer("x86_64-windows-gnu", folder, wheel_own / "sources")
+    env = {**os.environ, "WINEPREFIX": str(tmp_path / "wineprefix"), "WINEDEBUG": "-all"}
+    np.testing.assert_array_equal(run([wine, windows.name, "Wheel.dll", *scenario(wheel_own)], folder, env), own)
+    if platforms.host_folder() == "linux64":  # and the host's C compiler's build (gcc here, not zig)
+        host = build.build_fmu("Wheel", tmp_path / "host", elementary="own")
+        fmpy.extract(str(host.path), str(tmp_path / "host" / "Wheel"))
+        np.testing.assert_array_equal(
+            run([str(linux), str(tmp_path / "host" / "Wheel" / "binaries" / "linux64" / "Wheel.so"),
+                 *scenario(wheel_own)], wheel_own), own)
+
+
 def pe_exports(library: Path) -> set[str]:
     text = subprocess.run(["objdump", "-p", str(library)], capture_output=True, text=True, check=True).stdout
     table = text.split("[Ordinal/Name Pointer] Table", 1)[-1]

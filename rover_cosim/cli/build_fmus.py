@@ -24,6 +24,10 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--jobs", type=int, default=None, help="parallel builds (default: number of CPUs)")
     parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
                         help="2 (default): FMI 2.0 FMUs; 3: FMI 3.0 FMUs of the same model code (use another --out)")
+    parser.add_argument("--elementary", default="libm", choices=("libm", "own"),
+                        help="the elementary functions (exp, log, pow, sin, cos, ...) the FMUs compute with: libm "
+                        "(default: the C library's, the fastest on each host) or own (the FMUs' own: the same "
+                        "bits on every host and platform; slower, see the design page)")
     add_quiet(parser)
     parser.add_argument("--platforms", default="host", metavar="LIST",
                         help="binaries/ folders to build: host (default: this machine's, by $CC or cc), all "
@@ -55,7 +59,8 @@ def run(args: argparse.Namespace) -> int:
     progress = _Progress(bar, len(models), steps_of(platforms))
     try:
         build_all(models, args.out, force=args.force, jobs=args.jobs, backend=args.backend, platforms=platforms,
-                  report=progress.report, step=progress.step, fmi_version=args.fmi_version)
+                  report=progress.report, step=progress.step, fmi_version=args.fmi_version,
+                  elementary=args.elementary)
     except (UnsupportedConstruct, ValueError, RuntimeError) as error:
         bar.close()
         fail("build-fmus", str(error))
