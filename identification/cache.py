@@ -10,7 +10,7 @@ another case, with its own checksum, is refused), and it has the expected rows a
 other file is reported (naming it and why) and computed again. Partial files of an
 interrupted sweep (``.*.part``) are removed when the next sweep starts.
 
-A file whose name ends in ``.gz`` holds its CSV gzip-compressed (a sweep's runs: a quarter of the
+A file whose name ends in ``.gz`` holds its CSV gzip-compressed (a sweep's runs: a third of the
 plain CSV's size; written with a zero timestamp, so the same run gives the same bytes).
 """
 
@@ -24,6 +24,7 @@ import os
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 #: read_csv's options for floats read back exactly (none needed from pandas 3 on, where the option is deprecated)
@@ -58,14 +59,31 @@ def _digest(key: str, payload: bytes) -> str:
     return hashlib.sha256(key.encode() + b"\n" + payload).hexdigest()
 
 
+#: gzip's level for the run files: 1 compresses a run (111 kB of CSV) in 0.8 ms to 40 kB, 6 (zlib's
+#: default, used before) in 4.4 ms to 37 kB; a sweep writes hundreds of them.
+GZIP_LEVEL = 1
+
+
+def _csv(data: pd.DataFrame, float_format: str | None) -> bytes:
+    """``data.to_csv(index=False, float_format=...)``'s bytes; for a table of floats without NaN
+    (a run) by one %-format of the whole table, 5x faster than pandas' writer and the same bytes."""
+    values = data.to_numpy()
+    if (float_format is None or values.dtype != np.float64 or np.isnan(values).any()
+            or any("," in str(c) or '"' in str(c) for c in data.columns)):
+        return data.to_csv(index=False, float_format=float_format).encode()
+    row = ",".join([float_format] * values.shape[1]) + "\n"
+    header = ",".join(str(c) for c in data.columns) + "\n"
+    return (header + (row * values.shape[0]) % tuple(values.ravel().tolist())).encode()
+
+
 def write_run(target: Path, data: pd.DataFrame, float_format: str | None = "%.12g") -> None:
     """The run's CSV, then its checksum (so a checksum always describes a whole file, and the
     case it was computed for). ``float_format`` None writes every float exactly (shortest repr
     that reads back the same)."""
     target = Path(target)
-    payload = data.to_csv(index=False, float_format=float_format).encode()
+    payload = _csv(data, float_format)
     if target.name.endswith(".gz"):
-        payload = gzip.compress(payload, compresslevel=6, mtime=0)
+        payload = gzip.compress(payload, compresslevel=GZIP_LEVEL, mtime=0)
     _atomic_write(target, payload)
     key = case_key(target)
     record = {"key": key, "sha256": _digest(key, payload), "rows": len(data), "columns": list(data.columns)}

@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from rover_cosim.identification import cache
 from rover_cosim.identification import sweep as sweep_module
 from rover_cosim.identification.fits import (
     IdentifiedModel,
@@ -79,11 +80,26 @@ def test_a_failing_run_is_recorded_and_the_sweep_goes_on(single_wheel, tmp_path,
     assert sorted(p.name for p in outcome.cache_folder.glob("*.csv.gz")) == ["W300_tau10.csv.gz", "W300_tau30.csv.gz"]
 
 
+def test_the_run_files_fast_writer_gives_pandas_bytes():
+    """cache._csv (one %-format of the table) writes what DataFrame.to_csv writes, for a run's
+    floats (tiny, huge, negative, integral, infinite) and, by pandas itself, for a table with NaN."""
+    rng = np.random.default_rng(3)
+    values = rng.normal(size=(50, 4)) * 10.0 ** rng.integers(-300, 300, size=(50, 4))
+    values[0] = [0.0, -0.0, 1.0, np.inf]
+    table = pd.DataFrame(values, columns=["time", "tau", "Fx", "slip"])
+    for float_format in ("%.12g", "%.17g"):
+        assert cache._csv(table, float_format) == table.to_csv(index=False, float_format=float_format).encode()
+    table.iloc[3, 2] = np.nan
+    assert cache._csv(table, "%.12g") == table.to_csv(index=False, float_format="%.12g").encode()
+    assert b",," in cache._csv(table, "%.12g")  # pandas' empty field for NaN
+
+
 def test_an_interrupted_write_leaves_no_file(single_wheel, tmp_path, monkeypatch):
     def interrupted(self, *args, **kwargs):
         raise OSError("disk full")
 
-    monkeypatch.setattr(pd.DataFrame, "to_csv", interrupted)
+    monkeypatch.setattr(pd.DataFrame, "to_csv", interrupted)  # the writer of tables with NaN
+    monkeypatch.setattr(cache, "_csv", interrupted)  # the run's fast writer
     target = tmp_path / "W300_tau10.csv"
     _case, error, _ = compute_run(str(single_wheel), Case(300.0, 10.0), 0.01, 1e-3, 1e-8, 1.0, str(target))
     assert error is not None and "disk full" in error
