@@ -180,3 +180,21 @@ def test_a_second_command_on_the_same_results_is_refused_naming_the_first(tmp_pa
         assert f"is being written by PID {os.getpid()} (rover-cosim identify)" in err
         assert not out.exists()
     assert cli.main(["fig3", "--out", str(out), "--loads", "300", "--slip-step", "0.3"]) == 0  # free again
+
+
+def test_a_long_line_is_thinned_to_its_bins_extremes_and_ends():
+    """common.figures.thinned: a 20,001-sample line becomes ~4,000 points holding every bin's
+    smallest and largest value (a one-sample spike survives), the first and last samples, in order;
+    a short line comes back whole."""
+    from rover_cosim.common.figures import LINE_POINTS, thinned
+
+    t = np.arange(20001) * 1e-3
+    y = np.sin(t)
+    y[12345], y[777] = 50.0, -50.0  # spikes one sample wide
+    tx, ty = thinned(t, y)
+    assert len(tx) <= LINE_POINTS + 4 and len(tx) >= LINE_POINTS // 2
+    assert np.all(np.diff(tx) > 0) and tx[0] == t[0] and tx[-1] == t[-1]
+    assert ty.max() == 50.0 and ty.min() == -50.0 and 12.345 in tx and 0.777 in tx
+    np.testing.assert_array_equal(ty, y[np.searchsorted(t, tx)])  # samples of the line, not new values
+    short_t, short_y = thinned(t[:100], y[:100])
+    np.testing.assert_array_equal(short_y, y[:100])

@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import pandas as pd
 
-from rover_cosim.common.figures import render
+from rover_cosim.common.figures import render, thinned
 from rover_cosim.common.rows import indices
 
 #: Line styles of limbs 1-3: curves that coincide (the limbs share one Fx_des, and their forces
@@ -45,17 +45,17 @@ def fig10(table: pd.DataFrame, plant: str) -> bytes:
     flat = axes.ravel()
     for ax, (name, title, label) in zip(flat, PANELS):
         for i in one_side(table):
-            ax.plot(table["time"], table[f"{name}_{i}"], label=f"limb {i}", **_style(i))
+            ax.plot(*thinned(table["time"], table[f"{name}_{i}"]), label=f"limb {i}", **_style(i))
         ax.set_title(title)
         ax.set_ylabel(label)
         ax.legend(fontsize=8)
-    flat[6].plot(table["time"], table["v"], "k-", label="v")
+    flat[6].plot(*thinned(table["time"], table["v"]), "k-", label="v")
     flat[6].axhline(1.0, color="gray", ls=":", label="target 1.0 m/s")
     flat[6].set_title("(g) rover velocity")
     flat[6].set_ylabel("v [m/s]")
     flat[6].legend(fontsize=8)
-    flat[7].plot(table["time"], table["Fx_1"], label="Fx limb 1")
-    flat[7].plot(table["time"], table["Fx_des_1"], "--", label="Fx_des limb 1")
+    flat[7].plot(*thinned(table["time"], table["Fx_1"]), label="Fx limb 1")
+    flat[7].plot(*thinned(table["time"], table["Fx_des_1"]), "--", label="Fx_des limb 1")
     flat[7].set_title("(h) actual and desired Fx, limb 1")
     flat[7].set_ylabel("F_x [N]")
     flat[7].legend(fontsize=8)
@@ -74,20 +74,20 @@ def tracking(mono: pd.DataFrame, cosim: pd.DataFrame, mono_label: str = "Rover.f
     (d) the co-simulated plant minus the monolithic one (velocity and loads)."""
     fig, axes = plt.subplots(2, 2, figsize=(11, 8), sharex=True)
     time = mono["time"]
-    axes[0][0].plot(time, mono["x"], label=f"x, {mono_label}", lw=2)
-    axes[0][0].plot(time, cosim["x"], "--", label=f"x, {cosim_label}")
-    axes[0][0].plot(time, time * 1.0, ":", color="k", label="target x_t = 1.0 m/s · t")
+    axes[0][0].plot(*thinned(time, mono["x"]), label=f"x, {mono_label}", lw=2)
+    axes[0][0].plot(*thinned(time, cosim["x"]), "--", label=f"x, {cosim_label}")
+    axes[0][0].plot(*thinned(time, time * 1.0), ":", color="k", label="target x_t = 1.0 m/s · t")
     axes[0][0].set_title("(a) position [m]")
-    axes[0][1].plot(time, mono["x"] - time, label=mono_label, lw=2)
-    axes[0][1].plot(time, cosim["x"] - time, "--", label=cosim_label)
+    axes[0][1].plot(*thinned(time, mono["x"] - time), label=mono_label, lw=2)
+    axes[0][1].plot(*thinned(time, cosim["x"] - time), "--", label=cosim_label)
     axes[0][1].set_title("(b) position lag x - x_t [m]")
     side = one_side(mono)
     for i in side:
-        axes[1][0].plot(time, mono[f"Fx_{i}"] - mono[f"Fx_des_{i}"], label=f"limb {i}", **_style(i))
+        axes[1][0].plot(*thinned(time, mono[f"Fx_{i}"] - mono[f"Fx_des_{i}"]), label=f"limb {i}", **_style(i))
     axes[1][0].set_title(f"(c) force error Fx - Fx_des, {mono_label} [N]")
-    axes[1][1].plot(time, 1000 * (cosim["v"] - mono["v"]), label="velocity [mm/s]", lw=2)
+    axes[1][1].plot(*thinned(time, 1000 * (cosim["v"] - mono["v"])), label="velocity [mm/s]", lw=2)
     for i in sorted({side[0], side[-1]}):
-        axes[1][1].plot(time, cosim[f"Fz_{i}"] - mono[f"Fz_{i}"], label=f"load, limb {i} [N]", **_style(i))
+        axes[1][1].plot(*thinned(time, cosim[f"Fz_{i}"] - mono[f"Fz_{i}"]), label=f"load, limb {i} [N]", **_style(i))
     axes[1][1].set_title("(d) co-simulated minus monolithic")
     for ax in axes.ravel():
         ax.grid(alpha=0.3)

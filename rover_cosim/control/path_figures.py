@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.figures import thinned
 from rover_cosim.common.rows import indices
 from rover_cosim.identification.figures import png_bytes
 
@@ -50,14 +51,14 @@ def wheels(table: pd.DataFrame, scenario: str) -> bytes:
     numbers = indices(table.columns, "Fz")
     colors = plt.cm.tab10(np.arange(len(numbers)) % 10)
     for i, color in zip(numbers, colors):
-        axes[0].plot(table["time"], table[f"Fx_{i}"], color=color, lw=1, label=f"wheel {i}")
-        axes[0].plot(table["time"], table[f"Fx_des_{i}"], color=color, lw=1, ls="--")
-        axes[1].plot(table["time"], table[f"Fy_{i}"], color=color, lw=1, label=f"wheel {i}")
-        axes[1].plot(table["time"], table[f"Fy_des_{i}"], color=color, lw=1, ls="--")
-        axes[2].plot(table["time"], np.degrees(table[f"slipAngle_{i}"]), color=color, lw=1,
+        axes[0].plot(*thinned(table["time"], table[f"Fx_{i}"]), color=color, lw=1, label=f"wheel {i}")
+        axes[0].plot(*thinned(table["time"], table[f"Fx_des_{i}"]), color=color, lw=1, ls="--")
+        axes[1].plot(*thinned(table["time"], table[f"Fy_{i}"]), color=color, lw=1, label=f"wheel {i}")
+        axes[1].plot(*thinned(table["time"], table[f"Fy_des_{i}"]), color=color, lw=1, ls="--")
+        axes[2].plot(*thinned(table["time"], np.degrees(table[f"slipAngle_{i}"])), color=color, lw=1,
                      label=f"wheel {i} slip angle")
-        axes[2].plot(table["time"], np.degrees(table[f"steer_{i}"]), color=color, lw=1, ls=":")
-        axes[3].plot(table["time"], table[f"Fz_{i}"], color=color, lw=1, label=f"wheel {i}")
+        axes[2].plot(*thinned(table["time"], np.degrees(table[f"steer_{i}"])), color=color, lw=1, ls=":")
+        axes[3].plot(*thinned(table["time"], table[f"Fz_{i}"]), color=color, lw=1, label=f"wheel {i}")
     axes[0].set_ylabel("Fx [N] (dashed: Fx_des)")
     axes[1].set_ylabel("Fy [N] (dashed: Fy_des)")
     axes[2].set_ylabel("slip angle, steering (dotted) [deg]")

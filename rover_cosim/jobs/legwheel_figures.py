@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.figures import thinned
 from rover_cosim.control.posture import JOINT_INPUTS
 from rover_cosim.identification.figures import png_bytes
 from rover_cosim.limbs import athlete_limbs, attitude, forward
@@ -81,11 +82,12 @@ def limbs(tables: dict[str, pd.DataFrame], title: str) -> bytes:
         for run, (label, table) in enumerate(tables.items()):
             t = table["time"]
             for k, name in enumerate(JOINT_INPUTS):
-                axes[0][column].plot(t, table[f"{name}Torque_{i}"], styles[run % 4], color=f"C{k}", lw=1,
+                axes[0][column].plot(*thinned(t, table[f"{name}Torque_{i}"]), styles[run % 4], color=f"C{k}", lw=1,
                                      label=f"{JOINT_LABELS[k]}" if run == 0 else None)
-            axes[1][column].plot(t, table[f"Fz_{i}"], styles[run % 4], color="C0", lw=1.2, label=label)
-            axes[2][column].plot(t, 1e3 * table[f"sinkage_{i}"], styles[run % 4], color="C1", lw=1.2, label=label)
-            axes[3][column].plot(t, table[f"slip_{i}"], styles[run % 4], color="C2", lw=1.2, label=label)
+            axes[1][column].plot(*thinned(t, table[f"Fz_{i}"]), styles[run % 4], color="C0", lw=1.2, label=label)
+            axes[2][column].plot(*thinned(t, 1e3 * table[f"sinkage_{i}"]), styles[run % 4], color="C1", lw=1.2,
+                                 label=label)
+            axes[3][column].plot(*thinned(t, table[f"slip_{i}"]), styles[run % 4], color="C2", lw=1.2, label=label)
         axes[0][column].set_title(f"limb {i} ({LIMB_NAMES[column]})")
         axes[3][column].set_xlabel("time [s]")
     for ax, label in zip(axes[:, 0], ("joint torque [N·m]", "load Fz [N]", "sinkage [mm]", "slip ratio [-]")):
@@ -95,6 +97,5 @@ def limbs(tables: dict[str, pd.DataFrame], title: str) -> bytes:
     axes[0][0].legend(fontsize=7, loc="best")
     axes[1][0].legend(fontsize=7, loc="best")
     fig.suptitle(f"Leg-wheel rover, {title}: per limb (line style: run)")
-    fig.tight_layout()
     return png_bytes(fig)
 

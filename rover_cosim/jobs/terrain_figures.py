@@ -11,6 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.figures import thinned
 from rover_cosim.common.rows import indices
 from rover_cosim.control.path import Path
 from rover_cosim.identification.figures import png_bytes
@@ -91,7 +92,7 @@ def wheels(tables: dict[str, pd.DataFrame], scenario: str) -> bytes:
         colors = plt.cm.tab10(np.arange(len(numbers)) % 10)
         for ax, (name, _, scale) in zip(axes, names):
             for i, color in zip(numbers, colors):
-                ax.plot(table["time"], scale * table[f"{name}_{i}"], STYLES[label], color=color, lw=1,
+                ax.plot(*thinned(table["time"], scale * table[f"{name}_{i}"]), STYLES[label], color=color, lw=1,
                         label=f"wheel {i}" if label == next(iter(tables)) else None)
     for ax, (_, ylabel, _) in zip(axes, names):
         ax.set_ylabel(ylabel)
