@@ -8,8 +8,9 @@ two agree. Nothing here runs when an FMU is built.
 
 What is computed (each named as in ``elementary.h``):
 - Taylor coefficients (correctly rounded): 1/n! for exp's and sin's and cos's polynomials,
-  2/(2i+1) for log's ``R(z) = sum 2 z^i/(2i+1)`` (log(1+f) = 2 atanh(s), s = f/(2+f)),
-  (-1)^k/(2k+1) for atan's and the first terms of tanh's series;
+  (-1)^(n+1)/n for log(1 + g), (-1)^k/(2k+1) for atan's and the first terms of tanh's series;
+- ``LOG_TABLE``: for c = 1 + j/128, j = -37..53: 1/c (nearest), log c on the grid 2^-42, and the
+  rest of log c;
 - ``EXP_TABLE``: 2^(j/128) for j = 0..127 as a double and the double nearest its remainder;
 - splittings of ln 2, ln 2/128 and pi/2 into a leading part with trailing zero bits (so that an
   integer times it is exact) and the remainder (Cody & Waite's argument reduction);
@@ -32,7 +33,14 @@ EXP_TABLE_SIZE = 128
 EXP_DEGREE = 5          # |r| <= ln2/256
 SIN_DEGREE = 17         # |r| <= pi/4
 COS_DEGREE = 16
-LOG_TERMS = 11          # z = s^2 <= 0.0295
+LOG_DEGREE = 10         # |g| < 2^-6.5
+#: log's table: c = 1 + j/LOG_TABLE_SIZE for j from LOG_TABLE_FIRST (the mantissas from sqrt(1/2))
+#: to LOG_TABLE_LAST (up to sqrt(2)), rounded toward 1.
+LOG_TABLE_SIZE = 128
+LOG_TABLE_FIRST = -37
+LOG_TABLE_LAST = 53
+#: The grid [absolute] of the leading parts of k ln2 and log c: their sum is exact.
+LOG_GRID = Fraction(1, 2 ** 42)
 ATAN_TERMS = 10         # |u| <= 1/8
 ATAN_BREAKPOINTS = (Fraction(1, 4), Fraction(1, 2), Fraction(3, 4), Fraction(1))
 
@@ -100,9 +108,11 @@ def constants() -> list[tuple[str, list[float]]]:
         ("EXP_N_OVER_LN2", [nearest(EXP_TABLE_SIZE / LN2)]),
         # k ln2/128 exact for |k| < 2^18 (exp's arguments reach +-746 * 128 / ln2 < 2^18)
         ("EXP_LN2_OVER_N", list(split(LN2 / EXP_TABLE_SIZE, 53 - 18))),
-        # k ln2 exact for |k| < 2^11 (the exponents of doubles, subnormals scaled)
-        ("LN2", list(split(LN2, 53 - 11))),
-        ("LOG_R", [nearest(Fraction(2, 2 * i + 1)) for i in range(1, LOG_TERMS + 1)]),
+        # on the grid 2^-42 (42 bits): k ln2 exact for |k| < 2^11 (the exponents of doubles, subnormals
+        # scaled), and k ln2 + log c exact (both on the grid, below 2^10)
+        ("LN2", list(on_grid(LN2))),
+        ("LOG1P_TAYLOR", [nearest(Fraction((-1) ** (n + 1), n)) for n in range(2, LOG_DEGREE + 1)]),
+        ("LOG_TABLE", _log_table()),
         ("SIN_TAYLOR", [nearest(Fraction((-1) ** i, math.factorial(2 * i + 1)))
                         for i in range(1, (SIN_DEGREE - 1) // 2 + 1)]),
         ("COS_TAYLOR", [nearest(Fraction((-1) ** i, math.factorial(2 * i)))
@@ -119,6 +129,21 @@ def constants() -> list[tuple[str, list[float]]]:
         # tanh(x) = x + x^3 (-1/3 + x^2 (2/15 + x^2 (-17/315))) for |x| < 2^-8
         ("TANH_TAYLOR", [nearest(Fraction(-1, 3)), nearest(Fraction(2, 15)), nearest(Fraction(-17, 315))]),
     ]
+
+
+def on_grid(value: Decimal | Fraction) -> tuple[float, float]:
+    """``value`` as its nearest multiple of LOG_GRID and the double nearest the rest."""
+    exact = Fraction(value)
+    high = Fraction(round(exact / LOG_GRID)) * LOG_GRID
+    return float(high), nearest(exact - high)
+
+
+def _log_table() -> list[float]:
+    table: list[float] = []
+    for j in range(LOG_TABLE_FIRST, LOG_TABLE_LAST + 1):
+        c = 1 + Fraction(j, LOG_TABLE_SIZE)
+        table += [nearest(1 / c), *on_grid((Decimal(c.numerator) / Decimal(c.denominator)).ln())]
+    return table
 
 
 def _pio2_parts() -> list[float]:

@@ -8,8 +8,8 @@
  * no name; portable C99, no fused multiply-add needed.
  *
  * How: every function reduces its argument exactly (Cody & Waite: a constant split into a leading
- * part with trailing zero bits, so that an integer times it is exact, and the remainder), evaluates
- * a Taylor polynomial on the reduced interval (terms kept until the next is below 2^-60 of the
+ * part with trailing zero bits, so that an integer times it is exact, and the remainder; exp and
+ * log with a table besides), evaluates a Taylor polynomial on the reduced interval (terms kept until the next is below 2^-60 of the
  * result, by Estrin's scheme: shorter chains of dependent operations than Horner's), and rounds
  * once at the end where it can: the last addition is of a number and a much smaller correction.
  * The constants are exact values rounded once (fmubuild/elementary_constants.py, C99 hexadecimal
@@ -19,9 +19,9 @@
  * two-product below are exact without one.
  *
  * Accuracy, in units in the last place of the correctly rounded result, measured against mpmath
- * (tests/test_elementary.py asserts the bounds in brackets): exp 0.51 [1], log 0.75 [1], pow 0.53
- * for |y log x| <= 35 [1 for 16], 2.1 for <= 64 [3], 6 for <= 700; sin, cos 0.74 [1]; tan 1.8,
- * asin, acos 1.7, atan 1.2, atan2 1.7, tanh 1.9 [2]. Special values (zeros, infinities, NaN,
+ * (tests/test_elementary.py asserts the bounds in brackets): exp 0.51 [1], log 0.68 [1], pow 0.52
+ * for |y log x| <= 700 [1]; sin, cos 0.74 [1]; tan 1.8, asin, acos 1.7, atan 1.2, atan2 1.7, tanh
+ * 1.9 [2]. Special values (zeros, infinities, NaN,
  * overflow, underflow, C99 Annex F's cases of pow) are the C library's. sin, cos and tan reduce
  * their argument exactly for |x| < 823549 (2^19 pi/2) and call the C library beyond. */
 #ifndef ROVER_COSIM_ELEMENTARY_H
@@ -102,10 +102,81 @@ static const double EXP_TABLE[256] = {
 static const double EXP_N_OVER_LN2[1] = {0x1.71547652b82fep+7};
 static const double EXP_LN2_OVER_N[2] = {0x1.62e42fef80000p-8, 0x1.1cf79abc9e3b4p-43};
 static const double LN2[2] = {0x1.62e42fefa3800p-1, 0x1.ef35793c76730p-45};
-static const double LOG_R[11] = {
-    0x1.5555555555555p-1, 0x1.999999999999ap-2, 0x1.2492492492492p-2, 0x1.c71c71c71c71cp-3,
-    0x1.745d1745d1746p-3, 0x1.3b13b13b13b14p-3, 0x1.1111111111111p-3, 0x1.e1e1e1e1e1e1ep-4,
-    0x1.af286bca1af28p-4, 0x1.8618618618618p-4, 0x1.642c8590b2164p-4,
+static const double LOG1P_TAYLOR[9] = {
+    -0x1.0000000000000p-1, 0x1.5555555555555p-2, -0x1.0000000000000p-2, 0x1.999999999999ap-3,
+    -0x1.5555555555555p-3, 0x1.2492492492492p-3, -0x1.0000000000000p-3, 0x1.c71c71c71c71cp-4,
+    -0x1.999999999999ap-4,
+};
+static const double LOG_TABLE[273] = {
+    0x1.6816816816817p+0, -0x1.5d5bddf596000p-2, 0x1.a0b2a08a465dcp-47, 0x1.642c8590b2164p+0,
+    -0x1.522ae0738a000p-2, -0x1.ebe708164c759p-45, 0x1.6058160581606p+0, -0x1.4718dc271c000p-2,
+    -0x1.06c18fb4c14c5p-44, 0x1.5c9882b931057p+0, -0x1.3c25277333000p-2, -0x1.83b54b606bd5cp-46,
+    0x1.58ed2308158edp+0, -0x1.314f1e1d36000p-2, 0x1.8e27ad3213cb8p-45, 0x1.5555555555555p+0,
+    -0x1.269621134e000p-2, 0x1.1b61f10522625p-44, 0x1.51d07eae2f815p+0, -0x1.1bf99635a7000p-2,
+    0x1.1ac89575c2125p-44, 0x1.4e5e0a72f0539p+0, -0x1.1178e8227e000p-2, -0x1.1ef78ce2d07f2p-44,
+    0x1.4afd6a052bf5bp+0, -0x1.07138604d6000p-2, 0x1.e76324e912b17p-44, 0x1.47ae147ae147bp+0,
+    -0x1.f991c6cb3c000p-3, 0x1.90d04cd7cc834p-44, 0x1.446f86562d9fbp+0, -0x1.e530effe72000p-3,
+    0x1.fdbdbb13f7c18p-44, 0x1.4141414141414p+0, -0x1.d1037f2656000p-3, 0x1.84a7e75b6f6e4p-47,
+    0x1.3e22cbce4a902p+0, -0x1.bd087383be000p-3, 0x1.d4bc4595412b6p-45, 0x1.3b13b13b13b14p+0,
+    -0x1.a93ed3c8ae000p-3, 0x1.8724350562169p-45, 0x1.3813813813814p+0, -0x1.95a5adcf70000p-3,
+    -0x1.7f22858a0ff6fp-47, 0x1.3521cfb2b78c1p+0, -0x1.823c16551a000p-3, -0x1.e0ddb9a631e83p-46,
+    0x1.323e34a2b10bfp+0, -0x1.6f0128b756000p-3, -0x1.577390d31ef0fp-44, 0x1.2f684bda12f68p+0,
+    -0x1.5bf406b544000p-3, 0x1.27023eb68981cp-46, 0x1.2c9fb4d812ca0p+0, -0x1.4913d8333c000p-3,
+    0x1.53e43558124c4p-44, 0x1.29e4129e4129ep+0, -0x1.365fcb015a000p-3, 0x1.fd3a0afb9691bp-44,
+    0x1.27350b8812735p+0, -0x1.23d712a49c000p-3, -0x1.00d238fd3df5cp-46, 0x1.2492492492492p+0,
+    -0x1.1178e8227e000p-3, -0x1.1ef78ce2d07f2p-45, 0x1.21fb78121fb78p+0, -0x1.fe89139dbc000p-4,
+    -0x1.56594d82f7a82p-44, 0x1.1f7047dc11f70p+0, -0x1.da72763844000p-4, -0x1.a89401fa71733p-46,
+    0x1.1cf06ada2811dp+0, -0x1.b6ac88dad4000p-4, -0x1.b1bdff50225c7p-44, 0x1.1a7b9611a7b96p+0,
+    -0x1.9335e5d594000p-4, -0x1.3115c3abd47dap-45, 0x1.1811811811812p+0, -0x1.700d30aeac000p-4,
+    -0x1.c1e8da99ded32p-49, 0x1.15b1e5f75270dp+0, -0x1.4d3115d208000p-4, 0x1.53a2582f4e1efp-48,
+    0x1.135c81135c811p+0, -0x1.2aa04a4470000p-4, -0x1.7a48ba8b1cb41p-44, 0x1.1111111111111p+0,
+    -0x1.08598b59e4000p-4, 0x1.7e5dd7009902cp-46, 0x1.0ecf56be69c90p+0, -0x1.ccb73cddd8000p-5,
+    -0x1.965c36e09f5fep-44, 0x1.0c9714fbcda3bp+0, -0x1.894aa149f8000p-5, -0x1.9a19a8be97661p-44,
+    0x1.0a6810a6810a7p+0, -0x1.466aed42e0000p-5, 0x1.c167375bdfd28p-45, 0x1.0842108421084p+0,
+    -0x1.0415d89e78000p-5, 0x1.dddc7f461c516p-44, 0x1.0624dd2f1a9fcp+0, -0x1.8492528c90000p-6,
+    0x1.aa0ba325a0c34p-45, 0x1.0410410410410p+0, -0x1.0205658930000p-6, -0x1.611d27c8e8417p-44,
+    0x1.0204081020408p+0, -0x1.0101575880000p-7, -0x1.bce251998b506p-44, 0x1.0000000000000p+0,
+    0.0, 0.0, 0x1.fc07f01fc07f0p-1, 0x1.fe02a6b100000p-8,
+    0x1.9e23f0dda40e4p-46, 0x1.f81f81f81f820p-1, 0x1.fc0a8b0fc0000p-7, 0x1.f1e7cf6d3a69cp-50,
+    0x1.f44659e4a4271p-1, 0x1.7b91b07d60000p-6, -0x1.3b955b602ace4p-44, 0x1.f07c1f07c1f08p-1,
+    0x1.f829b0e780000p-6, 0x1.980267c7e09e4p-45, 0x1.ecc07b301ecc0p-1, 0x1.39e87b9fe8000p-5,
+    0x1.eafd480ad9015p-44, 0x1.e9131abf0b767p-1, 0x1.77458f6330000p-5, -0x1.181dce586af09p-44,
+    0x1.e573ac901e574p-1, 0x1.b42dd71198000p-5, -0x1.c827ae5d6704cp-46, 0x1.e1e1e1e1e1e1ep-1,
+    0x1.f0a30c0118000p-5, -0x1.d599e83368e91p-45, 0x1.de5d6e3f8868ap-1, 0x1.16536eea38000p-4,
+    -0x1.47c5e768fa309p-46, 0x1.dae6076b981dbp-1, 0x1.341d7961bc000p-4, 0x1.1d09299837610p-44,
+    0x1.d77b654b82c34p-1, 0x1.51b073f060000p-4, 0x1.83f69278e686ap-44, 0x1.d41d41d41d41dp-1,
+    0x1.6f0d28ae58000p-4, -0x1.4b4641b664613p-44, 0x1.d0cb58f6ec074p-1, 0x1.8c345d6318000p-4,
+    0x1.b20f5acb42a66p-44, 0x1.cd85689039b0bp-1, 0x1.a926d3a4ac000p-4, 0x1.563650bd22a9cp-44,
+    0x1.ca4b3055ee191p-1, 0x1.c5e548f5bc000p-4, 0x1.d0c57585fbe06p-46, 0x1.c71c71c71c71cp-1,
+    0x1.e27076e2b0000p-4, -0x1.a342c2af0003cp-45, 0x1.c3f8f01c3f8f0p-1, 0x1.fec9131dc0000p-4,
+    -0x1.54555d1ae6607p-44, 0x1.c0e070381c0e0p-1, 0x1.0d77e7cd08000p-3, 0x1.cb2cd2ee2f482p-44,
+    0x1.bdd2b899406f7p-1, 0x1.1b72ad52f6000p-3, 0x1.e80a41811a396p-45, 0x1.bacf914c1bad0p-1,
+    0x1.29552f8200000p-3, -0x1.5b967f4471dfcp-44, 0x1.b7d6c3dda338bp-1, 0x1.371fc201e8000p-3,
+    0x1.ee8779b2d8abcp-44, 0x1.b4e81b4e81b4fp-1, 0x1.44d2b6ccb8000p-3, -0x1.70cc16135783cp-46,
+    0x1.b2036406c80d9p-1, 0x1.526e5e3a1c000p-3, -0x1.790ba37fc5238p-44, 0x1.af286bca1af28p-1,
+    0x1.5ff3070a7a000p-3, -0x1.8586f183bebf2p-44, 0x1.ac5701ac5701bp-1, 0x1.6d60fe719e000p-3,
+    -0x1.bc6e557134767p-44, 0x1.a98ef606a63bep-1, 0x1.7ab890210e000p-3, -0x1.bdb9072534a58p-45,
+    0x1.a6d01a6d01a6dp-1, 0x1.87fa06520c000p-3, 0x1.22120401202fcp-44, 0x1.a41a41a41a41ap-1,
+    0x1.9525a9cf46000p-3, -0x1.297137d9f158fp-44, 0x1.a16d3f97a4b02p-1, 0x1.a23bc1fe2c000p-3,
+    -0x1.539cd91dc9f0bp-44, 0x1.9ec8e951033d9p-1, 0x1.af3c94e80c000p-3, -0x1.a4e633fcd9066p-52,
+    0x1.9c2d14ee4a102p-1, 0x1.bc286742d8000p-3, 0x1.9ac53f39d121cp-44, 0x1.999999999999ap-1,
+    0x1.c8ff7c79aa000p-3, -0x1.7794f689f8434p-45, 0x1.970e4f80cb872p-1, 0x1.d5c216b4fc000p-3,
+    -0x1.1ba91bbca681bp-45, 0x1.948b0fcd6e9e0p-1, 0x1.e27076e2b0000p-3, -0x1.a342c2af0003cp-44,
+    0x1.920fb49d0e229p-1, 0x1.ef0adcbdc6000p-3, -0x1.b26b79c86af24p-45, 0x1.8f9c18f9c18fap-1,
+    0x1.fb9186d5e4000p-3, -0x1.d572aab993c87p-47, 0x1.8d3018d3018d3p-1, 0x1.0402594b4d000p-2,
+    0x1.036b89ef42d7fp-48, 0x1.8acb90f6bf3aap-1, 0x1.0a324e2739000p-2, 0x1.c6bee7ef4030ep-47,
+    0x1.886e5f0abb04ap-1, 0x1.1058bf9ae5000p-2, -0x1.4ab9d817d52cdp-44, 0x1.8618618618618p-1,
+    0x1.1675cababa000p-2, 0x1.8380e731f55c4p-44, 0x1.83c977ab2beddp-1, 0x1.1c898c169a000p-2,
+    -0x1.81410e5c62affp-44, 0x1.8181818181818p-1, 0x1.22941fbcf8000p-2, -0x1.a6976f5eb0963p-44,
+    0x1.7f405fd017f40p-1, 0x1.2895a13de8000p-2, 0x1.a8d7ad24c13f0p-44, 0x1.7d05f417d05f4p-1,
+    0x1.2e8e2bae12000p-2, -0x1.67b1e99b72bd8p-45, 0x1.7ad2208e0ecc3p-1, 0x1.347dd9a988000p-2,
+    -0x1.5594dd4c58092p-45, 0x1.78a4c8178a4c8p-1, 0x1.3a64c55694000p-2, 0x1.7a71cbcd735d0p-44,
+    0x1.767dce434a9b1p-1, 0x1.404308686a000p-2, 0x1.f8ef43049f7d3p-44, 0x1.745d1745d1746p-1,
+    0x1.4618bc21c6000p-2, -0x1.3d82f484c84ccp-46, 0x1.724287f46debcp-1, 0x1.4be5f95778000p-2,
+    -0x1.d7c92cd9ad824p-44, 0x1.702e05c0b8170p-1, 0x1.51aad872e0000p-2, -0x1.f4bd8db0a7cc1p-44,
+    0x1.6e1f76b4337c7p-1, 0x1.5767717456000p-2, -0x1.64ead9524d7cap-44, 0x1.6c16c16c16c17p-1,
+    0x1.5d1bdbf581000p-2, -0x1.8d6bdc9c7c238p-44, 0x1.6a13cd1537290p-1, 0x1.62c82f2b9c000p-2,
+    0x1.e54bdbd7c8a98p-44,
 };
 static const double SIN_TAYLOR[8] = {
     -0x1.5555555555555p-3, 0x1.1111111111111p-7, -0x1.a01a01a01a01ap-13, 0x1.71de3a556c734p-19,
@@ -250,36 +321,36 @@ FUNCTION double rcm_exp(double x) {
 }
 
 /* ---- log ------------------------------------------------------------------------------------
- * x = 2^k (1 + f), 1 + f in [sqrt(1/2), sqrt(2)); log(1 + f) = 2 atanh(s) with s = f/(2 + f),
- * |s| <= 0.1716: = f - (f^2/2 - s (f^2/2 + R(s^2))), R(z) = sum 2 z^i/(2i+1) (11 terms: the
- * next is below 2^-64 of the result); k ln2 added in two parts. */
+ * x = 2^k (1 + f), 1 + f in [sqrt(1/2), sqrt(2)) (f exact); c = 1 + j/128, j = f 128 rounded
+ * toward 0 (c between 1 and 1 + f), d = f - j/128 exact, |d| < 1/128; log x = k ln2 + log c +
+ * log(1 + g), g = d/c (d times the table's 1/c; j = 0: g = f exactly), |g| < 2^-6.5, log(1 + g) =
+ * g - g^2/2 + ... - g^10/10 (the next term below 2^-60 g). k ln2 + log c: their leading parts lie
+ * on the grid 2^-42, so their sum is exact, and their remainders are added with the small terms:
+ * no division, and log(1 + g) has the sign of log c (no cancellation). */
 KERNEL int log_reduce(double x, double *f) {
     int scale = 0;
     if (x < 0x1p-1022) { /* subnormal */
         x *= 0x1p54;
         scale = 54;
     }
+    /* k and m = x/2^k in [sqrt(1/2), sqrt(2)) from the bits, without a branch: the exponent of
+     * x/sqrt(1/2) by an integer subtraction of sqrt(1/2)'s bits (0x3fe6a09e667f3bcd) */
     uint64_t u = bits_of(x);
-    int k = (int)(u >> 52) - 1023;
-    double m = double_of((u & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL); /* [1, 2) */
-    if (m > 1.4142135623730951) {
-        m *= 0.5;
-        k += 1;
-    }
+    int k = (int)((u + (0x400ULL << 52) - 0x3fe6a09e667f3bcdULL) >> 52) - 0x400; /* 0x400: kept positive */
+    double m = double_of(u - ((uint64_t)(int64_t)k << 52));
     *f = m - 1.0; /* exact (Sterbenz) */
     return k - scale;
 }
 
-/* R(z) = z (a0 + a1 z + ... + a10 z^10), Estrin's scheme */
-KERNEL double log_series(double z) {
-    const double *a = LOG_R;
-    double z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
-    double low = (a[0] + z * a[1]) + z2 * (a[2] + z * a[3]) + z4 * ((a[4] + z * a[5]) + z2 * (a[6] + z * a[7]));
-    double high = (a[8] + z * a[9]) + z2 * a[10];
-    return z * (low + z8 * high);
+/* log(1 + g) - g = g^2 (a0 + a1 g + ... + a8 g^8), a_i = (-1)^i / (i + 2), Estrin's scheme */
+KERNEL double log1p_series(double g) {
+    const double *a = LOG1P_TAYLOR;
+    double g2 = g * g, g4 = g2 * g2, g8 = g4 * g4;
+    return g2 * (((a[0] + g * a[1]) + g2 * (a[2] + g * a[3])) + g4 * ((a[4] + g * a[5]) + g2 * (a[6] + g * a[7]))
+                 + g8 * a[8]);
 }
 
-/* NaN for negative x and NaN, -inf for zero, +inf for +inf; else 0 and *k, *f set */
+/* NaN for negative x and NaN, -inf for zero, +inf for +inf; else 0 */
 FUNCTION int log_special(double x, double *result) {
     if (x != x || x < 0.0) {
         *result = x != x ? x + x : (x - x) / (x - x);
@@ -296,31 +367,46 @@ FUNCTION int log_special(double x, double *result) {
     return 0;
 }
 
+/* The reduction of x > 0 (finite): returns g; *entry the table's row of c (1/c, log c's leading
+ * part on the grid, its rest), *d, *kd (k as a double), *j. */
+KERNEL double log_argument(double x, const double **entry, double *d, double *kd, int *j) {
+    double f;
+    int k = log_reduce(x, &f);
+    *j = (int)(f * 128.0); /* toward 0 */
+    *d = f - (double)*j * 0.0078125;
+    *entry = LOG_TABLE + 3 * (*j + 37);
+    *kd = (double)k;
+    return *d * (*entry)[0];
+}
+
 FUNCTION double rcm_log(double x) {
     double special;
     if (log_special(x, &special)) return special;
-    double f;
-    int k = log_reduce(x, &f);
-    double s = f / (2.0 + f);
-    double hfsq = 0.5 * f * f;
-    double kd = (double)k;
-    return kd * LN2[0] + (f - (hfsq - (s * (hfsq + log_series(s * s)) + kd * LN2[1])));
+    const double *entry;
+    double d, kd;
+    int j;
+    double g = log_argument(x, &entry, &d, &kd, &j);
+    double a = kd * LN2[0] + entry[1]; /* exact: both on the grid 2^-42 */
+    double e, hi = two_sum(a, g, &e);
+    return hi + (e + (log1p_series(g) + (kd * LN2[1] + entry[2])));
 }
 
-/* log(x) = hi + *lo to about 2^-60 relative, for pow: s carried with its rounding error
- * (log(1 + f) = 2 s + 2 s_lo + s R(s^2)) and every sum kept exact. */
+/* log(x) = hi + *lo to about 2^-66 relative, for pow: g carried with its rounding error g_lo (d/c
+ * = g + g_lo exactly to 2^-106), log(1 + g + g_lo) = g + g_lo (1 - g) + (log(1 + g) - g). */
 FUNCTION double log_extended(double x, double *lo) {
-    double f;
-    int k = log_reduce(x, &f);
-    double u_lo, u = fast_two_sum(2.0, f, &u_lo); /* 2 + f exactly */
-    double s = f / u;
-    double p_lo, p = two_product(s, u, &p_lo);
-    double s_lo = (((f - p) - p_lo) - s * u_lo) / u;
-    double correction = 2.0 * s_lo + s * log_series(s * s);
-    double l_lo, l = fast_two_sum(2.0 * s, correction, &l_lo);
-    double kd = (double)k;
-    double e, sum = two_sum(kd * LN2[0], l, &e);
-    return fast_two_sum(sum, e + l_lo + kd * LN2[1], lo);
+    const double *entry;
+    double d, kd;
+    int j;
+    double g = log_argument(x, &entry, &d, &kd, &j);
+    double g_lo = 0.0;
+    if (j != 0) {
+        double pe, p = two_product(g, 1.0 + (double)j * 0.0078125, &pe);
+        g_lo = ((d - p) - pe) * entry[0];
+    }
+    double a = kd * LN2[0] + entry[1];
+    double e, hi = two_sum(a, g, &e);
+    double rest = e + (g_lo - g * g_lo + (log1p_series(g) + (kd * LN2[1] + entry[2])));
+    return fast_two_sum(hi, rest, lo);
 }
 
 /* ---- pow (C99 Annex F's special cases, then exp(y log x) with log and the product extended) -- */
