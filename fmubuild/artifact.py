@@ -49,6 +49,18 @@ def input_digest(name: str) -> str:
     return digest.hexdigest()
 
 
+def stored_elementary(fmu: Path) -> str:
+    """The elementary functions an FMU built by this module computes with (its build record's
+    ``elementary``; ``libm`` for an FMU that records none: built before the choice existed, or by
+    another tool)."""
+    try:
+        with zipfile.ZipFile(fmu) as archive:
+            choice = json.loads(archive.read(BUILD_RECORD)).get("elementary", elementary.DEFAULT)
+    except (OSError, KeyError, ValueError, AttributeError, zipfile.BadZipFile):
+        return elementary.DEFAULT
+    return choice if choice in elementary.CHOICES else elementary.DEFAULT
+
+
 def stored_digest(fmu: Path) -> str | None:
     """The input digest recorded in an FMU built by this module, or None."""
     try:

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from rover_cosim.fmubuild import build, elementary, elementary_constants
+from rover_cosim.fmubuild.artifact import stored_elementary
 
 HARNESS = Path(__file__).with_name("elementary_harness.c")
 RUNTIME = Path(elementary_constants.__file__).parent / "runtime"
@@ -189,3 +190,5 @@ def test_an_own_build_calls_no_elementary_function_of_the_c_library(fmus: dict[s
             assert elementary.remaining_calls(text) == [] and "rcm_" in text, source
         record = fmu.read("documentation/build.json").decode()
     assert '"elementary": "own"' in record
+    assert stored_elementary(own.path) == "own" and stored_elementary(fmus["Rover"]) == "libm"
+    assert stored_elementary(tmp_path / "missing.fmu") == "libm"

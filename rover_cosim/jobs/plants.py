@@ -34,16 +34,20 @@ def rover_fmu(fmu_dir: str | Path, name: str, choice: Choice | None) -> Path:
     """The rover FMU ``name`` (Rover, RoverBody, SteerableRover, SteerableRoverBody) for the rover of
     ``choice``: ``fmu_dir/NAME.fmu`` where it has the rover's number of wheels (the package's six;
     a missing one is the caller's to report), else ``fmu_dir/wheels<N>/NAME.fmu``, built on demand
-    from the Modelica source for N wheels and kept (rebuilt only when its inputs change)."""
+    from the Modelica source for N wheels, with the elementary functions ``fmu_dir/NAME.fmu`` was
+    built with, and kept (rebuilt only when its inputs change)."""
     path = Path(fmu_dir) / f"{name}.fmu"
     wheels = choice.rover.wheels if choice is not None else PACKAGE_WHEELS
     if (path.is_file() and len(hubs(path)) == wheels) or (wheels == PACKAGE_WHEELS and not path.is_file()):
         return path
+    from rover_cosim.fmubuild.artifact import stored_elementary
     from rover_cosim.fmubuild.build import build_fmu
 
     folder = Path(fmu_dir) / f"wheels{wheels}"
+    # with the elementary functions of the folder's own FMU (make fmus ELEMENTARY=own: own here too)
+    elementary = stored_elementary(path) if path.is_file() else "libm"
     try:
-        return build_fmu(name, folder, axles=wheels // 2).path
+        return build_fmu(name, folder, axles=wheels // 2, elementary=elementary).path
     except Exception as error:  # noqa: BLE001 - a compiler, a file system, the exporter: said as one error
         raise ValueError(f"the rover {choice.rover_name if choice else ''} has {wheels} wheels: {name}.fmu for them "
                          f"could not be built into {folder} ({type(error).__name__}: {error})") from None
