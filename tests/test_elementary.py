@@ -16,6 +16,7 @@ from pathlib import Path
 import mpmath
 import numpy as np
 import pytest
+from fmpy.validation import validate_fmu
 
 from rover_cosim.fmubuild import build, elementary, elementary_constants
 from rover_cosim.fmubuild.artifact import stored_elementary
@@ -191,4 +192,5 @@ def test_an_own_build_calls_no_elementary_function_of_the_c_library(fmus: dict[s
         record = fmu.read("documentation/build.json").decode()
     assert '"elementary": "own"' in record
     assert stored_elementary(own.path) == "own" and stored_elementary(fmus["Rover"]) == "libm"
+    assert validate_fmu(str(own.path)) == []
     assert stored_elementary(tmp_path / "missing.fmu") == "libm"
