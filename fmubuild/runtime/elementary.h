@@ -19,9 +19,9 @@
  * two-product below are exact without one.
  *
  * Accuracy, in units in the last place of the correctly rounded result, measured against mpmath
- * (tests/test_elementary.py asserts the bounds in brackets): exp 0.51 [1], log 0.68 [1], pow 0.52
- * for |y log x| <= 700 [1]; sin, cos 0.74 [1]; tan 1.8, asin, acos 1.7, atan 1.2, atan2 1.7, tanh
- * 1.9 [2]. Special values (zeros, infinities, NaN,
+ * (tests/test_elementary.py asserts 1 ulp for each): exp 0.51, log 0.68, pow 0.52 for |y log x| <=
+ * 700, sin and cos 0.74, tan 0.77, asin, acos, atan and atan2 0.50, tanh 0.79 (the last four with
+ * their intermediate ratios and square roots carried with their rounding errors). Special values (zeros, infinities, NaN,
  * overflow, underflow, C99 Annex F's cases of pow) are the C library's. sin, cos and tan reduce
  * their argument exactly for |x| < 823549 (2^19 pi/2) and call the C library beyond. */
 #ifndef ROVER_COSIM_ELEMENTARY_H
@@ -467,25 +467,38 @@ KERNEL int reduce_half_pi(double x, double *r, double *rt) {
     return (int)((int64_t)nd & 3);
 }
 
-/* sin(r + rt) = r + r^3 S(r^2) + rt (1 - r^2/2), Taylor to r^17 */
-KERNEL double sin_kernel(double r, double rt) {
+/* sin(r + rt) = r + *lo, *lo = r^3 S(r^2) + rt (1 - r^2/2), Taylor to r^17 */
+KERNEL double sin_parts(double r, double rt, double *lo) {
     const double *a = SIN_TAYLOR;
     double z = r * r;
     double v = z * r;
     double z2 = z * z, z4 = z2 * z2;
     double s = ((a[0] + z * a[1]) + z2 * (a[2] + z * a[3])) + z4 * ((a[4] + z * a[5]) + z2 * (a[6] + z * a[7]));
-    return r + (v * s + rt * (1.0 - 0.5 * z));
+    *lo = v * s + rt * (1.0 - 0.5 * z);
+    return r;
 }
 
-/* cos(r + rt) = 1 - r^2/2 + r^4 C(r^2) - r rt, Taylor to r^16; 1 - r^2/2 with its rounding error */
-KERNEL double cos_kernel(double r, double rt) {
+KERNEL double sin_kernel(double r, double rt) {
+    double lo, hi = sin_parts(r, rt, &lo);
+    return hi + lo;
+}
+
+/* cos(r + rt) = w + *lo, w = 1 - r^2/2 rounded and *lo the rest: w's rounding error, r^4 C(r^2)
+ * (Taylor to r^16) and -r rt; r^2 exact as z + z_lo */
+KERNEL double cos_parts(double r, double rt, double *lo) {
     const double *a = COS_TAYLOR;
-    double z = r * r;
+    double z_lo, z = two_product(r, r, &z_lo);
     double z2 = z * z, z4 = z2 * z2;
     double c = ((a[0] + z * a[1]) + z2 * (a[2] + z * a[3])) + z4 * ((a[4] + z * a[5]) + z2 * a[6]);
     double hz = 0.5 * z;
     double w = 1.0 - hz;
-    return w + (((1.0 - w) - hz) + (z * z * c - r * rt));
+    *lo = ((1.0 - w) - hz) + (z2 * c - (r * rt + 0.5 * z_lo));
+    return w;
+}
+
+KERNEL double cos_kernel(double r, double rt) {
+    double lo, hi = cos_parts(r, rt, &lo);
+    return hi + lo;
 }
 
 FUNCTION double rcm_sin(double x) {
@@ -517,36 +530,76 @@ FUNCTION double rcm_tan(double x) {
     if (!(fabs(x) < REDUCTION_LIMIT)) return x - x == 0.0 ? tan(x) : x - x;
     double r, rt;
     int n = reduce_half_pi(x, &r, &rt);
-    double s = sin_kernel(r, rt), c = cos_kernel(r, rt);
-    return n & 1 ? -c / s : s / c;
+    double s_lo, s = sin_parts(r, rt, &s_lo);
+    double c_lo, c = cos_parts(r, rt, &c_lo);
+    s = fast_two_sum(s, s_lo, &s_lo); /* each a sum and its rounding error */
+    c = fast_two_sum(c, c_lo, &c_lo);
+    if (n & 1) { /* -cos/sin */
+        double t = c, t_lo = c_lo;
+        c = -s, c_lo = -s_lo;
+        s = t, s_lo = t_lo;
+    }
+    /* (s + s_lo)/(c + c_lo) = q + its error, as ratio() does */
+    double q = s / c;
+    double pe, p = two_product(q, c, &pe);
+    return q + (((s - p) - pe) + (s_lo - q * c_lo)) / c;
 }
 
 /* ---- atan, atan2, asin, acos ---------------------------------------------------------------
- * atan(t), t in [0, 1]: the nearest breakpoint c of 0, 1/4, 1/2, 3/4, 1 and atan(t) = atan(c) +
- * atan(u), u = (t - c)/(1 + t c) (t - c exact), |u| <= 1/8; atan(u) = u + u^3 Q(u^2), Taylor to
- * u^21. Returned as hi + *lo. */
-KERNEL double atan_unit(double t, double *lo) {
+ * atan(t + t_lo), t in [0, 1]: the nearest breakpoint c of 0, 1/4, 1/2, 3/4, 1 and atan(t) =
+ * atan(c) + atan(u), u = (t - c)/(1 + t c) (t - c exact; u carried with its rounding error u_lo),
+ * |u| <= 1/8; atan(u + u_lo) = u + u^3 Q(u^2) + u_lo (1 - u^2), Taylor to u^21. Returned as
+ * hi + *lo. */
+KERNEL double atan_unit(double t, double t_lo, double *lo) {
     int i = (int)(t * 4.0 + 0.5);
-    double u = t;
-    if (i > 0) u = (t - ATAN_BREAKPOINT[i - 1]) / (1.0 + t * ATAN_BREAKPOINT[i - 1]);
+    double u = t, u_lo = t_lo, head = 0.0, head_lo = 0.0;
+    if (i > 0) {
+        double c = ATAN_BREAKPOINT[i - 1];
+        double num = t - c; /* exact (Sterbenz) */
+        double pe, p = two_product(t, c, &pe);
+        double de, den = two_sum(1.0, p, &de);
+        double den_lo = de + pe + t_lo * c;
+        u = num / den;
+        double re, r = two_product(u, den, &re);
+        u_lo = (((num - r) - re) + t_lo - u * den_lo) / den;
+        head = ATAN_OF_BREAKPOINT[2 * (i - 1)];
+        head_lo = ATAN_OF_BREAKPOINT[2 * (i - 1) + 1];
+    }
     const double *a = ATAN_TAYLOR;
     double z = u * u;
     double z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
     double q = ((a[0] + z * a[1]) + z2 * (a[2] + z * a[3])) + z4 * ((a[4] + z * a[5]) + z2 * (a[6] + z * a[7]))
                + z8 * (a[8] + z * a[9]);
-    double poly = u * z * q;
-    if (i == 0) {
-        *lo = 0.0;
-        return fast_two_sum(u, poly, lo);
-    }
-    double hi = ATAN_OF_BREAKPOINT[2 * (i - 1)];
-    return fast_two_sum(hi, u + (poly + ATAN_OF_BREAKPOINT[2 * (i - 1) + 1]), lo);
+    double e, sum = two_sum(head, u, &e);
+    return fast_two_sum(sum, e + ((u * z * q + u_lo * (1.0 - z)) + head_lo), lo);
 }
 
-/* atan(q) for q = n/d >= 0 given as its parts, as hi + lo: atan(d/n) reflected about pi/2 when n > d */
-FUNCTION double atan_ratio(double n, double d, double *lo) {
-    if (n <= d) return atan_unit(n / d, lo);
-    double l, h = atan_unit(d / n, &l);
+/* (n + n_lo)/(d + d_lo) = q + *lo for 0 < n <= d (finite; the lo parts below their ulp): q
+ * rounded, *lo its error (0 where the ratio is below 2^-60, whose atan is the ratio itself); n and
+ * d scaled by a power of two first, so that the exact product below neither overflows nor
+ * underflows. */
+KERNEL double ratio(double n, double n_lo, double d, double d_lo, double *lo) {
+    double q = n / d;
+    *lo = 0.0;
+    if (n < d * 0x1p-60) return q;
+    int e = (int)((bits_of(d) >> 52) & 0x7ff) - 1023;
+    double scale = power_of_two(-e);
+    double ns = n * scale, ds = d * scale;
+    double pe, p = two_product(q, ds, &pe);
+    *lo = (((ns - p) - pe) + (n_lo - q * d_lo) * scale) / ds;
+    return q;
+}
+
+/* atan((n + n_lo)/(d + d_lo)) for n, d > 0 (finite) as hi + *lo: atan(d/n) reflected about pi/2
+ * when n > d */
+FUNCTION double atan_ratio(double n, double n_lo, double d, double d_lo, double *lo) {
+    double q_lo;
+    if (n <= d) {
+        double q = ratio(n, n_lo, d, d_lo, &q_lo);
+        return atan_unit(q, q_lo, lo);
+    }
+    double q = ratio(d, d_lo, n, n_lo, &q_lo);
+    double l, h = atan_unit(q, q_lo, &l);
     double e, s = two_sum(PI_OVER_2[0], -h, &e);
     return fast_two_sum(s, e + (PI_OVER_2[1] - l), lo);
 }
@@ -564,7 +617,7 @@ FUNCTION double rcm_atan2(double y, double x) {
     } else if (ax == 0.0) {
         angle = PI_OVER_2[0];
     } else {
-        double lo, hi = atan_ratio(ay, ax, &lo);
+        double lo, hi = atan_ratio(ay, 0.0, ax, 0.0, &lo);
         if (x < 0.0) {
             double e, s = two_sum(PI[0], -hi, &e);
             angle = s + (e + (PI[1] - lo));
@@ -580,27 +633,62 @@ FUNCTION double rcm_atan(double x) {
     return rcm_atan2(x, 1.0);
 }
 
-/* asin(x) = atan2(x, sqrt((1 - x)(1 + x))), acos(x) = atan2(sqrt((1 - x)(1 + x)), x) */
-FUNCTION double cosine_of_asin(double x) {
-    return sqrt((1.0 - x) * (1.0 + x));
+/* sqrt(1 - x^2) = c + *lo for |x| <= 1: 1 - x^2 as (1 - |x|)(1 + |x|) for |x| >= 1/2 (1 - |x|
+ * exact) or 1 - x x below, each with its rounding error, then the square root corrected by it */
+KERNEL double cosine_of_asin(double x, double *lo) {
+    double ax = fabs(x), a, a_lo;
+    if (ax >= 0.5) {
+        double om = 1.0 - ax;
+        double be, b = two_sum(1.0, ax, &be);
+        double pe;
+        a = two_product(om, b, &pe);
+        a_lo = pe + om * be;
+    } else {
+        double x2e, x2 = two_product(ax, ax, &x2e);
+        double ae;
+        a = two_sum(1.0, -x2, &ae);
+        a_lo = ae - x2e;
+    }
+    double c = sqrt(a);
+    *lo = 0.0;
+    if (c > 0.0) {
+        double ce, cc = two_product(c, c, &ce);
+        *lo = (((a - cc) - ce) + a_lo) / (2.0 * c);
+    }
+    return c;
 }
 
+/* asin(x) = atan2(x, sqrt(1 - x^2)), acos(x) = atan2(sqrt(1 - x^2), x), the square root carried
+ * with its rounding error */
 FUNCTION double rcm_asin(double x) {
     if (x != x) return x + x;
     if (fabs(x) > 1.0) return (x - x) / (x - x);
     if (fabs(x) < 0x1p-26) return x;
-    return rcm_atan2(x, cosine_of_asin(x));
+    double c_lo, c = cosine_of_asin(x, &c_lo);
+    double angle = PI_OVER_2[0];
+    if (c > 0.0) {
+        double lo, hi = atan_ratio(fabs(x), 0.0, c, c_lo, &lo);
+        angle = hi + lo;
+    }
+    return sign_bit(x) ? -angle : angle;
 }
 
 FUNCTION double rcm_acos(double x) {
     if (x != x) return x + x;
     if (fabs(x) > 1.0) return (x - x) / (x - x);
-    return rcm_atan2(cosine_of_asin(x), x);
+    if (x == 0.0) return PI_OVER_2[0];
+    double c_lo, c = cosine_of_asin(x, &c_lo);
+    if (c == 0.0) return x > 0.0 ? 0.0 : PI[0];
+    double lo, hi = atan_ratio(c, c_lo, fabs(x), 0.0, &lo);
+    if (x > 0.0) return hi + lo;
+    double e, s = two_sum(PI[0], -hi, &e);
+    return s + (e + (PI[1] - lo));
 }
 
 /* ---- tanh ------------------------------------------------------------------------------------
  * |x| < 2^-8: x + x^3 (-1/3 + x^2 (2/15 - 17 x^2/315)) (the next term is below 2^-60 x);
- * else e = expm1(2|x|) from exp's parts with 2^m t - 1 exact, tanh = e/(e + 2); 1 beyond 22. */
+ * else e = expm1(2|x|) from exp's parts (2^m t - 1 and 2^m c summed exactly), tanh = e/(e + 2)
+ * with e and e + 2 carried with their rounding errors; 1 beyond 22. */
 FUNCTION double rcm_tanh(double x) {
     if (x != x) return x + x;
     double ax = fabs(x);
@@ -615,8 +703,14 @@ FUNCTION double rcm_tanh(double x) {
     } else {
         double t, c;
         double scale = power_of_two((int)exp_parts(2.0 * ax, 0.0, &t, &c));
-        double em1 = (scale * t - 1.0) + scale * c;
-        result = em1 / (em1 + 2.0);
+        double e1, h1 = two_sum(scale * t, -1.0, &e1); /* scale t exact */
+        double e2, em1 = two_sum(h1, scale * c, &e2);
+        double em1_lo = e1 + e2;
+        double de, den = two_sum(em1, 2.0, &de);
+        double den_lo = de + em1_lo;
+        double q = em1 / den; /* (em1 + em1_lo)/(den + den_lo) = q + its error */
+        double pe, p = two_product(q, den, &pe);
+        result = q + (((em1 - p) - pe) + (em1_lo - q * den_lo)) / den;
     }
     return x < 0.0 ? -result : result;
 }
