@@ -9,6 +9,8 @@
 - ``fmubuild.codegen``: the ODE → C (CasADi) and the value-reference layout;
   ``fmubuild.description``: modelDescription.xml (units via ``rover_cosim.common.units``).
 - ``fmubuild.runtime``: the FMI 2.0 C runtime (ME + CS, Rosenbrock integrator) the FMUs link.
+- ``fmubuild.elementary``: ``--elementary own``, the FMUs' own exp, log, sin, ... (``runtime/elementary.h``,
+  its constants from ``fmubuild.elementary_constants``): the same bits on every host.
 - ``fmubuild.artifact``: what an FMU is made from (input digest) and its build record;
   ``fmubuild.build``: compile and package, incremental and atomic; ``fmubuild.omc``: the
   OpenModelica backend.

@@ -20,6 +20,11 @@ RUNTIME_CALLERS = ("ode23s.c",)
 _CALL = re.compile(r"(?<![\w.])(" + "|".join(OWN_FUNCTIONS) + r")\s*\(")
 
 
+def _is_code(line: str) -> bool:
+    """A line of C that is neither a comment line (CasADi's ``/* ... */``) nor a preprocessor line."""
+    return not line.lstrip().startswith(("/*", "*", "//", "#"))
+
+
 def check(choice: str) -> str:
     """``choice`` if it is one of CHOICES, else ValueError naming the allowed ones."""
     if choice not in CHOICES:
@@ -32,9 +37,7 @@ def use_own_elementary(code: str) -> str:
     preprocessor lines are left as they are."""
     lines = []
     for line in code.splitlines(keepends=True):
-        if not line.lstrip().startswith(("/*", "*", "//", "#")):
-            line = _CALL.sub(r"rcm_\1(", line)
-        lines.append(line)
+        lines.append(_CALL.sub(r"rcm_\1(", line) if _is_code(line) else line)
     text = "".join(lines)
     if "#include <math.h>\n" not in text:
         raise ValueError("C without #include <math.h>: cannot place elementary.h after it")
@@ -43,8 +46,4 @@ def use_own_elementary(code: str) -> str:
 
 def remaining_calls(code: str) -> list[str]:
     """The C library's elementary functions ``code`` still calls outside comments (for checks)."""
-    found = []
-    for line in code.splitlines():
-        if not line.lstrip().startswith(("/*", "*", "//", "#")):
-            found += _CALL.findall(line)
-    return found
+    return [name for line in code.splitlines() if _is_code(line) for name in _CALL.findall(line)]

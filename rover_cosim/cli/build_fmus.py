@@ -24,7 +24,9 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--jobs", type=int, default=None, help="parallel builds (default: number of CPUs)")
     parser.add_argument("--fmi-version", type=int, choices=(2, 3), default=2,
                         help="2 (default): FMI 2.0 FMUs; 3: FMI 3.0 FMUs of the same model code (use another --out)")
-    parser.add_argument("--elementary", default="libm", choices=("libm", "own"),
+    from rover_cosim.fmubuild import elementary
+
+    parser.add_argument("--elementary", default=elementary.DEFAULT, choices=elementary.CHOICES,
                         help="the elementary functions (exp, log, pow, sin, cos, ...) the FMUs compute with: libm "
                         "(default: the C library's, the fastest on each host) or own (the FMUs' own: the same "
                         "bits on every host and platform; slower, see the design page)")

@@ -45,9 +45,8 @@ def rover_fmu(fmu_dir: str | Path, name: str, choice: Choice | None) -> Path:
 
     folder = Path(fmu_dir) / f"wheels{wheels}"
     # with the elementary functions of the folder's own FMU (make fmus ELEMENTARY=own: own here too)
-    elementary = stored_elementary(path) if path.is_file() else "libm"
     try:
-        return build_fmu(name, folder, axles=wheels // 2, elementary=elementary).path
+        return build_fmu(name, folder, axles=wheels // 2, elementary=stored_elementary(path)).path
     except Exception as error:  # noqa: BLE001 - a compiler, a file system, the exporter: said as one error
         raise ValueError(f"the rover {choice.rover_name if choice else ''} has {wheels} wheels: {name}.fmu for them "
                          f"could not be built into {folder} ({type(error).__name__}: {error})") from None
