@@ -9,6 +9,7 @@ import math
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import fmpy
 import numpy as np
@@ -208,6 +209,60 @@ def test_the_limb_soil_block_puts_each_hub_where_the_rover_says_it_is():
     assert block.step(0.0, 1e-3, np.concatenate([[0.0, 0.0, 0.0], hub_x, hub_y])).tolist() == [1.0] + [0.0] * 5
     turned = block.step(0.0, 1e-3, np.concatenate([[1.0, 0.0, 0.5 * math.pi], hub_x, hub_y]))  # the body turned left
     assert turned[0] == 0.0
+
+
+@pytest.mark.parametrize("run_", ["step", "roll"])
+def test_the_posture_and_limb_soil_twins_step_the_soft_patch_natively_bit_for_bit(fmus, identified, results_root,
+                                                                                  run_):
+    """The soft patch, 1.2 s (12 updates of the slow loops; with step-over the front-left limb
+    lifts from 0.1 s, up 0.25 m from 0.6 s): the posture block's and the limb soil block's C twins step natively (the
+    posture twin calls back into the block's update every 0.1 s) and the run gives the Python-stepped
+    run's trajectories to the bit, and the same posture report."""
+    import dataclasses
+
+    from rover_cosim.jobs import legwheel
+    from rover_cosim.orchestrator import native
+    from rover_cosim.orchestrator.master import run
+
+    if native.unavailable_reason() is not None:
+        pytest.skip(str(native.unavailable_reason()))
+    model = results_root / "identification" / "model.json"
+    fmu_dir = fmus["LegWheelRover"].parent
+    tables, reports = {}, {}
+    for stepped_natively in (False, True):
+        system = dataclasses.replace(legwheel.patch_system(fmu_dir, model, run_), stop_time=1.2,
+                                     native=stepped_natively)
+        if stepped_natively:
+            blocks: dict[str, Any] = {entry.name: entry.block for entry in system.blocks}
+            assert blocks["posture"].native() is not None and blocks["soil"].native() is not None
+        tables[stepped_natively] = run(system).data
+        reports[stepped_natively] = legwheel._posture_report(system)
+    pd.testing.assert_frame_equal(tables[True], tables[False], check_exact=True)
+    assert reports[True] == reports[False]
+    assert reports[True]["updates"] == 12
+    assert (reports[True]["lift_m"][0] > 0.2) == (run_ == "step")  # the front-left hub up in the air
+
+
+def test_a_failing_posture_update_in_the_c_twin_fails_the_run_naming_the_block_and_the_error(
+        fmus, identified, results_root, monkeypatch):
+    import dataclasses
+
+    from rover_cosim.jobs import legwheel
+    from rover_cosim.orchestrator import native
+    from rover_cosim.orchestrator.master import RunError, run
+
+    if native.unavailable_reason() is not None:
+        pytest.skip(str(native.unavailable_reason()))
+
+    def broken(self, t, u):
+        raise ArithmeticError("the loads are gone")
+
+    monkeypatch.setattr(PostureController, "_update", broken)
+    model = results_root / "identification" / "model.json"
+    system = dataclasses.replace(legwheel.slope_system(fmus["LegWheelRover"].parent, model, "posture"), stop_time=0.5)
+    with pytest.raises(RunError, match=r"posture \(block\).*the posture update at t = 0.1 s failed: "
+                                       r"ArithmeticError: the loads are gone"):
+        run(system)
 
 
 def test_posture_settings_out_of_range_are_refused_with_their_value():

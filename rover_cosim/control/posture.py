@@ -59,22 +59,35 @@ Every command moves at a bounded rate (``rate_*``), so a posture is reached smoo
 the run starts, and the set-points move linearly from one update's joints to the next over the
 period (a first-order hold: a step of a few millimetres at a hub would load a stiff limb with
 hundreds of newtons at once). Without ``control`` the block holds the posture it was made with (the paper's by
-default) and only steers. The block runs every step in Python (its inverse kinematics only every
-``period``); it has no C twin: at 10 Hz its cost is the inverse kinematics (about 15 ms an
-update), not the step.
+default) and only steers.
+
+What runs every step (the hold, the steering, the torques through) has a C twin
+(``posture_block.c``) for the native stepper, bit for bit the block's; the slow loops stay
+Python's: every ``period`` the twin calls back into the block's update (the inverse kinematics,
+about 15 ms an update at 10 Hz), which leaves the block's state (its report, its history) as a
+run stepped in Python would.
 """
 
 from __future__ import annotations
 
+import ctypes
 import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from rover_cosim.limbs import JOINTS, LimbGeometry, Unreachable, athlete_limbs, stance_inverse
+from rover_cosim.orchestrator import native as native_code
+from rover_cosim.orchestrator.native import doubles
+
+#: The block's C twin (what runs every step; the slow loops call back into Python), for the native stepper.
+C_SOURCE = Path(__file__).with_name("posture_block.c")
+#: posture_block.c's PostureUpdate: (now [s], the inputs) -> 0 on success.
+_UPDATE = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.POINTER(ctypes.c_double))
 
 #: The joints' variable names in the leg-wheel FMUs, in a limb's joint order.
 JOINT_INPUTS = ("hipYaw", "hipPitch", "kneePitch", "anklePitch", "ankleSteer", "ankleRoll")
@@ -354,14 +367,65 @@ class PostureController:
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
         self.loops = self._initial()
         self.loops.next_update = t0 + self.period
-        return self._outputs(u0, t0)
+        self._last = (np.array(u0, float), self._outputs(u0, t0))
+        return self._last[1]
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         now = t + h
         if self.control and now >= self.loops.next_update - 1e-12:
             self._update(now, u)
             self.loops.next_update += self.period
-        return self._outputs(u, now)
+        outputs = self._outputs(u, now)
+        self._last = (u, outputs)
+        return outputs
+
+    def native(self) -> native_code.NativeBlock | None:
+        """The block's C twin (posture_block.c) from its state now, for the native stepper; None
+        where it cannot be compiled (the block then steps in Python). The twin calls back into this
+        block's update every ``period``, so that the block's state follows the run."""
+        library = native_code.load_library(C_SOURCE)
+        if isinstance(library, str):
+            return None
+        n, n_inputs = len(self.limbs), len(self.inputs)
+        shared = np.zeros(2 * n * JOINTS + 6)
+        self._share(shared)
+        made: list[int] = []
+
+        def update(now: float, inputs: Any) -> int:
+            try:
+                u = np.ctypeslib.as_array(inputs, shape=(n_inputs,)).copy()
+                self._update(now, u)
+                self.loops.next_update += self.period
+                self._share(shared)
+                return 0
+            except BaseException as error:  # noqa: BLE001 - reported through the twin's message
+                text = f"the posture update at t = {now:.6g} s failed: {type(error).__name__}: {error}"
+                library.posture_fail(made[0], text.encode(errors="replace"))
+                return 1
+
+        callback = _UPDATE(update)
+        pointer = ctypes.c_void_p
+        library.posture_new.restype = pointer
+        library.posture_new.argtypes = [ctypes.c_int] * 3 + [ctypes.c_double] * 2 + [pointer, _UPDATE, pointer,
+                                                                                      pointer]
+        library.posture_fail.argtypes = [pointer, ctypes.c_char_p]
+        inputs, outputs = getattr(self, "_last", (np.zeros(n_inputs), np.zeros(len(self.outputs))))
+        component = library.posture_new(n, int(self.step_over is not None), int(self.control), self.period,
+                                        self.loops.next_update, shared.ctypes.data, callback, doubles(inputs),
+                                        doubles(outputs))
+        if not component:
+            raise MemoryError(f"block {self.name!r}: its C twin could not be made (out of memory)")
+        made.append(component)
+        return native_code.NativeBlock(library, component, "posture", keep=(shared, callback))
+
+    def _share(self, shared: np.ndarray) -> None:
+        """The state the C twin reads (posture_block.c): the joints of the update before and of the
+        last one (a row per limb), the commands and the lifted limb (-1: none)."""
+        loops, size = self.loops, self.loops.joints.size
+        shared[:size] = loops.previous.reshape(-1)
+        shared[size:2 * size] = loops.joints.reshape(-1)
+        shared[2 * size:2 * size + 5] = (loops.height, loops.shift[0], loops.shift[1], loops.roll, loops.pitch)
+        shared[2 * size + 5] = loops.step.limb if loops.step is not None else -1
 
     def get_state(self) -> _Loops:
         loops = self.loops

@@ -157,7 +157,7 @@ class LimbSoilBlock:
     """Orchestrator block: the soil under each wheel of a rover whose hubs move on its body (the
     leg-wheel rover): ``SoilBlock``'s shares, the hubs where the rover says they are. Inputs: x, y,
     yaw of the body, hubX[i], hubY[i] [m] (body frame; pitch and roll neglected as ``SoilBlock``
-    does). Outputs: soilShare[i] [1]. Python only (no C twin)."""
+    does). Outputs: soilShare[i] [1]. A C twin (soil_block.c) for six hubs."""
 
     def __init__(self, name: str, soil_map: SoilMap, hubs: int = 6):
         if not isinstance(soil_map, SoilMap):
@@ -178,7 +178,27 @@ class LimbSoilBlock:
                                    np.asarray(u[3 + n:3 + 2 * n], float))
 
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
-        return self.shares(u0)
+        self.last = (np.array(u0, float), self.shares(u0))
+        return self.last[1]
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         return self.shares(u)
+
+    def native(self) -> native_code.NativeBlock | None:
+        """The block's C twin (soil_block.c: the same shares, bit for bit) with its hubs and outputs
+        at the start, for the native stepper; None for other than six hubs or where it cannot be
+        compiled (the block then steps in Python)."""
+        if self.hubs != TWIN_HUBS:
+            return None
+        library = native_code.load_library(SOIL_C_SOURCE)
+        if isinstance(library, str):
+            return None
+        library.soil_new_limbs.restype = ctypes.c_void_p
+        library.soil_new_limbs.argtypes = [ctypes.c_int] * 2 + [ctypes.c_void_p] * 5
+        inputs, shares = getattr(self, "last", (np.zeros(len(self.inputs)), np.zeros(self.hubs)))
+        grid = self.map.grid
+        component = library.soil_new_limbs(grid.x.size, grid.y.size, doubles(grid.x), doubles(grid.y),
+                                           doubles(grid.heights), doubles(inputs[3:]), doubles(shares))
+        if not component:
+            raise MemoryError(f"block {self.name!r}: its C twin could not be made (bad sizes or out of memory)")
+        return native_code.NativeBlock(library, component, "soil")

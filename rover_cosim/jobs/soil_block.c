@@ -1,26 +1,29 @@
-/* The C twin of the soil participant (ground.py: SoilBlock) for the native stepper
+/* The C twin of the soil participants (ground.py: SoilBlock, LimbSoilBlock) for the native stepper
  * (rover_cosim.orchestrator.native): the law of ../terramechanics/soil_map.h, so that it gives the
  * Python block's outputs bit for bit (checked by the tests).
  *
- * Inputs (value references 0 ..): x, y [m], yaw [rad] of the body. Outputs: soilShare[1..6] [1].
- * The functions follow fmi2SetReal, fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the
- * error's text from soil_message). */
+ * Inputs (value references 0 ..): x, y [m], yaw [rad] of the body; a LimbSoilBlock's (soil_new_limbs)
+ * also hubX[1..6], hubY[1..6] [m] (the hubs in the body frame, where the rover says they are).
+ * Outputs: soilShare[1..6] [1]. The functions follow fmi2SetReal, fmi2GetReal and fmi2DoStep
+ * (status 0 ok, 3 error; the error's text from soil_message). */
 #include "block_io.h"
 #include "../terramechanics/soil_map.h"
 
 #define HUBS 6
-#define N_INPUTS 3
+#define BODY_INPUTS 3
 
 typedef struct {
     SoilGrid grid;
+    int limbs;                          /* the hubs are inputs (LimbSoilBlock), not x_hub, y_hub */
     double x_hub[HUBS], y_hub[HUBS];
-    double in[N_INPUTS], out[HUBS];
+    double in[BODY_INPUTS + 2 * HUBS], out[HUBS];
     char message[128];
 } SoilBlock;
 
 int soil_set_real(void *component, const unsigned int *vr, size_t n, const double *value) {
     SoilBlock *c = component;
-    return block_set(c->in, N_INPUTS, c->message, sizeof c->message, vr, n, value);
+    return block_set(c->in, c->limbs ? BODY_INPUTS + 2 * HUBS : BODY_INPUTS, c->message, sizeof c->message, vr, n,
+                     value);
 }
 
 int soil_get_real(void *component, const unsigned int *vr, size_t n, double *value) {
@@ -34,7 +37,9 @@ int soil_do_step(void *component, double t, double h, int no_prior_state) {
     (void)t;
     (void)h;
     (void)no_prior_state;
-    soil_shares(&c->grid, c->in[0], c->in[1], c->in[2], c->x_hub, c->y_hub, HUBS, c->out);
+    const double *x_hub = c->limbs ? c->in + BODY_INPUTS : c->x_hub;
+    const double *y_hub = c->limbs ? c->in + BODY_INPUTS + HUBS : c->y_hub;
+    soil_shares(&c->grid, c->in[0], c->in[1], c->in[2], x_hub, y_hub, HUBS, c->out);
     return OK;
 }
 
@@ -64,5 +69,15 @@ void *soil_new(int nx, int ny, const double *x, const double *y, const double *s
         c->y_hub[k] = hubs[HUBS + k];
         c->out[k] = start[k];
     }
+    return c;
+}
+
+/* A LimbSoilBlock's twin: as soil_new, the hubs inputs (``hubs``: their values now, x[6] then y[6] [m]). */
+void *soil_new_limbs(int nx, int ny, const double *x, const double *y, const double *share, const double *hubs,
+                     const double *start) {
+    SoilBlock *c = soil_new(nx, ny, x, y, share, hubs, start);
+    if (!c) return NULL;
+    c->limbs = 1;
+    for (int k = 0; k < 2 * HUBS; k++) c->in[BODY_INPUTS + k] = hubs[k];
     return c;
 }
