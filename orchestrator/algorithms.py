@@ -8,8 +8,9 @@ is the executors' business (``executors``); ``execution`` puts the two together.
   before it (a stage each; with threads, FMUs in a row of the order that read none of each
   other's outputs form one stage: the same values as one after the other);
 - :class:`GaussSeidelInterpolated`: Gauss-Seidel where an FMU that can interpolate its inputs gets
-  those from participants before it as the line from their value at ``t`` to the one at ``t + h``
-  (fmi2SetRealInputDerivatives) instead of the value at ``t + h`` held over the step;
+  those from participants before it (FMUs, and blocks' declared ``ramped_outputs``) as the line
+  from their value at ``t`` to the one at ``t + h`` (fmi2SetRealInputDerivatives) instead of the
+  value at ``t + h`` held over the step;
 - :class:`Iterative`: each step repeated from the participants' saved states until the exchanged
   values converge.
 
@@ -26,6 +27,7 @@ from typing import Protocol
 import numpy as np
 
 from .model import Iteration
+from .native import NativeStepper
 from .participants import BlockParticipant, Participant, RunError
 
 
@@ -40,6 +42,10 @@ class Stepping(Protocol):
     step_seconds: dict[str, float]
     slot_names: list[str]                 # "instance.variable" of each slot of the value vector
     output_names: dict[str, list[str]]    # per participant, its outputs in the order of its slots
+    natively: frozenset[int]              # the participants the native stepper steps
+
+    @property
+    def stepper(self) -> NativeStepper | None: ...
 
     def run_stage(self, stage: Sequence[int], values: np.ndarray, t: float, h: float) -> None: ...
 
@@ -78,11 +84,6 @@ class Algorithm:
 
     def prepare(self, execution: Stepping) -> None:
         """Called once the execution is set up (before the first step)."""
-
-    def stepped_in_python(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
-                          outputs: Sequence[np.ndarray]) -> frozenset[int]:
-        """Participants this algorithm steps itself, in Python, whatever the native stepper could do."""
-        return frozenset()
 
     def step(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         """Advance every participant from ``t`` to ``t + h``; ``values`` then holds the outputs at ``t + h``."""
@@ -123,46 +124,59 @@ class GaussSeidelInterpolated(Algorithm):
     source did over the step, fmi2SetRealInputDerivatives), not the value at ``t + h`` held over
     the whole step: a wheel fed the hub's speed of an accelerating body sees it rise through the
     step, as in the monolithic model, not half a step ahead. A block's outputs are held (a
-    controller's output is a sample and hold); inputs from participants after it (the values at
-    ``t``), discrete inputs and every input of a block or of an FMU that cannot interpolate are as
-    in Gauss-Seidel. The FMUs with ramped inputs step in Python (the native stepper sets no input
-    derivatives); the others, and blocks with a C twin, natively as under Gauss-Seidel."""
+    controller's output is a sample and hold), except those it declares ``ramped_outputs`` (a
+    first-order hold of its own: a set-point moving linearly between updates), which are ramped
+    as an FMU's. Inputs from participants after it (the values at ``t``), discrete inputs and
+    every input of a block or of an FMU that cannot interpolate are as in Gauss-Seidel. The
+    native stepper ramps as the Python master does (the same calls, the same results); an FMU it
+    cannot step (other than FMI 2.0 Co-Simulation exchanging Reals) steps in Python."""
 
     name = "gauss-seidel-interpolated"
 
     def __init__(self) -> None:
         self.ramped: list[np.ndarray] = []  # per participant, which of its inputs ramp (bool per input)
+        self._marks: object | None = None   # the native stepper whose ramped units need the step's start values
 
     def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
                outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
         last = sources(participants, inputs)
         return [[i] for i in range(len(participants)) if i not in last] + [[i] for i in last]
 
-    def stepped_in_python(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
-                          outputs: Sequence[np.ndarray]) -> frozenset[int]:
+    def _ramps(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
+               outputs: Sequence[np.ndarray]) -> list[np.ndarray]:
+        """Per participant, which of its inputs ramp."""
         last = sources(participants, inputs)
-        self.ramped = [np.zeros(len(slots), bool) for slots in inputs]
+        ramped = [np.zeros(len(slots), bool) for slots in inputs]
         moved: list[np.ndarray] = []
         for [i] in self.stages(participants, inputs, outputs, 1):
             participant = participants[i]
             if getattr(participant, "can_interpolate", False) and moved and i not in last:
                 discrete = getattr(participant, "discrete_inputs", np.zeros(len(inputs[i]), dtype=bool))
-                self.ramped[i] = np.isin(inputs[i], np.concatenate(moved)) & ~discrete
+                ramped[i] = np.isin(inputs[i], np.concatenate(moved)) & ~discrete
             if not isinstance(participant, BlockParticipant):
                 moved.append(np.asarray(outputs[i]))
-        return frozenset(i for i, ramped in enumerate(self.ramped) if ramped.any())
+            else:
+                declared = set(getattr(participant.block, "ramped_outputs", ()))
+                moved.append(np.asarray(outputs[i])[[name in declared for name in participant.outputs]])
+        return ramped
 
     def prepare(self, execution: Stepping) -> None:
-        # (again where the execution asked already: the same answer; it does not ask without a stepper)
-        self.stepped_in_python(execution.participants, execution.inputs, execution.outputs)
+        self.ramped = self._ramps(execution.participants, execution.inputs, execution.outputs)
+        stepper, self._marks = execution.stepper, None
+        for i, ramped in enumerate(self.ramped):
+            if stepper is not None and i in execution.natively and ramped.any():
+                stepper.ramp(i, ramped)
+                self._marks = stepper
 
     def step(self, execution: Stepping, values: np.ndarray, t: float, h: float) -> None:
         clock = time.perf_counter
         start = values.copy()
+        if self._marks is not None:
+            self._marks.mark(values)  # type: ignore[attr-defined]
         for stage in execution.stages:
             i = stage[0]
             ramped = self.ramped[i]
-            if not ramped.any():
+            if not ramped.any() or i in execution.natively:
                 execution.run_stage(stage, values, t, h)
                 continue
             participant, slots = execution.participants[i], execution.inputs[i]

@@ -12,7 +12,10 @@ The interface is small and mirrors an FMU slave at a fixed communication step:
   participants under Gauss-Seidel) and return the outputs at ``t + h``.
 
 Optional: ``feedthrough`` (bool; default True for a block with inputs: its outputs depend on
-its inputs at the same instant, which the algebraic-loop check follows); ``get_state() -> state``
+its inputs at the same instant, which the algebraic-loop check follows); ``ramped_outputs``
+(names): outputs that move linearly over each step from their value at ``t`` to the one at
+``t + h`` (a first-order hold, not a sample and hold), which ``gauss-seidel-interpolated`` gives
+an FMU after the block that can interpolate its inputs as that line; ``get_state() -> state``
 and ``set_state(state)`` for the iterative master, which repeats a step (without them the
 master keeps a deep copy of the block's attributes); ``native() -> native.NativeBlock | None``:
 the block's C twin, made from its state after ``start``, which the Jacobi and Gauss-Seidel masters

@@ -546,6 +546,10 @@ class SystemBuilder:
             if kind_of not in VARIABLE_TYPES or kind_of == "String":
                 raise self.error(where, f"types {variable} = {kind_of!r}: expected a number or Boolean type "
                                  f"({', '.join(k for k in VARIABLE_TYPES if k != 'String')})")
+        unknown = [v for v in getattr(block, "ramped_outputs", ()) if v not in block.outputs]
+        if unknown:
+            raise self.error(where, f"ramped_outputs {unknown}: not outputs of the block (outputs "
+                             f"{list(block.outputs)})")
         if kind is None:
             kind = next((k for k, cls in BLOCK_TYPES.items() if type(block) is cls), "python")
         self._blocks[name] = BlockEntry(name, kind, block, keys)

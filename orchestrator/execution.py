@@ -81,11 +81,10 @@ class Execution:
         (Jacobi: the participants of its one stage that can), when the stepper is available."""
         if native.unavailable_reason() is not None:
             return None
-        own = self.algorithm.stepped_in_python(self.participants, self.inputs, self.outputs)
         if self.algorithm.gathers_first:
-            chosen = [[i for i in g if i not in own and self._steppable(i)] for g in self.stages]
+            chosen = [[i for i in g if self._steppable(i)] for g in self.stages]
         else:
-            chosen = [g for g in self.stages if all(i not in own and self._steppable(i) for i in g)]
+            chosen = [g for g in self.stages if all(self._steppable(i) for i in g)]
         chosen = [g for g in chosen if g]
         if not any(not isinstance(self.participants[i], BlockParticipant) for g in chosen for i in g):
             return None  # blocks alone: nothing to gain

@@ -387,7 +387,8 @@ class FmuParticipant:
         dll = self.fmu.dll
         return NativeCalls(self.fmu.component, function_address(dll, "fmi2SetReal"),
                            function_address(dll, "fmi2GetReal"), function_address(dll, "fmi2DoStep"),
-                           self.input_references, self.output_references)
+                           self.input_references, self.output_references,
+                           function_address(dll, "fmi2SetRealInputDerivatives") if self.can_interpolate else 0)
 
     @property
     def input_references(self) -> list[int]:

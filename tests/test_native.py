@@ -39,7 +39,7 @@ def rover(blocks: bool = True, **simulation: object) -> dict:
 
 
 @pytest.mark.parametrize("blocks", [True, False], ids=["with a block", "FMUs only"])
-@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
+@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi", "gauss-seidel-interpolated"])
 @pytest.mark.parametrize("threads", [1, 2])
 def test_native_stepping_gives_the_python_masters_results_exactly(fmu_dir, fmus, algorithm, threads, blocks):
     python = run(system_from_dict(rover(blocks, algorithm=algorithm, native=False, threads=1), name="p",

@@ -37,7 +37,7 @@ import numpy as np
 
 SOURCE = Path(__file__).with_name("stepper.c")
 #: What a failed unit's call was (stepper.c).
-CALLS = {1: "fmi2SetReal", 2: "fmi2DoStep", 3: "fmi2GetReal", 4: "finite outputs"}
+CALLS = {1: "fmi2SetReal", 2: "fmi2DoStep", 3: "fmi2GetReal", 4: "finite outputs", 5: "fmi2SetRealInputDerivatives"}
 NOT_FINITE = 4
 
 
@@ -76,6 +76,10 @@ def _declare(library: ctypes.CDLL) -> ctypes.CDLL:
     library.stepper_group.argtypes = [pointer, pointer, integer, real, real]
     library.stepper_run.restype = integer
     library.stepper_run.argtypes = [pointer, pointer, pointer, integer, integer, pointer, integer, pointer, pointer]
+    library.stepper_ramp.restype = integer
+    library.stepper_ramp.argtypes = [pointer, integer, pointer, pointer]
+    library.stepper_mark.restype = None
+    library.stepper_mark.argtypes = [pointer, pointer]
     for name, restype in (("stepper_failed_call", integer), ("stepper_status", integer),
                           ("stepper_seconds", real)):
         getattr(library, name).restype = restype
@@ -153,7 +157,8 @@ def load_library(source: Path, symbols: tuple[str, ...] = ()) -> ctypes.CDLL | s
 def _library() -> ctypes.CDLL | str:
     """The loaded stepper library, or why there is none."""
     library = load_library(SOURCE, ("stepper_new", "stepper_step", "stepper_group", "stepper_run",
-                                     "stepper_failed_call", "stepper_status", "stepper_seconds", "stepper_free"))
+                                     "stepper_failed_call", "stepper_status", "stepper_seconds", "stepper_free",
+                                     "stepper_ramp", "stepper_mark"))
     if isinstance(library, str):
         return f"native stepper unavailable ({library}); the masters step FMUs from Python"
     return _declare(library)
@@ -181,6 +186,8 @@ class NativeCalls:
     do_step: int
     input_references: list[int]
     output_references: list[int]
+    #: shaped like fmi2SetRealInputDerivatives (0: none; a unit that ramps inputs needs it)
+    set_derivatives: int = 0
 
 
 def doubles(values: object) -> ctypes.Array:
@@ -246,6 +253,7 @@ class NativeStepper:
             return array(kind, [int(v) for values in per_unit for v in values])
 
         calls: list[NativeCalls] = [unit.native_calls() for unit in self.units]
+        self._calls = calls
         self._handle = library.stepper_new(
             len(self.units), array(ctypes.c_void_p, [c.component for c in calls]),
             array(ctypes.c_void_p, [c.set_real for c in calls]),
@@ -263,6 +271,22 @@ class NativeStepper:
             raise MemoryError("native stepper: out of memory or no threads")
         self._keep = keep
         self._reached = ctypes.c_int(0)
+
+    def ramp(self, index: int, ramped: np.ndarray) -> None:
+        """Unit ``index`` (a position in the master's participants) takes the inputs flagged in
+        ``ramped`` as ramps (gauss-seidel-interpolated): their values at the step's start, the
+        slopes to their values when it steps by fmi2SetRealInputDerivatives."""
+        position = self.position[index]
+        address = self._calls[position].set_derivatives
+        if not address:
+            raise ValueError(f"{self.units[position].name}: no fmi2SetRealInputDerivatives to ramp its inputs with")
+        flags = (ctypes.c_int * max(1, len(ramped)))(*[int(bool(v)) for v in ramped])
+        if self.library.stepper_ramp(self._handle, position, address, flags) != 0:
+            raise MemoryError("native stepper: out of memory")
+
+    def mark(self, values: np.ndarray) -> None:
+        """The ramped inputs' values at the step's start (before a step made group by group)."""
+        self.library.stepper_mark(self._handle, _pointer(values))
 
     def step_group(self, values: np.ndarray, index: int, t: float, h: float) -> int:
         """Step the group holding unit ``index`` (a position in the master's participants)."""

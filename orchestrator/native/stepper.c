@@ -8,6 +8,11 @@
  * stepper's threads (the six wheels after the body); the calls each FMU sees, and so the results,
  * are those of the Python master, in the same order per FMU.
  *
+ * Ramps (the interpolated Gauss-Seidel master): a unit may take some of its inputs as the line
+ * from their value at the step's start to the value they hold when it steps (another participant
+ * before it moved them to t + h): it is set the start values, and fmi2SetRealInputDerivatives the
+ * line's slopes (0 for its other inputs), as the Python master does (stepper_ramp).
+ *
  * Errors: a call that returns more than fmi2Warning stops the stepping; the unit, the call and
  * the status are left for the caller (which reports it with the FMU's logged message). */
 #include <math.h>
@@ -21,6 +26,7 @@ typedef unsigned int ValueReference;
 typedef int (*SetRealFunction)(Component, const ValueReference *, size_t, const double *);
 typedef int (*GetRealFunction)(Component, const ValueReference *, size_t, double *);
 typedef int (*DoStepFunction)(Component, double, double, int);
+typedef int (*SetDerivativesFunction)(Component, const ValueReference *, size_t, const int *, const double *);
 
 /* Hand-offs between the threads spin this long before sleeping on a condition variable: waking
  * a sleeping thread costs tens of microseconds on a virtual machine, a step of six wheels on two
@@ -35,7 +41,7 @@ static void relax(void) {
 #endif
 }
 
-enum { CALL_SET_REAL = 1, CALL_DO_STEP = 2, CALL_GET_REAL = 3, CALL_NOT_FINITE = 4 };
+enum { CALL_SET_REAL = 1, CALL_DO_STEP = 2, CALL_GET_REAL = 3, CALL_NOT_FINITE = 4, CALL_SET_DERIVATIVES = 5 };
 #define WARNING 1
 
 typedef struct {
@@ -47,6 +53,11 @@ typedef struct {
     const ValueReference *in_vr, *out_vr;
     const long long *in_slot, *out_slot;
     double *in, *out;   /* gathered inputs, outputs read */
+    /* ramps (stepper_ramp): which inputs ramp (NULL: none), their values at the step's start, the
+     * slopes of all inputs [1/s] and their orders (1) for fmi2SetRealInputDerivatives */
+    SetDerivativesFunction set_derivatives;
+    int *ramped, *orders;
+    double *start, *slope;
     double seconds;     /* time inside this unit's FMI calls */
     double last;        /* ... in its last step, to order the next one */
     int failed_call, status;
@@ -81,8 +92,27 @@ static double now(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void gather(Unit *u, const double *values) {
-    for (int i = 0; i < u->n_in; i++) u->in[i] = values[u->in_slot[i]];
+/* The inputs now; a ramped input its value at the step's start, its slope to the value now over h. */
+static void gather(Unit *u, const double *values, double h) {
+    if (!u->ramped) {
+        for (int i = 0; i < u->n_in; i++) u->in[i] = values[u->in_slot[i]];
+        return;
+    }
+    for (int i = 0; i < u->n_in; i++) {
+        double value = values[u->in_slot[i]];
+        u->in[i] = u->ramped[i] ? u->start[i] : value;
+        u->slope[i] = u->ramped[i] ? (value - u->start[i]) / h : 0.0;
+    }
+}
+
+/* The ramped inputs' values at the step's start (before any unit steps). */
+static void mark_start(Stepper *s, const double *values) {
+    for (int k = 0; k < s->n_units; k++) {
+        Unit *u = &s->units[k];
+        if (!u->ramped) continue;
+        for (int i = 0; i < u->n_in; i++)
+            if (u->ramped[i]) u->start[i] = values[u->in_slot[i]];
+    }
 }
 
 static void scatter(const Unit *u, double *values) {
@@ -96,6 +126,9 @@ static void advance(Unit *u, double t, double h) {
     u->failed_call = 0;
     if (u->n_in && (status = u->set_real(u->component, u->in_vr, (size_t)u->n_in, u->in)) > WARNING)
         u->failed_call = CALL_SET_REAL;
+    else if (u->ramped &&
+             (status = u->set_derivatives(u->component, u->in_vr, (size_t)u->n_in, u->orders, u->slope)) > WARNING)
+        u->failed_call = CALL_SET_DERIVATIVES;
     else if ((status = u->do_step(u->component, t, h, 1)) > WARNING)
         u->failed_call = CALL_DO_STEP;
     else if (u->n_out && (status = u->get_real(u->component, u->out_vr, (size_t)u->n_out, u->out)) > WARNING)
@@ -203,10 +236,11 @@ static int first_failure(const Stepper *s, double *values, int begin, int end) {
     return -1;
 }
 
-/* Group g: gather, step (in parallel), scatter. Returns -1, or the unit that failed. */
+/* Group g: gather, step (in parallel), scatter. Returns -1, or the unit that failed. (Ramps: the
+ * step's start values marked first, by stepper_mark.) */
 int stepper_group(Stepper *s, double *values, int g, double t, double h) {
     int begin = s->group_start[g], end = s->group_start[g + 1];
-    for (int i = begin; i < end; i++) gather(&s->units[i], values);
+    for (int i = begin; i < end; i++) gather(&s->units[i], values, h);
     advance_units(s, begin, end, t, h);
     int failed = first_failure(s, values, begin, end);
     if (failed >= 0) return failed;
@@ -219,13 +253,14 @@ int stepper_group(Stepper *s, double *values, int g, double t, double h) {
  * the outputs of the groups before it. Returns -1, or the index of the unit that failed. */
 int stepper_step(Stepper *s, double *values, double t, double h) {
     if (s->jacobi) {
-        for (int i = 0; i < s->n_units; i++) gather(&s->units[i], values);
+        for (int i = 0; i < s->n_units; i++) gather(&s->units[i], values, h);
         advance_units(s, 0, s->n_units, t, h);
         int failed = first_failure(s, values, 0, s->n_units);
         if (failed >= 0) return failed;
         for (int i = 0; i < s->n_units; i++) scatter(&s->units[i], values);
         return -1;
     }
+    mark_start(s, values);
     for (int g = 0; g < s->n_groups; g++) {
         int failed = stepper_group(s, values, g, t, h);
         if (failed >= 0) return failed;
@@ -247,6 +282,28 @@ int stepper_run(Stepper *s, double *values, const double *times, int first, int 
     }
     *reached = last;
     return -1;
+}
+
+/* The values at the step's start of the ramped inputs, for a step made group by group (stepper_group). */
+void stepper_mark(Stepper *s, const double *values) { mark_start(s, values); }
+
+/* Unit ``unit`` ramps the inputs flagged in ``ramped`` (one per input, copied) with
+ * ``set_derivatives`` (fmi2SetRealInputDerivatives). 0 on success, -1 when out of memory. */
+int stepper_ramp(Stepper *s, int unit, void *set_derivatives, const int *ramped) {
+    Unit *u = &s->units[unit];
+    size_t n = (size_t)(u->n_in ? u->n_in : 1);
+    u->ramped = calloc(n, sizeof *u->ramped);
+    u->orders = calloc(n, sizeof *u->orders);
+    u->start = calloc(n, sizeof *u->start);
+    u->slope = calloc(n, sizeof *u->slope);
+    if (!u->ramped || !u->orders || !u->start || !u->slope) {
+        free(u->ramped); free(u->orders); free(u->start); free(u->slope);
+        u->ramped = u->orders = NULL; u->start = u->slope = NULL;
+        return -1;
+    }
+    for (int i = 0; i < u->n_in; i++) { u->ramped[i] = ramped[i] != 0; u->orders[i] = 1; }
+    u->set_derivatives = (SetDerivativesFunction)set_derivatives;
+    return 0;
 }
 
 int stepper_failed_call(const Stepper *s, int unit) { return s->units[unit].failed_call; }
@@ -312,7 +369,10 @@ void stepper_free(Stepper *s) {
         for (int k = 0; k < s->threads - 1; k++) pthread_join(s->helpers[k].thread, NULL);
         free(s->helpers);
     }
-    for (int i = 0; i < s->n_units; i++) { free(s->units[i].in); free(s->units[i].out); }
+    for (int i = 0; i < s->n_units; i++) {
+        Unit *u = &s->units[i];
+        free(u->in); free(u->out); free(u->ramped); free(u->orders); free(u->start); free(u->slope);
+    }
     free(s->units);
     free(s->order);
     pthread_mutex_destroy(&s->lock);

@@ -58,8 +58,11 @@ block holds the last posture the limbs reach (``report()["held_unreachable_s"]``
 Every command moves at a bounded rate (``rate_*``), so a posture is reached smoothly from where
 the run starts, and the set-points move linearly from one update's joints to the next over the
 period (a first-order hold: a step of a few millimetres at a hub would load a stiff limb with
-hundreds of newtons at once). Without ``control`` the block holds the posture it was made with (the paper's by
-default) and only steers.
+hundreds of newtons at once); the block declares them ``ramped_outputs``, so that under
+``gauss-seidel-interpolated`` the FMU takes each step's set-points as the line they move on, not
+held at the step's end value (a joint servo fed a staircase of 1 ms steps makes the FMU's
+integrator reject and re-linearise: on the soft patch 2.5x the FMU's time). Without ``control``
+the block holds the posture it was made with (the paper's by default) and only steers.
 
 What runs every step (the hold, the steering, the torques through) has a C twin
 (``posture_block.c``) for the native stepper, bit for bit the block's; the slow loops stay
@@ -245,6 +248,8 @@ class PostureController:
                       **{f"sinkage[{i}]": "m" for i in range(1, n + 1)},
                       **{f"{name}[{i}]": "N.m" for name in ("tau_cmd", "tau") for i in range(1, n + 1)}}
         self.units = {k: v for k, v in self.units.items() if k in self.inputs or k in self.outputs}
+        #: the set-points move linearly over each step (gauss-seidel-interpolated ramps them in the FMU)
+        self.ramped_outputs = self.outputs[:JOINTS * n]
         self.feedthrough = True
         self.loops = self._initial()
 

@@ -237,7 +237,7 @@ def _plane_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choi
         raise ValueError(f"run {run_!r}: expected one of {', '.join(RUNS)}")
     choice = as_choice(choice)
     builder = SystemBuilder(title).simulation(
-        stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
+        stop_time=stop_time(length, speed), step=STEP, algorithm=RAMPED, allow_algebraic_loops=True)
     radius = choice.wheel.r
     start = {"v": speed, "height0": settled_height(choice), **{f"omega[{i}]": speed / radius for i in range(1, 7)}}
     _add_leg_wheel_rover(builder, fmu_dir, choice, start)
@@ -247,6 +247,10 @@ def _plane_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choi
     _add_path_and_posture(builder, model, choice, length, speed, posture, terrain)
     return builder.simulation(order=["ctrl", "posture", "rover"]).build()
 
+
+#: The master of the runs under the posture block: its set-points reach the FMU as the ramps they
+#: are over each step (``PostureController.ramped_outputs``), not held at their end values.
+RAMPED = "gauss-seidel-interpolated"
 
 #: The soft patch: a drift of loose dust ours (the paper's soil with its pressure-sinkage moduli a
 #: tenth, its cohesion a quarter and a 30 deg friction angle: the wheel sinks about 115 mm at
@@ -278,7 +282,7 @@ def patch_system(fmu_dir: Path, model: ModelSet | Path, run_: str, choice: Choic
     speed, length = float(PATCH["speed"]), float(PATCH["length"])  # type: ignore[arg-type]
     soil_map = soil_patch(PATCH["centre"], float(PATCH["radius"]), choice.soil, soft_soil(choice.soil))  # type: ignore[arg-type]
     builder = SystemBuilder(f"leg-wheel rover, a wheel in a soft patch ({run_})").simulation(
-        stop_time=stop_time(length, speed), step=STEP, algorithm="gauss-seidel", allow_algebraic_loops=True)
+        stop_time=stop_time(length, speed), step=STEP, algorithm=RAMPED, allow_algebraic_loops=True)
     _add_leg_wheel_rover(builder, fmu_dir, choice, {"height0": settled_height(choice)})
     builder.set_parameters("rover", soil_parameters(soil_map.soil_b, "soilB"))
     posture = PostureController("posture", control=True, step_over=StepOver() if run_ == "step" else None)
