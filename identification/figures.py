@@ -23,9 +23,11 @@ def finish(axes, legend: bool = True) -> None:  # noqa: ANN001 - matplotlib Axes
         ax.grid(alpha=0.3)
 
 
-def png_bytes(fig) -> bytes:
-    """The figure as PNG (110 dpi, or the --dpi asked for), with the other --figures formats attached."""
-    fig.tight_layout()
+def png_bytes(fig, tight: bool = True) -> bytes:
+    """The figure as PNG (110 dpi, or the --dpi asked for), with the other --figures formats attached;
+    ``tight``: laid out by matplotlib's tight layout first (a figure laid out by hand skips its cost)."""
+    if tight:
+        fig.tight_layout()
     rendered = render(fig, 110)
     plt.close(fig)
     return rendered

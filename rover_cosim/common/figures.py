@@ -10,10 +10,14 @@ beside the PNG (``fig.png`` -> ``fig.pdf``, ``fig.svg``), all or none with the r
 from __future__ import annotations
 
 import io
+import math
+from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
+
+Key = TypeVar("Key", bound=Hashable)
 
 #: The formats a figure may be written in besides PNG (matplotlib's backends for them).
 FORMATS = ("png", "pdf", "svg")
@@ -87,3 +91,27 @@ def thinned(x: Any, y: Any, points: int = LINE_POINTS) -> tuple[np.ndarray, np.n
     index[1::2] = starts + np.maximum(low, high)
     index = np.unique(np.concatenate(([0], index, np.arange(whole, n), [n - 1])))
     return x[index], y[index]
+
+
+def drawn(figures: Mapping[Key, Callable[[], bytes]], workers: int | None = None) -> dict[Key, bytes]:
+    """Each figure function's bytes by its key, drawn side by side in ``workers`` processes
+    (default: the cores) where processes can be forked (the functions and what they draw are the
+    parent's, not sent), else one after the other here. The same bytes either way: a figure
+    function is pure."""
+    import multiprocessing
+
+    from .parallel import cores, parallel_map
+
+    keys = list(figures)
+    workers = min(workers or cores(), len(keys))
+    if workers <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        return {key: figures[key]() for key in keys}
+
+    def draw(index: int) -> tuple[int, bytes]:
+        return index, figures[keys[index]]()
+
+    def lost(arguments: tuple[Any, ...], reason: str) -> Any:
+        raise RuntimeError(f"figure {keys[arguments[0]]}: {reason}")
+
+    done = dict(parallel_map(draw, [(k,) for k in range(len(keys))], workers, lost=lost, timeout=math.inf))
+    return {key: done[k] for k, key in enumerate(keys)}

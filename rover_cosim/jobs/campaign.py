@@ -1,7 +1,8 @@
 """The skeleton the closed-loop jobs share (simulate's straight run, the path following, the terrain
-scenarios): their runs stepped one after the other, each with its share of the progress; what each
-system was and how long it ran; the record's common part, with the master's algorithm and step read
-from the systems that ran; the files written as one set, all or none.
+scenarios): their runs stepped one after the other, each with its share of the progress, or
+independent runs side by side on the cores (``run_all``); what each system was and how long it
+ran; the record's common part, with the master's algorithm and step read from the systems that
+ran; the files written as one set, all or none.
 
 A job builds its systems and makes tables of the runs' data; the campaign does the rest::
 
@@ -13,13 +14,16 @@ A job builds its systems and makes tables of the runs' data; the campaign does t
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import time
 from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
 from typing import Any
 
 from rover_cosim.common.outputs import file_sha256, run_record, write_all
-from rover_cosim.orchestrator.master import run
+from rover_cosim.common.parallel import cores, parallel_map
+from rover_cosim.orchestrator.master import RunError, run
 from rover_cosim.orchestrator.model import System
 from rover_cosim.orchestrator.recorder import RunResult
 from rover_cosim.orchestrator.runs import system_record
@@ -45,6 +49,38 @@ class Campaign:
         self.ran[key] = system
         self.walls[key] = outcome.wall_seconds
         return outcome
+
+    def run_all(self, systems: Mapping[str, System], workers: int | None = None) -> dict[str, RunResult]:
+        """Run every system (recorded under its key), independent runs side by side in ``workers``
+        processes (default: the cores; one, or a single system: one after the other here). Each
+        runs as it would alone, bit for bit (a run in a worker steps its FMUs on one thread: the
+        runs share the cores); a block's state after its run (a report) is in ``self.ran[key]``,
+        the system that ran. The first run that fails raises its RunError (the others are ended)."""
+        workers = min(workers or cores(), len(systems))
+        if workers <= 1:
+            return {key: self.run(key, system) for key, system in systems.items()}
+        first = len(self.ran)
+        stage = {key: first + k for k, key in enumerate(systems)}
+        for key, system in systems.items():
+            self.systems[key] = system_record(system)
+        arguments = [(key, dataclasses.replace(system, threads_setting=system.threads_setting or 1))
+                     for key, system in systems.items()]
+        done: dict[str, RunResult] = {}
+
+        def lost(arguments: tuple[Any, ...], reason: str) -> Any:
+            raise RunError(f"run {arguments[0]!r}: {reason}")
+
+        for key, outcome, ran in parallel_map(_run_one, arguments, workers, lost=lost, timeout=math.inf):
+            if isinstance(outcome, str):
+                raise RunError(outcome)
+            done[key], self.ran[key], self.walls[key] = outcome, ran, outcome.wall_seconds
+            report = self.stages.stage(stage[key])
+            if report is not None:
+                report(1.0)
+        self.ran = {**{key: self.ran[key] for key in self.ran if key not in systems},
+                    **{key: self.ran[key] for key in systems}}
+        self.walls = {key: self.walls[key] for key in self.ran}
+        return {key: done[key] for key in systems}
 
     def settings(self) -> dict[str, Any]:
         """The master's settings of the systems that ran: the algorithm and the step [s], one value
@@ -73,6 +109,14 @@ class Campaign:
         job's earlier files to remove); the files, sorted."""
         write_all(files, folder=Path(out), stale=stale)
         return sorted(files)
+
+
+def _run_one(key: str, system: System) -> tuple[str, RunResult | str, System | None]:
+    """In a worker: (key, the run's result or its RunError's message, the system after the run)."""
+    try:
+        return key, run(system), system
+    except RunError as error:
+        return key, str(error), None
 
 
 def _fmu_path(fmu: str | Path, fmu_dir: Path) -> Path:

@@ -57,6 +57,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.figures import drawn
 from rover_cosim.common.outputs import json_bytes, summary_repr
 from rover_cosim.common.paper import TABLE_3_RMS
 from rover_cosim.common.rows import csv_bytes, every, indices
@@ -378,25 +379,19 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     campaign = Campaign("rover-cosim simulate --only legwheel", 3 + 2 * len(RUNS) + len(PATCH_RUNS), progress)
-    tables = {"straight": straight_table(campaign.run("straight", straight_system(fmu_dir, models, choice,
-                                                                                   stop)).data),
-              "straight_cosim": straight_table(campaign.run("straight_cosim", straight_cosim_system(
-                  fmu_dir, models, choice, stop)).data, cosim=True)}
-    spring = dataclasses.replace(spring_damper_system(fmu_dir, models, choice), stop_time=stop)
-    tables["straight_spring_damper"] = straight_trajectories(campaign.run("straight_spring_damper", spring).data,
-                                                             "monolithic")
+    results = campaign.run_all(_systems(fmu_dir, models, choice, stop, length, slope_deg, climb_deg, patch_stop))
+    tables = {"straight": straight_table(results["straight"].data),
+              "straight_cosim": straight_table(results["straight_cosim"].data, cosim=True),
+              "straight_spring_damper": straight_trajectories(results["straight_spring_damper"].data, "monolithic")}
     reports = {}
-    for scenario, make, degrees in (("slope", slope_system, slope_deg), ("climb", climb_system, climb_deg)):
+    for scenario in ("slope", "climb"):
         for run_ in RUNS:
-            system = make(fmu_dir, models, run_, choice, slope_deg=degrees, length=length)
-            tables[f"{scenario}_{run_}"] = slope_table(campaign.run(f"{scenario}_{run_}", system).data)
-            reports[run_ if scenario == "slope" else f"{scenario}_{run_}"] = _posture_report(system)
+            tables[f"{scenario}_{run_}"] = slope_table(results[f"{scenario}_{run_}"].data)
+            reports[run_ if scenario == "slope" else f"{scenario}_{run_}"] = _posture_report(
+                campaign.ran[f"{scenario}_{run_}"])
     for run_ in PATCH_RUNS:
-        system = dataclasses.replace(patch_system(fmu_dir, models, run_, choice),
-                                     stop_time=min(stop_time(float(PATCH["length"]), float(PATCH["speed"])),  # type: ignore[arg-type]
-                                                   patch_stop))
-        tables[f"patch_{run_}"] = patch_table(campaign.run(f"patch_{run_}", system).data)
-        reports[f"patch_{run_}"] = _posture_report(system)
+        tables[f"patch_{run_}"] = patch_table(results[f"patch_{run_}"].data)
+        reports[f"patch_{run_}"] = _posture_report(campaign.ran[f"patch_{run_}"])
     legs, spring_rms = rms(tables["straight"]), rms(tables["straight_spring_damper"])
     rms_table = pd.DataFrame({"limb": legs["limb"], "rms_legwheel_N": legs["rms_N"],
                               "rms_legwheel_cosim_N": rms(tables["straight_cosim"])["rms_N"],
@@ -425,17 +420,24 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
                                                         (side, 0.0)),
               f"posture control, {climb_deg:g} deg climb (its end)": (
                   *_end_posture(tables["climb_posture"], reports["climb_posture"]), (0.0, climb))}
+    limbs = legwheel_figures.limbs
+    figures: dict[Path, Callable[[], bytes]] = {
+        out / "legwheel_stance.png": lambda: legwheel_figures.stance(stance),
+        out / "legwheel_limbs_straight.png": lambda: limbs({"leg-wheel rover": tables["straight"]},
+                                                           "straight run, paper's posture"),
+        out / "legwheel_limbs_slope.png": lambda: limbs({LABELS[r]: tables[f"slope_{r}"] for r in RUNS},
+                                                        f"{slope_deg:g} deg side slope at {SPEED:g} m/s"),
+        out / "legwheel_limbs_climb.png": lambda: limbs({CLIMB_LABELS[r]: tables[f"climb_{r}"] for r in RUNS},
+                                                        f"{climb_deg:g} deg climb at {SPEED:g} m/s"),
+        out / "legwheel_limbs_patch.png": lambda: limbs(
+            {PATCH_LABELS[r]: tables[f"patch_{r}"] for r in PATCH_RUNS},
+            f"front-left wheel in a soft patch, {float(PATCH['speed']):g} m/s"),  # type: ignore[arg-type]
+    }
     files = {
         out / "legwheel_straight.csv": csv_bytes(every(tables["straight"], record_interval, STEP), "%.8g"),
         out / "legwheel_rms.csv": rms_table.to_csv(index=False, float_format="%.4f").encode(),
         out / "legwheel_metrics.csv": metrics.to_csv(index=False, float_format="%.6g").encode(),
-        out / "legwheel_stance.png": legwheel_figures.stance(stance),
-        out / "legwheel_limbs_straight.png": legwheel_figures.limbs({"leg-wheel rover": tables["straight"]},
-                                                                    "straight run, paper's posture"),
-        out / "legwheel_limbs_slope.png": legwheel_figures.limbs(
-            {LABELS[r]: tables[f"slope_{r}"] for r in RUNS}, f"{slope_deg:g} deg side slope at {SPEED:g} m/s"),
-        out / "legwheel_limbs_climb.png": legwheel_figures.limbs(
-            {CLIMB_LABELS[r]: tables[f"climb_{r}"] for r in RUNS}, f"{climb_deg:g} deg climb at {SPEED:g} m/s"),
+        **drawn(figures),  # side by side on the cores
         out / "legwheel.json": json_bytes(record),
     }
     for scenario in ("slope", "climb"):
@@ -445,11 +447,24 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     for run_ in PATCH_RUNS:
         files[out / f"legwheel_patch_{run_}.csv"] = csv_bytes(every(tables[f"patch_{run_}"], record_interval, STEP),
                                                               "%.8g")
-    files[out / "legwheel_limbs_patch.png"] = legwheel_figures.limbs(
-        {PATCH_LABELS[r]: tables[f"patch_{r}"] for r in PATCH_RUNS},
-        f"front-left wheel in a soft patch, {float(PATCH['speed']):g} m/s")  # type: ignore[arg-type]
     written = campaign.write(out, files, stale=("legwheel_*",))
     return LegWheelResult(written, tables, rms_table, metrics, record)
+
+
+def _systems(fmu_dir: Path, models: ModelSet, choice: Choice, stop: float, length: float, slope_deg: float,
+             climb_deg: float, patch_stop: float) -> dict[str, System]:
+    """Every run of the job by its key (independent runs: the campaign steps them side by side)."""
+    systems = {"straight": straight_system(fmu_dir, models, choice, stop),
+               "straight_cosim": straight_cosim_system(fmu_dir, models, choice, stop),
+               "straight_spring_damper": dataclasses.replace(spring_damper_system(fmu_dir, models, choice),
+                                                             stop_time=stop)}
+    for scenario, make, degrees in (("slope", slope_system, slope_deg), ("climb", climb_system, climb_deg)):
+        for run_ in RUNS:
+            systems[f"{scenario}_{run_}"] = make(fmu_dir, models, run_, choice, slope_deg=degrees, length=length)
+    patch = min(stop_time(float(PATCH["length"]), float(PATCH["speed"])), patch_stop)  # type: ignore[arg-type]
+    for run_ in PATCH_RUNS:
+        systems[f"patch_{run_}"] = dataclasses.replace(patch_system(fmu_dir, models, run_, choice), stop_time=patch)
+    return systems
 
 
 def _posture_report(system: System) -> dict[str, Any]:
