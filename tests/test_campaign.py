@@ -1,7 +1,7 @@
 """A job's independent runs side by side (``Campaign.run_all``) and its figures drawn side by side
 (``common.figures.drawn``): the same results as one after the other, bit for bit and in the order
-given; the blocks' state after their runs comes back; a failing run fails the job naming it; no
-worker outlives the call."""
+given; the blocks' state after their runs comes back; a system that cannot be sent to a worker runs
+here; a failing run fails the job naming it; no worker outlives the call."""
 
 from __future__ import annotations
 
@@ -59,6 +59,21 @@ def test_runs_side_by_side_give_each_runs_results_in_order_with_the_blocks_state
     blocks = [next(b.block for b in system.blocks) for system in campaign.ran.values()]
     assert all(isinstance(block, CountingTorque) and block.steps == 200 for block in blocks)
     assert sorted(progress)[-1] == 1.0 and len(progress) == len(torques)
+
+
+def test_a_system_that_cannot_travel_to_a_worker_runs_here_and_the_order_is_kept(fmus):
+    systems = {f"t{k}": wheel(fmus, k) for k in (10.0, 20.0, 30.0)}
+    local = next(b.block for b in systems["t20.0"].blocks)
+    assert isinstance(local, CountingTorque)
+    local.hook = lambda: None  # type: ignore[attr-defined]  # a local function: it does not pickle
+    campaign = Campaign("test", 3)
+    together = campaign.run_all(systems, workers=2)
+    assert list(together) == list(campaign.ran) == list(campaign.systems) == list(systems)
+    assert campaign.ran["t20.0"] is systems["t20.0"] and local.steps == 200  # it ran here, on this block
+    assert campaign.ran["t10.0"] is not systems["t10.0"]  # it ran in a worker
+    alone = Campaign("test", 3).run_all({f"t{k}": wheel(fmus, k) for k in (10.0, 20.0, 30.0)}, workers=1)
+    for key in systems:
+        pd.testing.assert_frame_equal(together[key].data, alone[key].data, check_exact=True)
 
 
 def test_a_failing_run_among_others_fails_the_job_naming_its_error_and_leaves_no_worker(fmus):

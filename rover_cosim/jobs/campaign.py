@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import pickle
 import time
 from collections.abc import Callable, Collection, Mapping
 from pathlib import Path
@@ -55,31 +56,46 @@ class Campaign:
         processes (default: the cores; one, or a single system: one after the other here). Each
         runs as it would alone, bit for bit (a run in a worker steps its FMUs on one thread: the
         runs share the cores); a block's state after its run (a report) is in ``self.ran[key]``,
-        the system that ran. The first run that fails raises its RunError (the others are ended)."""
+        the system that ran. A system that cannot be sent to a worker (a block holding a local
+        function: the adaptive controller) runs here first. The first run that fails raises its
+        RunError (the others are ended)."""
         workers = min(workers or cores(), len(systems))
         if workers <= 1:
             return {key: self.run(key, system) for key, system in systems.items()}
+        # a system that cannot travel to a worker (a block holding a local function) runs here first
+        here = [key for key, system in systems.items() if not _travels(system)]
+        done: dict[str, RunResult] = {key: self.run(key, systems[key]) for key in here}
+        away = {key: system for key, system in systems.items() if key not in here}
+        if len(away) < 2:
+            done.update({key: self.run(key, system) for key, system in away.items()})
+            return self._in_order(systems, done)
         first = len(self.ran)
-        stage = {key: first + k for k, key in enumerate(systems)}
-        for key, system in systems.items():
+        stage = {key: first + k for k, key in enumerate(away)}
+        for key, system in away.items():
             self.systems[key] = system_record(system)
         arguments = [(key, dataclasses.replace(system, threads_setting=system.threads_setting or 1))
-                     for key, system in systems.items()]
-        done: dict[str, RunResult] = {}
+                     for key, system in away.items()]
 
         def lost(arguments: tuple[Any, ...], reason: str) -> Any:
             raise RunError(f"run {arguments[0]!r}: {reason}")
 
-        for key, outcome, ran in parallel_map(_run_one, arguments, workers, lost=lost, timeout=math.inf):
+        for key, outcome, ran in parallel_map(_run_one, arguments, min(workers, len(away)), lost=lost,
+                                              timeout=math.inf):
             if isinstance(outcome, str):
                 raise RunError(outcome)
+            assert ran is not None
             done[key], self.ran[key], self.walls[key] = outcome, ran, outcome.wall_seconds
             report = self.stages.stage(stage[key])
             if report is not None:
                 report(1.0)
-        self.ran = {**{key: self.ran[key] for key in self.ran if key not in systems},
-                    **{key: self.ran[key] for key in systems}}
-        self.walls = {key: self.walls[key] for key in self.ran}
+        return self._in_order(systems, done)
+
+    def _in_order(self, systems: Mapping[str, System], done: dict[str, RunResult]) -> dict[str, RunResult]:
+        """``done`` in the order of ``systems``, and so what the campaign recorded of them."""
+        def ordered(recorded: dict[str, Any]) -> dict[str, Any]:
+            return {**{k: v for k, v in recorded.items() if k not in systems}, **{k: recorded[k] for k in systems}}
+
+        self.ran, self.walls, self.systems = ordered(self.ran), ordered(self.walls), ordered(self.systems)
         return {key: done[key] for key in systems}
 
     def settings(self) -> dict[str, Any]:
@@ -109,6 +125,15 @@ class Campaign:
         job's earlier files to remove); the files, sorted."""
         write_all(files, folder=Path(out), stale=stale)
         return sorted(files)
+
+
+def _travels(system: System) -> bool:
+    """Whether ``system`` can be sent to a worker process (pickled)."""
+    try:
+        pickle.dumps(system)
+    except (pickle.PicklingError, AttributeError, TypeError):
+        return False
+    return True
 
 
 def _run_one(key: str, system: System) -> tuple[str, RunResult | str, System | None]:

@@ -257,24 +257,24 @@ def run_effects(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | None
         fit.insert(0, "variant", variant)
         fits.append(fit)
     rows, sinkage = [], {}
-    for variant, variant_chosen in chosen.items():
-        for label, controlled in ((GIVEN_MODEL, models), (OWN_MODEL, own[variant])):
-            if label == OWN_MODEL and controlled is models:
-                continue
-            key = variant if label == GIVEN_MODEL else f"{variant}_{label}"
-            table = trajectories(campaign.run(key, straight_system(fmu_dir, controlled, variant_chosen, variant)).data,
-                                 "monolithic")
-            at_cruise = cruise(table).merge(rms(table).rename(columns={"limb": "wheel"}), on="wheel")
-            at_cruise.insert(0, "model", label)
-            at_cruise.insert(0, "variant", variant)
-            rows.append(at_cruise)
-            if label == GIVEN_MODEL:
-                sinkage[f"sinkage_{variant}_m"] = at_cruise["sinkage_mean_m"].to_numpy()
-    turn = {}
+    planned = [(variant, label, variant if label == GIVEN_MODEL else f"{variant}_{label}", controlled)
+               for variant in chosen for label, controlled in ((GIVEN_MODEL, models), (OWN_MODEL, own[variant]))
+               if not (label == OWN_MODEL and controlled is models)]
+    systems = {key: straight_system(fmu_dir, controlled, chosen[variant], variant)
+               for variant, _, key, controlled in planned}
     for ruts in (False, True):
-        run = campaign.run(f"{PATH_SCENARIO}{'_ruts' if ruts else ''}",
-                           path_system(fmu_dir, models, choice, ruts, straight))
-        turn[ruts] = path_phases(run.data, straight)
+        systems[f"{PATH_SCENARIO}{'_ruts' if ruts else ''}"] = path_system(fmu_dir, models, choice, ruts, straight)
+    outcomes = campaign.run_all(systems)  # side by side on the cores
+    for variant, label, key, _ in planned:
+        table = trajectories(outcomes[key].data, "monolithic")
+        at_cruise = cruise(table).merge(rms(table).rename(columns={"limb": "wheel"}), on="wheel")
+        at_cruise.insert(0, "model", label)
+        at_cruise.insert(0, "variant", variant)
+        rows.append(at_cruise)
+        if label == GIVEN_MODEL:
+            sinkage[f"sinkage_{variant}_m"] = at_cruise["sinkage_mean_m"].to_numpy()
+    turn = {ruts: path_phases(outcomes[f"{PATH_SCENARIO}{'_ruts' if ruts else ''}"].data, straight)
+            for ruts in (False, True)}
     path_sinkage = turn[False][["wheel", "phase"]].assign(
         sinkage_virgin_m=turn[False]["sinkage_m"], sinkage_ruts_m=turn[True]["sinkage_m"],
         rut_depth_m=turn[True]["rut_depth_m"])

@@ -247,10 +247,11 @@ def run_path_following(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tup
               "cosim": lambda s: cosim_system(fmu_dir, models, s, choice, straight),
               "kinematic": lambda s: monolithic_system(fmu_dir, models, s, "kinematic", choice, straight)}
     campaign = Campaign("rover-cosim simulate (path following)", len(scenarios) * len(builds), progress)
+    outcomes = campaign.run_all({f"{scenario}/{label}": build(scenario) for scenario in scenarios
+                                 for label, build in builds.items()})  # side by side on the cores
     for scenario in scenarios:
-        for label, build in builds.items():
-            outcome = campaign.run(f"{scenario}/{label}", build(scenario))
-            tables[scenario, label] = trajectories(outcome.data, cosim=label == "cosim")
+        for label in builds:
+            tables[scenario, label] = trajectories(outcomes[f"{scenario}/{label}"].data, cosim=label == "cosim")
     rows = [{"scenario": s, "run": label, "target_speed_m_s": SCENARIOS[s], **metrics(tables[s, label], SCENARIOS[s])}
             for s in scenarios for label in builds]
     metric_table = pd.DataFrame(rows)

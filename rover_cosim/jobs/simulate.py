@@ -274,17 +274,21 @@ def run_simulation(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | S
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     static_load = choice.rover.static_wheel_load(choice.soil.gravity)  # N, the fixed load of the ablation
     cosim_label = f"RoverBody + {choice.rover.wheels} Wheel"
-    for plant, build in (("monolithic", monolithic_system), ("cosim", cosim_system)):
-        tables[plant] = trajectories(campaign.run(plant, build(fmu_dir, models, choice, ruts=ruts)).data, plant)
+    systems = {"monolithic": monolithic_system(fmu_dir, models, choice, ruts=ruts),
+               "cosim": cosim_system(fmu_dir, models, choice, ruts=ruts),
+               "fixed_load_ablation": monolithic_system(fmu_dir, models, choice, ruts=ruts, fixed_load=static_load)}
+    if adapt is not None:
+        systems["adaptive"] = adaptive_system(fmu_dir, models, choice, calibration=adapt)
+    outcomes = campaign.run_all(systems)  # side by side on the cores
+    for plant in ("monolithic", "cosim"):
+        tables[plant] = trajectories(outcomes[plant].data, plant)
         results[plant] = checks(tables[plant])
-    ablation = rms(trajectories(campaign.run("fixed_load_ablation", monolithic_system(
-        fmu_dir, models, choice, ruts=ruts, fixed_load=static_load)).data, "monolithic"))
+    ablation = rms(trajectories(outcomes["fixed_load_ablation"].data, "monolithic"))
     adaptation = None
     if adapt is not None:
-        system = adaptive_system(fmu_dir, models, choice, calibration=adapt)
-        tables["adaptive"] = trajectories(campaign.run("adaptive", system).data, "monolithic")
+        tables["adaptive"] = trajectories(outcomes["adaptive"].data, "monolithic")
         results["adaptive"] = checks(tables["adaptive"])
-        block = next(b.block for b in system.blocks if b.name == "ctrl")
+        block = next(b.block for b in campaign.ran["adaptive"].blocks if b.name == "ctrl")
         after = tables["adaptive"][tables["adaptive"]["time"] >= adapt.duration]
         adaptation = {**block.report(), "rms_after_calibration_N": rms(after)["rms_N"].tolist(),  # type: ignore[attr-defined]
                       "rms_after_calibration_nominal_model_N":

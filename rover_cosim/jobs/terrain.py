@@ -508,17 +508,19 @@ def run_terrain(fmu_dir: Path, model: Path, out_dir: Path, scenarios: tuple[str,
     tables: dict[tuple[str, str], pd.DataFrame] = {}
     prepared: dict[str, Prepared] = {}
     files: dict[Path, bytes] = {}
+    systems = {}
     for scenario, label in plan:
         if scenario.name not in prepared:
             prepared[scenario.name] = scenario.prepare(out, fmu_dir, choice, models)
             files.update(prepared[scenario.name].files)
         ground, model_b = prepared[scenario.name].ground, prepared[scenario.name].model_b
-        system = traverse_system(fmu_dir, models, ground.plane, label, choice, scenario.length,
-                                 speed=scenario.speed, height_map=ground.map, soil_map=ground.soil_map,
-                                 model_b=model_b)
-        data = campaign.run(f"{scenario.name}/{label}", system).data
-        trajectory = trajectories(data, cosim=label == "cosim")
-        trajectory["z_ground"] = ground.height(trajectory["x"], trajectory["y"])
+        systems[f"{scenario.name}/{label}"] = traverse_system(
+            fmu_dir, models, ground.plane, label, choice, scenario.length, speed=scenario.speed,
+            height_map=ground.map, soil_map=ground.soil_map, model_b=model_b)
+    outcomes = campaign.run_all(systems)  # side by side on the cores
+    for scenario, label in plan:
+        trajectory = trajectories(outcomes[f"{scenario.name}/{label}"].data, cosim=label == "cosim")
+        trajectory["z_ground"] = prepared[scenario.name].ground.height(trajectory["x"], trajectory["y"])
         tables[scenario.name, label] = trajectory
     metric_table = pd.DataFrame([{"scenario": s.name, "run": label, "side_slope_deg": s.side_slope_deg,
                                   "target_speed_m_s": s.speed, **metrics(tables[s.name, label], s.speed)}
