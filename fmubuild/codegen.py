@@ -45,6 +45,9 @@ STATISTICS = (
     ("statistics.jacobians", "Evaluations of the Jacobian by the Co-Simulation integrator"),
     ("statistics.steps", "Accepted steps of the Co-Simulation integrator"),
     ("statistics.rejectedSteps", "Rejected steps of the Co-Simulation integrator"),
+    ("statistics.derivativeUpdates",
+     "Steps of the Co-Simulation integrator that began from the last derivatives updated for inputs that enter "
+     "them linearly, without an evaluation"),
 )
 
 
@@ -116,6 +119,34 @@ def _functions(model: OdeModel) -> list[ca.Function]:
                     [ca.densify(sensitivity[:nx]), ca.densify(sensitivity[nx:])],
                     ["t", "x", "u", "p", "m", "dx", "du"], ["dxdot", "dy"]),
     ]
+
+
+def affine_inputs(model: OdeModel) -> list[int]:
+    """Per input, 1 where the derivatives are affine in it: d xdot / d u_j depends on none of the
+    time, the states, the memories and the inputs so marked (it may depend on the parameters and
+    the other inputs: a motor torque whose reaction turns with a steering set-point), else 0. For
+    those the Co-Simulation runtime updates the derivatives it has for a change of the input,
+    xdot += (d xdot / d u_j) du_j, instead of evaluating the model again (instance.c:
+    rc_set_real); the gain is taken where the other inputs are."""
+    u = model.u
+    nu = u.numel()
+    xdot = model.xdot if model.xdot_derivative is None else model.xdot_derivative
+    gain = ca.jacobian(xdot, u) if nu and model.x.numel() else ca.MX(0, 0)
+    if not gain.nnz():
+        return [0] * nu
+    entries = gain.nz[:]  # the structural nonzeros, column by column; which variables each reads:
+    _, column = gain.sparsity().get_triplet()
+    varying = {column[r] for v in (model.t, model.x, model.m) if v.numel()
+               for r in ca.jacobian_sparsity(entries, v).get_triplet()[0]}
+    reads: dict[int, set[int]] = {}
+    for r, k in zip(*ca.jacobian_sparsity(entries, u).get_triplet()):
+        reads.setdefault(column[r], set()).add(k)
+    chosen = {j for j in range(nu) if j not in varying}
+    while True:  # nor on an input so marked (u_j u_k is affine in neither)
+        kept = {j for j in chosen if not reads.get(j, set()) & chosen}
+        if kept == chosen:
+            return [1 if j in chosen else 0 for j in range(nu)]
+        chosen = kept
 
 
 def _column(entries: list[ca.MX]) -> ca.MX:
@@ -259,6 +290,7 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path, *
     calculated = [1 if v.initial == "calculated" else 0 for v in states]
     memory_source = [model.observed.index(source) for source in model.memory_sources]
     y_is_output = [1 if v.causality == "output" else 0 for v in by_kind.get("observed", [])]
+    u_affine = affine_inputs(model)
     names = ",\n    ".join(_c_string(v.name) for v in model_layout.variables)
     asserts = model.asserts
     value_start = [0]
@@ -282,6 +314,7 @@ static const int X_START_CALCULATED[] = {{{", ".join(map(str, calculated)) or "0
 static const double M_DEFAULT[] = {_c_doubles(model.memory_defaults)};
 static const int M_SOURCE[] = {{{", ".join(map(str, memory_source)) or "0"}}};
 static const int Y_IS_OUTPUT[] = {{{", ".join(map(str, y_is_output)) or "0"}}};
+static const int U_AFFINE[] = {{{", ".join(map(str, u_affine)) or "0"}}};
 static const char *const REAL_NAMES[] = {{
     {names}
 }};
@@ -291,7 +324,7 @@ const ModelInfo model_info = {{
     {model_layout.n_states}, {model_layout.n_inputs}, {model_layout.n_parameters}, {model_layout.n_observed},
     P_DEFAULT, U_DEFAULT, X_START, X_START_CALCULATED, REAL_NAMES,
     {len(asserts)}, ASSERT_MESSAGES, ASSERT_IS_ERROR, ASSERT_VALUE_START, ASSERT_VALUE_NAMES,
-    {len(model.memories)}, M_DEFAULT, M_SOURCE, Y_IS_OUTPUT
+    {len(model.memories)}, M_DEFAULT, M_SOURCE, Y_IS_OUTPUT, U_AFFINE
 }};
 """
     (directory / "model_data.c").write_text(data)

@@ -51,6 +51,7 @@ typedef struct {
     double t;
     double *x, *u, *m, *xdot, *y, *holds, *values;
     unsigned long long evaluations, reused;
+    unsigned long long updated;  /* steps begun from derivatives updated for affine inputs (rc_set_real) */
 } Evaluation;
 
 struct Instance {
@@ -79,6 +80,11 @@ struct Instance {
     casadi_int *iw;
     double *w;
     double *seed_x, *seed_u, *sens_x, *sens_y;
+    /* d xdot / d u of the inputs the derivatives are affine in (model_info.u_affine), nx x nu
+     * column-major (0 elsewhere), where the other inputs and the parameters are (gain_valid) */
+    double *gain;
+    int gain_valid;
+    int f0_updated;  /* the integrator's derivatives were updated for such inputs since the last step */
     Evaluation eval;
     Ode23s solver;
 };
@@ -92,7 +98,7 @@ static inline int off_m(void) { return off_y() + model_info.ny; }
 static inline int vr_rtol(void) { return off_m() + model_info.nm; }
 static inline int vr_max_step(void) { return vr_rtol() + 1; }
 static inline int vr_statistics(void) { return vr_max_step() + 1; }
-#define N_STATISTICS 5 /* codegen.STATISTICS */
+#define N_STATISTICS 6 /* codegen.STATISTICS */
 static inline int n_real(void) { return vr_statistics() + N_STATISTICS; }
 
 /* A value reference as an index, or -1 when it is no Real variable (compared unsigned, so

@@ -53,6 +53,8 @@ Status rc_do_step(Instance *c, int f, double currentCommunicationPoint, double c
     char message[512];
     double t = currentCommunicationPoint;
     c->t_step = currentCommunicationPoint;
+    if (c->f0_updated && c->solver.f0_valid) c->eval.updated++; /* begun from updated derivatives */
+    c->f0_updated = 0;
     int status = ode23s_integrate(&c->solver, &t, c->x, t_end, message, sizeof message);
     c->t = t;
     c->xdot_valid = 0;

@@ -103,7 +103,10 @@ static int evaluate(Instance *c, double t, const double *x) {
     return 0;
 }
 
-void rc_forget_evaluation(Instance *c) { c->eval.valid = 0; }
+void rc_forget_evaluation(Instance *c) {
+    c->eval.valid = 0;
+    c->gain_valid = 0;
+}
 
 static int all_finite(const double *v, int n) {
     for (int i = 0; i < n; i++) if (!isfinite(v[i])) return 0;
@@ -211,6 +214,8 @@ void rc_invalidate(Instance *c) {
     c->xdot_valid = 0;
     c->y_valid = 0;
     c->solver.f0_valid = 0;
+    c->gain_valid = 0;
+    c->f0_updated = 0;
 }
 
 static void set_defaults(Instance *c) {
@@ -239,7 +244,7 @@ void rc_free(Instance *c) {
     if (!c) return;
     void (*release)(void *) = c->release;
     void *blocks[] = {c->name, c->p, c->x, c->m, c->u, c->u_der, c->u_step, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
-                      (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y,
+                      (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y, c->gain,
                       c->eval.x, c->eval.u, c->eval.m, c->eval.xdot, c->eval.y, c->eval.holds, c->eval.values};
     for (size_t i = 0; i < sizeof(blocks) / sizeof(blocks[0]); i++) if (blocks[i]) release(blocks[i]);
     ode23s_free(&c->solver, release);
@@ -283,6 +288,7 @@ static int allocate_work(Instance *c) {
     c->seed_u = alloc(nu, sizeof(double));
     c->sens_x = alloc(nx, sizeof(double));
     c->sens_y = alloc(ny, sizeof(double));
+    c->gain = alloc(nx * nu, sizeof(double));
     Evaluation *e = &c->eval;
     e->x = alloc(nx, sizeof(double));
     e->u = alloc(nu, sizeof(double));
@@ -293,7 +299,7 @@ static int allocate_work(Instance *c) {
     e->values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
     int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
     return c->p && c->m && c->x && c->u && c->u_der && c->u_step && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
-           c->seed_u && c->sens_x && c->sens_y && e->x && e->u && e->xdot && e->y && e->holds && e->values &&
+           c->seed_u && c->sens_x && c->sens_y && c->gain && e->x && e->u && e->xdot && e->y && e->holds && e->values &&
            e->m && !solver_failed;
 }
 
@@ -375,7 +381,8 @@ static double statistic(const Instance *c, int k) {
     case 1: return (double)c->eval.reused;
     case 2: return (double)c->solver.jacobians;
     case 3: return (double)c->solver.steps;
-    default: return (double)c->solver.rejected;
+    case 4: return (double)c->solver.rejected;
+    default: return (double)c->eval.updated;
     }
 }
 
@@ -424,6 +431,39 @@ static const char *set_real_refusal(const Instance *c, int r, double value) {
     return NULL;
 }
 
+/* The columns of d xdot / d u of the affine inputs (model_info.u_affine) where the other inputs
+ * and the parameters are now, by model_directional (for those inputs a function of the
+ * parameters and the other inputs only); 0 on success. */
+static int input_gain(Instance *c) {
+    if (c->gain_valid) return 0;
+    double t = c->t;
+    for (int j = 0; j < model_info.nu; j++) {
+        if (!model_info.u_affine[j]) continue;
+        for (int k = 0; k < model_info.nx; k++) c->seed_x[k] = 0.0;
+        for (int k = 0; k < model_info.nu; k++) c->seed_u[k] = k == j ? 1.0 : 0.0;
+        c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->m;
+        c->arg[5] = c->seed_x; c->arg[6] = c->seed_u;
+        c->res[0] = c->sens_x; c->res[1] = c->sens_y;
+        if (model_directional(c->arg, c->res, c->iw, c->w, 0) || !all_finite(c->sens_x, model_info.nx)) return -1;
+        memcpy(c->gain + (size_t)model_info.nx * j, c->sens_x, sizeof(double) * (size_t)model_info.nx);
+    }
+    c->gain_valid = 1;
+    return 0;
+}
+
+/* Whether setting ``vr`` keeps the Co-Simulation integrator's derivatives at the current point
+ * (updated for the change, rc_set_real): every one an input the derivatives are affine in, the
+ * derivatives known at the current point and no input interpolated. Saves the evaluation the
+ * next step would begin with: a controller changes the motor torques every step. */
+static int keeps_derivatives(Instance *c, const unsigned int vr[], size_t nvr) {
+    if (c->kind != KIND_CO_SIMULATION || c->mode != MODE_STEP || !c->solver.f0_valid || c->interpolating) return 0;
+    for (size_t i = 0; i < nvr; i++) {
+        int r = real_index(vr[i]);
+        if (!(r >= off_u() && r < off_y() && model_info.u_affine[r - off_u()])) return 0;
+    }
+    return input_gain(c) == 0;
+}
+
 Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, const double value[]) {
     NOT_NULL(f, vr, nvr);
     NOT_NULL(f, value, nvr);
@@ -435,15 +475,26 @@ Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, cons
         const char *refusal = set_real_refusal(c, r, value[i]);
         if (refusal) return rc_fail(c, f, REJECTED, "%s = %g: %s", real_name(vr[i]), value[i], refusal);
     }
+    int keep = nvr > 0 && keeps_derivatives(c, vr, nvr);
     for (size_t i = 0; i < nvr; i++) {
         int r = real_index(vr[i]);
         if (r < off_x()) { c->p[r] = value[i]; rc_forget_evaluation(c); }
         else if (r < off_dx()) { c->x[r - off_x()] = value[i]; c->x_set[r - off_x()] = 1.0; }
-        else if (r >= off_u() && r < off_y()) c->u[r - off_u()] = value[i];
+        else if (r >= off_u() && r < off_y()) {
+            int j = r - off_u();
+            double du = value[i] - c->u[j];
+            if (keep && du != 0.0)
+                for (int k = 0; k < model_info.nx; k++) c->solver.F0[k] += c->gain[k + (size_t)model_info.nx * j] * du;
+            c->u[j] = value[i];
+        }
         else if (r == vr_rtol()) c->rtol = value[i];
         else if (r == vr_max_step()) c->max_step = value[i];
     }
-    if (nvr > 0) rc_invalidate(c);
+    if (keep) { /* the next step begins from the updated derivatives; outputs are evaluated again */
+        c->xdot_valid = 0;
+        c->y_valid = 0;
+        c->f0_updated = 1;
+    } else if (nvr > 0) rc_invalidate(c);
     return STATUS_OK;
 }
 

@@ -38,6 +38,9 @@ typedef struct {
     const double *m_default;          /* [nm] their value before the first step */
     const int *m_source;              /* [nm] index into y of the variable each one remembers */
     const int *y_is_output;           /* [ny] 1: an output (causality output), 0: a local variable */
+    const int *u_affine;              /* [nu] 1: the derivatives are affine in this input (d xdot/du a
+                                       * function of the parameters only: the runtime updates them for
+                                       * its change instead of evaluating again) */
 } ModelInfo;
 
 extern const ModelInfo model_info;

@@ -6,7 +6,7 @@
 
 #include "core.h"
 
-#define FMU_STATE_MAGIC 0x524f5646u /* layout 4: the interface kind, input derivatives and statistics */
+#define FMU_STATE_MAGIC 0x524f5647u /* layout 5: the interface kind, input derivatives and statistics */
 
 /* What a saved FMU state holds. */
 typedef struct {
@@ -17,7 +17,7 @@ typedef struct {
     int interpolating;  /* input derivatives set for the next step (u_der follows the inputs) */
     double t, rtol, max_step, h, t_step;
     long steps, rejected, jacobians, rhs_calls;    /* the statistics */
-    unsigned long long evaluations, reused;
+    unsigned long long evaluations, reused, updated;
     uint64_t checksum;  /* FNV-1a of the header (this field zero) and the doubles that follow */
     /* followed by x[nx], u[nu], u_der[nu], p[np], x_set[nx], F0[nx], J[nx*nx], m[nm] (doubles) */
 } StateHeader;
@@ -56,7 +56,7 @@ static void state_write(const Instance *c, unsigned char *payload) {
     head.t_step = c->t_step;
     head.steps = c->solver.steps; head.rejected = c->solver.rejected;
     head.jacobians = c->solver.jacobians; head.rhs_calls = c->solver.rhs_calls;
-    head.evaluations = c->eval.evaluations; head.reused = c->eval.reused;
+    head.evaluations = c->eval.evaluations; head.reused = c->eval.reused; head.updated = c->eval.updated;
     head.f0_valid = c->solver.f0_valid; head.jac_valid = c->solver.jac_valid;
     head.jac_current = c->solver.jac_current; head.jac_age = c->solver.jac_age;
     head.t = c->t; head.rtol = c->rtol; head.max_step = c->max_step; head.h = c->solver.h;
@@ -121,7 +121,7 @@ static void state_read(Instance *c, const unsigned char *payload) {
     c->solver.h = head.h;
     c->solver.steps = head.steps; c->solver.rejected = head.rejected;
     c->solver.jacobians = head.jacobians; c->solver.rhs_calls = head.rhs_calls;
-    c->eval.evaluations = head.evaluations; c->eval.reused = head.reused;
+    c->eval.evaluations = head.evaluations; c->eval.reused = head.reused; c->eval.updated = head.updated;
 }
 
 Status rc_get_state(Instance *c, int f, void **state) {

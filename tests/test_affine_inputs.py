@@ -1,0 +1,106 @@
+"""Inputs the derivatives are affine in (issue 49: fewer evaluations per step): the exporter marks
+them (a motor torque; not a load, a speed or a soil share), and the Co-Simulation runtime updates
+the derivatives it has for their change instead of evaluating the model again at the next step's
+start. Checked against the same FMU made to evaluate again (a non-affine input, a rut depth, set to its own value
+with each torque): the same trajectory to rounding, an evaluation fewer per step, the counter says
+so; a restored FMU state repeats a run exactly."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import fmpy
+import numpy as np
+import pytest
+from fmpy.fmi2 import FMU2Slave
+
+from rover_cosim.fmubuild import codegen, ode, source
+
+STEP, STEPS = 1e-3, 1500
+
+
+def test_the_exporter_marks_the_torques_and_nothing_the_contact_reads():
+    model = ode.translate(source.load(source.fmu_class("Rover")), "Rover")
+    flags = codegen.affine_inputs(model)
+    described = [v.name for v in codegen.layout(model).variables if v.kind == "input"]
+    assert len(flags) == len(described)
+    assert {name for name, flag in zip(described, flags) if flag} == {f"tau[{i}]" for i in range(1, 7)}, described
+
+
+class _Rover:
+    """Rover.fmu (Co-Simulation) stepped with torques that change every step."""
+
+    def __init__(self, fmu: Path, tmp: Path):
+        self.description = fmpy.read_model_description(str(fmu))
+        self.refs = {v.name: v.valueReference for v in self.description.modelVariables}
+        folder = fmpy.extract(str(fmu), unzipdir=str(tmp))
+        self.slave = FMU2Slave(guid=self.description.guid, unzipDirectory=folder,
+                               modelIdentifier=self.description.coSimulation.modelIdentifier, instanceName="r")
+        self.slave.instantiate()
+        self.slave.setupExperiment(startTime=0.0)
+        self.slave.enterInitializationMode()
+        self.slave.exitInitializationMode()
+        self.taus = [self.refs[f"tau[{i}]"] for i in range(1, 7)]
+        self.watched = [self.refs[n] for n in ("x", "v", "omega[1]", "omega[4]", "pitch")]
+
+    def run(self, first: int, last: int, evaluate_again: bool) -> np.ndarray:
+        rows = []
+        for k in range(first, last):
+            t = k * STEP
+            torque = 40.0 + 15.0 * math.sin(7.0 * t) + 0.01 * k
+            self.slave.setReal(self.taus, [torque, torque, torque, torque * 0.9, torque * 0.9, torque * 0.9])
+            if evaluate_again:  # a non-affine input, set to its own value: the derivatives are evaluated again
+                share = self.refs["rutDepth[1]"]
+                self.slave.setReal([share], self.slave.getReal([share]))
+            self.slave.doStep(t, STEP)
+            rows.append(self.slave.getReal(self.watched))
+        return np.array(rows)
+
+    def statistic(self, name: str) -> float:
+        return self.slave.getReal([self.refs[f"statistics.{name}"]])[0]
+
+    def close(self) -> None:
+        self.slave.terminate()
+        self.slave.freeInstance()
+
+
+def test_updated_derivatives_follow_the_evaluated_ones_to_rounding_with_an_evaluation_fewer_per_step(fmus, tmp_path):
+    updated, evaluated = _Rover(fmus["Rover"], tmp_path / "a"), _Rover(fmus["Rover"], tmp_path / "b")
+    try:
+        fast, slow = updated.run(0, STEPS, False), evaluated.run(0, STEPS, True)
+        assert fast[-1, 1] > 0.1  # it drove off
+        scale = np.abs(slow).max(axis=0)
+        assert np.all(np.abs(fast - slow).max(axis=0) <= 1e-9 * scale), np.abs(fast - slow).max(axis=0) / scale
+        assert updated.statistic("derivativeUpdates") >= STEPS - 2 and evaluated.statistic("derivativeUpdates") == 0
+        saved = evaluated.statistic("evaluations") - updated.statistic("evaluations")
+        assert saved >= 0.9 * STEPS, (updated.statistic("evaluations"), evaluated.statistic("evaluations"))
+    finally:
+        updated.close()
+        evaluated.close()
+
+
+def test_a_restored_state_repeats_a_run_of_updated_derivatives_exactly(fmus, tmp_path):
+    rover = _Rover(fmus["Rover"], tmp_path)
+    try:
+        rover.run(0, 200, False)
+        state = rover.slave.getFMUstate()
+        first = rover.run(200, 400, False)
+        rover.slave.setFMUstate(state)
+        again = rover.run(200, 400, False)
+        np.testing.assert_array_equal(first, again)
+        rover.slave.freeFMUstate(state)
+    finally:
+        rover.close()
+
+
+@pytest.mark.parametrize("name", ["Wheel", "SteerableRover", "LegWheelRover"])
+def test_the_wheels_torque_is_marked_in_every_fmu_that_takes_one(fmus, name):
+    """The generated layout (model_data.c) marks each motor torque input, and no other."""
+    import zipfile
+
+    with zipfile.ZipFile(fmus[name]) as archive:
+        data = archive.read("sources/model_data.c").decode()
+    flags = [int(v) for v in data.split("U_AFFINE[] = {")[1].split("}")[0].split(",")]
+    inputs = [v.name for v in fmpy.read_model_description(str(fmus[name])).modelVariables if v.causality == "input"]
+    assert {n for n, f in zip(inputs, flags) if f} == {n for n in inputs if n.startswith("tau")}
