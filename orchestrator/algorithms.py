@@ -135,7 +135,7 @@ class GaussSeidelInterpolated(Algorithm):
 
     def __init__(self) -> None:
         self.ramped: list[np.ndarray] = []  # per participant, which of its inputs ramp (bool per input)
-        self._marks: object | None = None   # the native stepper whose ramped units need the step's start values
+        self._marks: NativeStepper | None = None  # the native stepper whose ramped units need the start values
 
     def stages(self, participants: Sequence[Participant], inputs: Sequence[np.ndarray],
                outputs: Sequence[np.ndarray], threads: int) -> list[list[int]]:
@@ -172,7 +172,7 @@ class GaussSeidelInterpolated(Algorithm):
         clock = time.perf_counter
         start = values.copy()
         if self._marks is not None:
-            self._marks.mark(values)  # type: ignore[attr-defined]
+            self._marks.mark(values)
         for stage in execution.stages:
             i = stage[0]
             ramped = self.ramped[i]
