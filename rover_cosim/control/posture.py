@@ -252,6 +252,8 @@ class PostureController:
         self.ramped_outputs = self.outputs[:JOINTS * n]
         self.feedthrough = True
         self.loops = self._initial()
+        #: the last inputs and outputs (the C twin starts from them)
+        self._last: tuple[np.ndarray, np.ndarray] = (np.zeros(len(self.inputs)), np.zeros(len(self.outputs)))
 
     # --- the posture ----------------------------------------------------------------------------
     def joints_of(self, posture: Posture, start: np.ndarray | None = None,
@@ -414,7 +416,7 @@ class PostureController:
         library.posture_new.argtypes = [ctypes.c_int] * 3 + [ctypes.c_double] * 2 + [pointer, _UPDATE, pointer,
                                                                                       pointer]
         library.posture_fail.argtypes = [pointer, ctypes.c_char_p]
-        inputs, outputs = getattr(self, "_last", (np.zeros(n_inputs), np.zeros(len(self.outputs))))
+        inputs, outputs = self._last
         component = library.posture_new(n, int(self.step_over is not None), int(self.control), self.period,
                                         self.loops.next_update, shared.ctypes.data, callback, doubles(inputs),
                                         doubles(outputs))
