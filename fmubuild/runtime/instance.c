@@ -451,27 +451,17 @@ static int input_gain(Instance *c) {
     return 0;
 }
 
-enum { INPUTS_CHANGE, INPUTS_AFFINE, INPUTS_SAME };
-
-/* What setting ``vr`` to ``value`` changes: nothing the model reads (INPUTS_SAME: inputs set to the
- * bits they have, as a host that sends every input each step does); only inputs the derivatives
- * are affine in, with the Co-Simulation integrator's derivatives known at the current point and
- * no input interpolated (INPUTS_AFFINE: rc_set_real updates them, saving the evaluation the next
- * step would begin with: a controller changes the motor torques every step); else INPUTS_CHANGE. */
-static int input_change(Instance *c, const unsigned int vr[], size_t nvr, const double value[]) {
-    int affine = 0;
+/* Whether setting ``vr`` keeps the Co-Simulation integrator's derivatives at the current point
+ * (updated for the change, rc_set_real): every one an input the derivatives are affine in, the
+ * derivatives known at the current point and no input interpolated. Saves the evaluation the
+ * next step would begin with: a controller changes the motor torques every step. */
+static int keeps_derivatives(Instance *c, const unsigned int vr[], size_t nvr) {
+    if (c->kind != KIND_CO_SIMULATION || c->mode != MODE_STEP || !c->solver.f0_valid || c->interpolating) return 0;
     for (size_t i = 0; i < nvr; i++) {
         int r = real_index(vr[i]);
-        if (!(r >= off_u() && r < off_y())) return INPUTS_CHANGE;
-        if (memcmp(&value[i], &c->u[r - off_u()], sizeof(double)) == 0) continue;
-        if (!model_info.u_affine[r - off_u()]) return INPUTS_CHANGE;
-        affine = 1;
+        if (!(r >= off_u() && r < off_y() && model_info.u_affine[r - off_u()])) return 0;
     }
-    if (!affine) return INPUTS_SAME;
-    if (c->kind != KIND_CO_SIMULATION || c->mode != MODE_STEP || !c->solver.f0_valid || c->interpolating ||
-        input_gain(c) != 0)
-        return INPUTS_CHANGE;
-    return INPUTS_AFFINE;
+    return input_gain(c) == 0;
 }
 
 Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, const double value[]) {
@@ -485,8 +475,7 @@ Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, cons
         const char *refusal = set_real_refusal(c, r, value[i]);
         if (refusal) return rc_fail(c, f, REJECTED, "%s = %g: %s", real_name(vr[i]), value[i], refusal);
     }
-    int change = nvr > 0 ? input_change(c, vr, nvr, value) : INPUTS_SAME;
-    int keep = change == INPUTS_AFFINE;
+    int keep = nvr > 0 && keeps_derivatives(c, vr, nvr);
     for (size_t i = 0; i < nvr; i++) {
         int r = real_index(vr[i]);
         if (r < off_x()) { c->p[r] = value[i]; rc_forget_evaluation(c); }
@@ -505,7 +494,7 @@ Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, cons
         c->xdot_valid = 0;
         c->y_valid = 0;
         c->f0_updated = 1;
-    } else if (change == INPUTS_CHANGE) rc_invalidate(c);
+    } else if (nvr > 0) rc_invalidate(c);
     return STATUS_OK;
 }
 
