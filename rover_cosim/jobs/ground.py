@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import ctypes
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -63,18 +64,9 @@ class _HubBlock:
         it cannot be compiled."""
         if len(self.x_hub) != TWIN_HUBS:
             return None
-        library = native_code.load_library(source)
-        if isinstance(library, str):
-            return None
-        new = getattr(library, f"{prefix}_new")
-        new.restype = ctypes.c_void_p
-        new.argtypes = [*map_types, ctypes.c_void_p, ctypes.c_void_p]
         now = getattr(self, "last", None)
-        component = new(*map_arguments, doubles([self.x_hub, self.y_hub]),
-                        doubles(now if now is not None else np.zeros(len(self.outputs))))
-        if not component:
-            raise MemoryError(f"block {self.name!r}: its C twin could not be made (bad sizes or out of memory)")
-        return native_code.NativeBlock(library, component, prefix)
+        return _twin(self.name, source, prefix, f"{prefix}_new", map_types, map_arguments,
+                     np.concatenate([self.x_hub, self.y_hub]), now if now is not None else np.zeros(len(self.outputs)))
 
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
         self.last = self.values(u0)
@@ -178,8 +170,9 @@ class LimbSoilBlock:
                                    np.asarray(u[3 + n:3 + 2 * n], float))
 
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
-        self.last = (np.array(u0, float), self.shares(u0))
-        return self.last[1]
+        self.start_hubs = np.array(u0[3:3 + 2 * self.hubs], float)  # the twin starts from them
+        self.last = self.shares(u0)
+        return self.last
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         return self.shares(u)
@@ -190,15 +183,23 @@ class LimbSoilBlock:
         compiled (the block then steps in Python)."""
         if self.hubs != TWIN_HUBS:
             return None
-        library = native_code.load_library(SOIL_C_SOURCE)
-        if isinstance(library, str):
-            return None
-        library.soil_new_limbs.restype = ctypes.c_void_p
-        library.soil_new_limbs.argtypes = [ctypes.c_int] * 2 + [ctypes.c_void_p] * 5
-        inputs, shares = getattr(self, "last", (np.zeros(len(self.inputs)), np.zeros(self.hubs)))
         grid = self.map.grid
-        component = library.soil_new_limbs(grid.x.size, grid.y.size, doubles(grid.x), doubles(grid.y),
-                                           doubles(grid.heights), doubles(inputs[3:]), doubles(shares))
-        if not component:
-            raise MemoryError(f"block {self.name!r}: its C twin could not be made (bad sizes or out of memory)")
-        return native_code.NativeBlock(library, component, "soil")
+        return _twin(self.name, SOIL_C_SOURCE, "soil", "soil_new_limbs", [ctypes.c_int] * 2 + [ctypes.c_void_p] * 3,
+                     (grid.x.size, grid.y.size, doubles(grid.x), doubles(grid.y), doubles(grid.heights)),
+                     getattr(self, "start_hubs", np.zeros(2 * self.hubs)), getattr(self, "last", np.zeros(self.hubs)))
+
+
+def _twin(name: str, source: Path, prefix: str, constructor: str, map_types: list[Any], map_arguments: Sequence[Any],
+          hubs: np.ndarray, now: np.ndarray) -> native_code.NativeBlock | None:
+    """The C twin made by ``constructor(map_arguments..., hubs, outputs now)`` of ``source``
+    (functions ``<prefix>_...``) for block ``name``; None where it cannot be compiled."""
+    library = native_code.load_library(source)
+    if isinstance(library, str):
+        return None
+    new = getattr(library, constructor)
+    new.restype = ctypes.c_void_p
+    new.argtypes = [*map_types, ctypes.c_void_p, ctypes.c_void_p]
+    component = new(*map_arguments, doubles(hubs), doubles(now))
+    if not component:
+        raise MemoryError(f"block {name!r}: its C twin could not be made (bad sizes or out of memory)")
+    return native_code.NativeBlock(library, component, prefix)
