@@ -62,8 +62,11 @@ class Campaign:
         workers = min(workers or cores(), len(systems))
         if workers <= 1:
             return {key: self.run(key, system) for key, system in systems.items()}
-        # a system that cannot travel to a worker (a block holding a local function) runs here first
-        here = [key for key, system in systems.items() if not _travels(system)]
+        # each system as it travels to a worker (pickled once, on one stepper thread: the runs share
+        # the cores); one that cannot (a block holding a local function) runs here first
+        packed = {key: _packed(dataclasses.replace(system, threads_setting=system.threads_setting or 1))
+                  for key, system in systems.items()}
+        here = [key for key in systems if packed[key] is None]
         done: dict[str, RunResult] = {key: self.run(key, systems[key]) for key in here}
         away = {key: system for key, system in systems.items() if key not in here}
         if len(away) < 2:
@@ -73,8 +76,7 @@ class Campaign:
         stage = {key: first + k for k, key in enumerate(away)}
         for key, system in away.items():
             self.systems[key] = system_record(system)
-        arguments = [(key, dataclasses.replace(system, threads_setting=system.threads_setting or 1))
-                     for key, system in away.items()]
+        arguments = [(key, packed[key]) for key in away]
 
         def lost(arguments: tuple[Any, ...], reason: str) -> Any:
             raise RunError(f"run {arguments[0]!r}: {reason}")
@@ -127,17 +129,17 @@ class Campaign:
         return sorted(files)
 
 
-def _travels(system: System) -> bool:
-    """Whether ``system`` can be sent to a worker process (pickled)."""
+def _packed(system: System) -> bytes | None:
+    """``system`` pickled for a worker process, or None where it cannot be."""
     try:
-        pickle.dumps(system)
+        return pickle.dumps(system)
     except (pickle.PicklingError, AttributeError, TypeError):
-        return False
-    return True
+        return None
 
 
-def _run_one(key: str, system: System) -> tuple[str, RunResult | str, System | None]:
+def _run_one(key: str, packed: bytes) -> tuple[str, RunResult | str, System | None]:
     """In a worker: (key, the run's result or its RunError's message, the system after the run)."""
+    system = pickle.loads(packed)
     try:
         return key, run(system), system
     except RunError as error:
