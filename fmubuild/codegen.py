@@ -8,7 +8,8 @@ Generated per model (the runtime in ``fmubuild/runtime`` is the same for all):
   evaluation), ``model_initial``,
   ``model_ode_jacobian`` (dense df/dx and df/dt, for the Co-Simulation integrator) and
   ``model_directional`` (forward directional derivatives of derivatives and observed variables,
-  for ``fmi2GetDirectionalDerivative``);
+  for ``fmi2GetDirectionalDerivative``) and ``model_input_gain`` (d xdot / d u of the inputs the
+  derivatives are affine in, :func:`affine_inputs`);
 - ``model_data.c``: the ``ModelInfo`` of ``runtime/model.h`` (sizes, defaults, names, GUID).
 
 Real value references follow ``runtime/model.h``: parameters, states, derivatives, inputs, observed
@@ -89,7 +90,7 @@ class ModelLayout:
     state_starts: list[float]  # start of every state at the default parameters (calculated ones too)
 
 
-def _functions(model: OdeModel) -> list[ca.Function]:
+def _functions(model: OdeModel, u_affine: list[int]) -> list[ca.Function]:
     t, x, u, p, m = model.t, model.x, model.u, model.p, model.m
     dx = ca.MX.sym("dx", x.numel())
     du = ca.MX.sym("du", u.numel())
@@ -118,7 +119,30 @@ def _functions(model: OdeModel) -> list[ca.Function]:
         ca.Function("model_directional", [t, x, u, p, m, dx, du],
                     [ca.densify(sensitivity[:nx]), ca.densify(sensitivity[nx:])],
                     ["t", "x", "u", "p", "m", "dx", "du"], ["dxdot", "dy"]),
+        _input_gain(model, xdot_d, u_affine),
     ]
+
+
+def _input_gain(model: OdeModel, xdot: ca.MX, u_affine: list[int]) -> ca.Function:
+    """``model_input_gain(t, x, u, p, m) -> gain``: d xdot / d u [nx x nu, column-major, dense] in
+    the columns of the inputs the derivatives are affine in (0 in the others), for the runtime's
+    update of the derivatives when only those change (instance.c: input_gain). Those columns read
+    only the parameters and the other inputs: expanded to scalar operations they are a few hundred
+    (LegWheelRover: 454 against the 22,228 of the graph's Jacobian), so the runtime takes the gain
+    again cheaply whenever a set-point it reads has moved."""
+    t, x, u, p, m = model.t, model.x, model.u, model.p, model.m
+    nx, nu = x.numel(), u.numel()
+    if nx and nu and any(u_affine):
+        jacobian = ca.jacobian(xdot, u)
+        gain = ca.horzcat(*[jacobian[:, j] if u_affine[j] else ca.MX(nx, 1) for j in range(nu)])
+    else:
+        gain = ca.MX(nx, nu)
+    function = ca.Function("model_input_gain", [t, x, u, p, m], [ca.densify(gain)],
+                           ["t", "x", "u", "p", "m"], ["gain"])
+    try:
+        return function.expand()
+    except RuntimeError:  # a node that has no scalar form: the graph's Jacobian, as correct, slower
+        return function
 
 
 def affine_inputs(model: OdeModel) -> list[int]:
@@ -263,7 +287,8 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path, *
     directory.mkdir(parents=True, exist_ok=True)
     generator = ca.CodeGenerator("model_casadi.c", {"with_export": False, "with_header": False,
                                                      "casadi_int": "long long int", "casadi_real": "double"})
-    for function in _functions(model):
+    u_affine = affine_inputs(model)
+    for function in _functions(model, u_affine):
         generator.add(function)
     # Each branch of a run-time if computed only when taken (fmubuild.guards).
     code, _ = guard_generated_code(generator.dump())
@@ -290,7 +315,6 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path, *
     calculated = [1 if v.initial == "calculated" else 0 for v in states]
     memory_source = [model.observed.index(source) for source in model.memory_sources]
     y_is_output = [1 if v.causality == "output" else 0 for v in by_kind.get("observed", [])]
-    u_affine = affine_inputs(model)
     names = ",\n    ".join(_c_string(v.name) for v in model_layout.variables)
     asserts = model.asserts
     value_start = [0]

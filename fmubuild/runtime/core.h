@@ -71,8 +71,11 @@ struct Instance {
     double rtol, max_step;
     int xdot_valid, y_valid;
     /* Input interpolation over one communication step (input derivatives, order 1):
-     * u(t) = u + u_der (t - t_step) while interpolating; cleared after each step. */
-    double *u_der, *u_step, t_step;
+     * u(t) = u + u_der (t - t_step) while interpolating; cleared after each step. At the end of
+     * the step being taken, t_step + h_step, the time elapsed is h_step itself: the inputs end
+     * the step at u + u_der h, the arithmetic of the master's u_der = (u_end - u) / h, so that
+     * they are the bits it sets next (mostly: see cosim.c). h_step is 0 outside a step. */
+    double *u_der, *u_step, t_step, h_step;
     int interpolating;
     /* CasADi work */
     const double **arg;
@@ -134,6 +137,8 @@ Status rc_enter_initialization(Instance *c);
 Status rc_exit_initialization(Instance *c, int f);
 Status rc_terminate(Instance *c);
 void rc_invalidate(Instance *c);        /* outputs and derivatives to be evaluated again */
+/* The inputs at t: the held values, or their linear interpolation within the step (u_step). */
+const double *rc_inputs_at(Instance *c, double t);
 void rc_forget_evaluation(Instance *c); /* the last evaluation is no longer reused (parameters changed) */
 void rc_remember(Instance *c);          /* after a completed step: the memories take their values */
 /* Outputs (need_y) and derivatives (need_xdot) at the current point, with the asserts. */

@@ -2,6 +2,7 @@
  * with inputs held or interpolated linearly over it. */
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "core.h"
 
@@ -30,7 +31,8 @@ Status rc_set_input_derivatives(Instance *c, int f, const unsigned int vr[], siz
     c->t_step = c->t;  /* the inputs' values hold at the current time (the start time before the first step) */
     c->interpolating = 0;
     for (int i = 0; i < model_info.nu; i++) c->interpolating |= c->u_der[i] != 0.0;
-    rc_invalidate(c);
+    /* The inputs' values at the current point are unchanged: so are the derivatives and outputs
+     * known there (the integrator's first stage among them). */
     return STATUS_OK;
 }
 
@@ -53,17 +55,24 @@ Status rc_do_step(Instance *c, int f, double currentCommunicationPoint, double c
     char message[512];
     double t = currentCommunicationPoint;
     c->t_step = currentCommunicationPoint;
+    c->h_step = communicationStepSize;
     if (c->f0_updated && c->solver.f0_valid) c->eval.updated++; /* begun from updated derivatives */
     c->f0_updated = 0;
     int status = ode23s_integrate(&c->solver, &t, c->x, t_end, message, sizeof message);
     c->t = t;
     c->xdot_valid = 0;
     c->y_valid = 0;
-    if (c->interpolating) { /* the inputs now hold their values at the step's end */
-        for (int i = 0; i < model_info.nu; i++) { c->u[i] += c->u_der[i] * (t - c->t_step); c->u_der[i] = 0.0; }
+    if (c->interpolating) {
+        /* The inputs now hold their values at the step's end: those its last stage was evaluated
+         * with (rc_inputs_at(t): the same bits), so the integrator's derivatives there stay
+         * valid, and an input set next to the bits it has changes nothing (rc_set_real). The
+         * gain of the affine inputs may read the inputs that moved: taken again when needed. */
+        memcpy(c->u, rc_inputs_at(c, t), sizeof(double) * (size_t)model_info.nu);
+        for (int i = 0; i < model_info.nu; i++) c->u_der[i] = 0.0;
         c->interpolating = 0;
-        c->solver.f0_valid = 0;
+        c->gain_valid = 0;
     }
+    c->h_step = 0.0;
     if (status != 0) return rc_fail(c, F, BROKEN, "integration failed: %s", message);
     c->t = t_end;
     Status checked = rc_update(c, F, 0, 1); /* the outputs at t_end, and with them the asserts */

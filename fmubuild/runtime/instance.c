@@ -66,9 +66,10 @@ Status rc_set_debug_logging(Instance *c, int f, int on, size_t n, const char *co
 
 /* ---- model evaluation ------------------------------------------------------------------- */
 /* The inputs at time t: the held values, or their linear interpolation within the step. */
-static const double *inputs_at(Instance *c, double t) {
+const double *rc_inputs_at(Instance *c, double t) {
     if (!c->interpolating) return c->u;
-    for (int i = 0; i < model_info.nu; i++) c->u_step[i] = c->u[i] + c->u_der[i] * (t - c->t_step);
+    double elapsed = c->h_step > 0.0 && t == c->t_step + c->h_step ? c->h_step : t - c->t_step;
+    for (int i = 0; i < model_info.nu; i++) c->u_step[i] = c->u[i] + c->u_der[i] * elapsed;
     return c->u_step;
 }
 
@@ -83,7 +84,7 @@ static int same(const double *a, const double *b, int n) {
  * last stage, and the next step starts from them when the inputs did not change. Parameters
  * change only through calls that clear it (forget_evaluation). */
 static int evaluate(Instance *c, double t, const double *x) {
-    const double *u = inputs_at(c, t);
+    const double *u = rc_inputs_at(c, t);
     Evaluation *e = &c->eval;
     if (e->valid && e->t == t && same(e->x, x, model_info.nx) && same(e->u, u, model_info.nu) &&
         same(e->m, c->m, model_info.nm)) {
@@ -122,7 +123,7 @@ static int rhs(void *ctx, double t, const double *x, double *xdot) {
 
 static int jacobian(void *ctx, double t, const double *x, double *dfdx, double *dfdt) {
     Instance *c = ctx;
-    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = inputs_at(c, t); c->arg[3] = c->p; c->arg[4] = c->m;
+    c->arg[0] = &t; c->arg[1] = x; c->arg[2] = rc_inputs_at(c, t); c->arg[3] = c->p; c->arg[4] = c->m;
     c->res[0] = dfdx; c->res[1] = dfdt;
     return model_ode_jacobian(c->arg, c->res, c->iw, c->w, 0);
 }
@@ -236,6 +237,7 @@ static void set_defaults(Instance *c) {
     c->solver.steps = c->solver.rejected = c->solver.jacobians = c->solver.rhs_calls = 0;
     c->eval.evaluations = c->eval.reused = 0;
     c->t_step = 0.0;
+    c->h_step = 0.0;
     rc_forget_evaluation(c);
     rc_invalidate(c);
 }
@@ -252,7 +254,7 @@ void rc_free(Instance *c) {
 }
 
 static casadi_work const WORKS[] = {model_evaluate_work, model_initial_work,
-                                    model_ode_jacobian_work, model_directional_work};
+                                    model_ode_jacobian_work, model_directional_work, model_input_gain_work};
 
 static int allocate_work(Instance *c) {
     casadi_int sz_arg = 7, sz_res = 4, sz_iw = 0, sz_w = 0;
@@ -431,37 +433,48 @@ static const char *set_real_refusal(const Instance *c, int r, double value) {
     return NULL;
 }
 
-/* The columns of d xdot / d u of the affine inputs (model_info.u_affine) where the other inputs
- * and the parameters are now, by model_directional (for those inputs a function of the
- * parameters and the other inputs only); 0 on success. */
+/* d xdot / d u in the columns of the affine inputs (model_info.u_affine) where the other inputs
+ * and the parameters are now (model_input_gain: for those inputs a function of the parameters and
+ * the other inputs only, a few hundred operations); 0 on success. */
 static int input_gain(Instance *c) {
     if (c->gain_valid) return 0;
     double t = c->t;
-    for (int j = 0; j < model_info.nu; j++) {
-        if (!model_info.u_affine[j]) continue;
-        for (int k = 0; k < model_info.nx; k++) c->seed_x[k] = 0.0;
-        for (int k = 0; k < model_info.nu; k++) c->seed_u[k] = k == j ? 1.0 : 0.0;
-        c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->m;
-        c->arg[5] = c->seed_x; c->arg[6] = c->seed_u;
-        c->res[0] = c->sens_x; c->res[1] = c->sens_y;
-        if (model_directional(c->arg, c->res, c->iw, c->w, 0) || !all_finite(c->sens_x, model_info.nx)) return -1;
-        memcpy(c->gain + (size_t)model_info.nx * j, c->sens_x, sizeof(double) * (size_t)model_info.nx);
-    }
+    c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->m;
+    c->res[0] = c->gain;
+    if (model_input_gain(c->arg, c->res, c->iw, c->w, 0) || !all_finite(c->gain, model_info.nx * model_info.nu))
+        return -1;
     c->gain_valid = 1;
     return 0;
 }
 
-/* Whether setting ``vr`` keeps the Co-Simulation integrator's derivatives at the current point
- * (updated for the change, rc_set_real): every one an input the derivatives are affine in, the
- * derivatives known at the current point and no input interpolated. Saves the evaluation the
- * next step would begin with: a controller changes the motor torques every step. */
-static int keeps_derivatives(Instance *c, const unsigned int vr[], size_t nvr) {
-    if (c->kind != KIND_CO_SIMULATION || c->mode != MODE_STEP || !c->solver.f0_valid || c->interpolating) return 0;
+/* Whether the value of input ``j`` would change (any bit: -0.0 and 0.0 differ) by ``value``. */
+static int changes_input(Instance *c, int j, double value) {
+    return memcmp(&c->u[j], &value, sizeof value) != 0;
+}
+
+/* Whether setting ``vr`` to ``value`` keeps the Co-Simulation integrator's derivatives at the
+ * current point (updated for the change, rc_set_real): every one an input set to the bits it has
+ * or one the derivatives are affine in, and the derivatives known at the current point (input
+ * derivatives set for the next step do not change them there). Saves the evaluation the next step
+ * would begin with: a controller changes the motor torques every step, and set-points ramped over
+ * a step end it where they are set next. */
+static int keeps_derivatives(Instance *c, const unsigned int vr[], size_t nvr, const double value[]) {
+    if (c->kind != KIND_CO_SIMULATION || c->mode != MODE_STEP || !c->solver.f0_valid) return 0;
     for (size_t i = 0; i < nvr; i++) {
         int r = real_index(vr[i]);
-        if (!(r >= off_u() && r < off_y() && model_info.u_affine[r - off_u()])) return 0;
+        if (!(r >= off_u() && r < off_y())) return 0;
+        if (!model_info.u_affine[r - off_u()] && changes_input(c, r - off_u(), value[i])) return 0;
     }
     return input_gain(c) == 0;
+}
+
+/* Whether setting ``vr`` to ``value`` changes nothing: inputs only, each set to the bits it has. */
+static int changes_nothing(Instance *c, const unsigned int vr[], size_t nvr, const double value[]) {
+    for (size_t i = 0; i < nvr; i++) {
+        int r = real_index(vr[i]);
+        if (!(r >= off_u() && r < off_y()) || changes_input(c, r - off_u(), value[i])) return 0;
+    }
+    return 1;
 }
 
 Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, const double value[]) {
@@ -475,7 +488,8 @@ Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, cons
         const char *refusal = set_real_refusal(c, r, value[i]);
         if (refusal) return rc_fail(c, f, REJECTED, "%s = %g: %s", real_name(vr[i]), value[i], refusal);
     }
-    int keep = nvr > 0 && keeps_derivatives(c, vr, nvr);
+    if (changes_nothing(c, vr, nvr, value)) return STATUS_OK;
+    int keep = keeps_derivatives(c, vr, nvr, value);
     for (size_t i = 0; i < nvr; i++) {
         int r = real_index(vr[i]);
         if (r < off_x()) { c->p[r] = value[i]; rc_forget_evaluation(c); }
@@ -494,7 +508,7 @@ Status rc_set_real(Instance *c, int f, const unsigned int vr[], size_t nvr, cons
         c->xdot_valid = 0;
         c->y_valid = 0;
         c->f0_updated = 1;
-    } else if (nvr > 0) rc_invalidate(c);
+    } else rc_invalidate(c);
     return STATUS_OK;
 }
 

@@ -39,8 +39,9 @@ typedef struct {
     const int *m_source;              /* [nm] index into y of the variable each one remembers */
     const int *y_is_output;           /* [ny] 1: an output (causality output), 0: a local variable */
     const int *u_affine;              /* [nu] 1: the derivatives are affine in this input (d xdot/du a
-                                       * function of the parameters only: the runtime updates them for
-                                       * its change instead of evaluating again) */
+                                       * function of the parameters and the other inputs only: the
+                                       * runtime updates them for its change instead of evaluating
+                                       * again, with model_input_gain) */
 } ModelInfo;
 
 extern const ModelInfo model_info;
@@ -64,5 +65,9 @@ int model_ode_jacobian_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *
 /* model_directional(t, x, u, p, m, dx, du) -> (dxdot, dy): forward directional derivatives */
 int model_directional(const double **arg, double **res, casadi_int *iw, double *w, int mem);
 int model_directional_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
+/* model_input_gain(t, x, u, p, m) -> (gain [nx*nu, column-major, dense]): d xdot / d u in the
+ * columns of the inputs marked u_affine, 0 in the others (those columns read neither t, x nor m) */
+int model_input_gain(const double **arg, double **res, casadi_int *iw, double *w, int mem);
+int model_input_gain_work(casadi_int *sz_arg, casadi_int *sz_res, casadi_int *sz_iw, casadi_int *sz_w);
 
 #endif
