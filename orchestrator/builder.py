@@ -125,10 +125,29 @@ def read_fmu(fmu_path: Path, where: str, validation: str = "strict") -> tuple[An
     return description, problems
 
 
+#: Model descriptions read, by the FMU file (its path, inode, modification time and size) and the
+#: validation: a job builds many systems of one FMU (the leg-wheel scenarios read LegWheelRover's
+#: 2,183 variables nine times), and a Monte Carlo study one per run. The descriptions are not
+#: changed by their readers.
+_READ: dict[tuple[Any, ...], tuple[Any, tuple[str, ...]]] = {}
+_READ_KEPT = 64
+
+
 def _description(fmu_path: Path, where: str, validation: str) -> tuple[Any, tuple[str, ...]]:
-    """FMPy's reading of the model description, checked as ``validation`` says (``read_fmu``)."""
+    """FMPy's reading of the model description, checked as ``validation`` says (``read_fmu``);
+    read once per version of the file."""
     if validation not in VALIDATION:
         raise SystemFileError(f"{where}: validation = {validation!r}: expected one of {', '.join(VALIDATION)}")
+    status = fmu_path.stat()
+    key = (str(fmu_path.resolve()), status.st_ino, status.st_mtime_ns, status.st_size, validation)
+    if key not in _READ:
+        if len(_READ) >= _READ_KEPT:
+            _READ.pop(next(iter(_READ)))
+        _READ[key] = _read_description(fmu_path, where, validation)
+    return _READ[key]
+
+
+def _read_description(fmu_path: Path, where: str, validation: str) -> tuple[Any, tuple[str, ...]]:
     problem = _structure_problem(fmu_path)
     if problem:  # FMPy reads index 0 as the last variable, and fails on one past the end with "list index ..."
         raise SystemFileError(f"{where}: {fmu_path.name}: its modelDescription.xml: {problem}")

@@ -270,3 +270,30 @@ def test_an_angle_may_be_given_in_degrees_as_set_takes_it(fmu_dir, fmus):
     assert system.fmus[0].parameters["soil.phi"] == math.radians(35.0)
     with pytest.raises(SystemFileError, match="expected a number of degrees"):
         SystemBuilder("bad").add_fmu("w", fmu_dir / "SingleWheel.fmu", parameters={"soil.phi_deg": "35"})
+
+
+def test_an_fmus_description_is_read_once_per_version_of_its_file(fmus, tmp_path, monkeypatch):
+    """Systems built on one FMU share its reading (a job builds many); a file replaced is read again."""
+    import shutil
+
+    import fmpy
+
+    from rover_cosim.orchestrator import builder
+
+    reads: list[str] = []
+    original = fmpy.read_model_description
+
+    def counted(filename: str, *args: Any, **kwargs: Any) -> Any:
+        reads.append(filename)
+        return original(filename, *args, **kwargs)
+
+    monkeypatch.setattr(builder.fmpy, "read_model_description", counted)
+    fmu = tmp_path / "Wheel.fmu"
+    shutil.copy(fmus["Wheel"], fmu)
+    first = builder.read_fmu(fmu, "a")[0]
+    assert builder.read_fmu(fmu, "b")[0] is first and len(reads) == 1
+    replaced = tmp_path / "other.fmu"
+    shutil.copy(fmus["RoverBody"], replaced)
+    replaced.replace(fmu)  # another FMU under the same name
+    again = builder.read_fmu(fmu, "c")[0]
+    assert len(reads) == 2 and again.modelName != first.modelName
