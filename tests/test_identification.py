@@ -177,3 +177,33 @@ def test_model_json_round_trips(out):
         restored = IdentifiedModel.from_dict(data)
         assert restored.degree == {"linear": 1, "quadratic": 2}[label]
         assert np.isfinite(restored.fx(575.0, 0.05)) and restored.gain_at(575.0, 20.0) > 0
+
+
+def test_the_test_bed_steps_natively_to_the_bits_of_its_python_loop(single_wheel, monkeypatch):
+    """Between level changes the bed's samples are stepped by the native stepper: the same FMI calls
+    as its Python loop (a staircase of torques and a turning track: several stretches), the same
+    rows to the bit."""
+    import math
+
+    from rover_cosim.identification.testbed import Staircase, WheelTestBed
+    from rover_cosim.orchestrator import native
+
+    if native.unavailable_reason() is not None:
+        pytest.skip(str(native.unavailable_reason()))
+    torque = Staircase.staircase((10.0, 40.0, 25.0), 0.05)
+    track = Staircase((0.0, 0.07), (0.0, math.radians(5.0)))
+    bed = WheelTestBed(single_wheel)
+    stretches: list[tuple[int, int]] = []
+    steps = bed._steps
+
+    def counted(stepper, times, first, last, h, rows):
+        stretches.append((first, last))
+        return steps(stepper, times, first, last, h, rows)
+
+    monkeypatch.setattr(bed, "_steps", counted)
+    natively = bed.run(575.0, torque, 0.15, 1e-4, start_speed=0.1, track_angle=track)
+    assert stretches == [(0, 500), (500, 700), (700, 1000), (1000, 1500)]
+    monkeypatch.setattr(native, "unavailable_reason", lambda: "switched off by the test")
+    in_python = bed.run(575.0, torque, 0.15, 1e-4, start_speed=0.1, track_angle=track)
+    pd.testing.assert_frame_equal(natively, in_python, check_exact=True)
+    assert natively["beta"].iloc[-1] != natively["beta"].iloc[100]  # the track turned

@@ -75,7 +75,8 @@ def _declare(library: ctypes.CDLL) -> ctypes.CDLL:
     library.stepper_group.restype = integer
     library.stepper_group.argtypes = [pointer, pointer, integer, real, real]
     library.stepper_run.restype = integer
-    library.stepper_run.argtypes = [pointer, pointer, pointer, integer, integer, pointer, integer, pointer, pointer]
+    library.stepper_run.argtypes = [pointer, pointer, pointer, integer, integer, real, pointer, integer, pointer,
+                                    pointer]
     library.stepper_ramp.restype = integer
     library.stepper_ramp.argtypes = [pointer, integer, pointer, pointer]
     library.stepper_mark.restype = None
@@ -296,11 +297,12 @@ class NativeStepper:
         return self._check(self.library.stepper_step(self._handle, _pointer(values), t, h), t)
 
     def run(self, values: np.ndarray, times: np.ndarray, first: int, last: int, record: np.ndarray,
-            rows: np.ndarray) -> int:
-        """Steps ``first`` .. ``last`` - 1, recording ``values[record]`` in ``rows[k + 1]``; returns
-        -1, or the unit that produced a non-finite output (values hold them; the caller names it),
-        raising the other failures. ``self.reached``: the steps completed."""
-        failed = self.library.stepper_run(self._handle, _pointer(values), _pointer(times), first, last,
+            rows: np.ndarray, h: float = 0.0) -> int:
+        """Steps ``first`` .. ``last`` - 1 (from ``times[k]`` to ``times[k + 1]``, or by ``h`` [s]
+        when > 0), recording ``values[record]`` in ``rows[k + 1]``; returns -1, or the unit that
+        produced a non-finite output (values hold them; the caller names it), raising the other
+        failures. ``self.reached``: the steps completed."""
+        failed = self.library.stepper_run(self._handle, _pointer(values), _pointer(times), first, last, h,
                                           _pointer(record), record.size, _pointer(rows), ctypes.byref(self._reached))
         return self._check(failed, float(times[min(self._reached.value, len(times) - 1)]))
 

@@ -268,13 +268,14 @@ int stepper_step(Stepper *s, double *values, double t, double h) {
     return -1;
 }
 
-/* Steps k = first .. last - 1 from times[k] to times[k + 1], recording the slots ``record`` of
- * the value vector after step k into row k + 1 of ``rows``. Returns -1, or the failed unit; the
- * step reached is in *reached (the number of steps completed). */
-int stepper_run(Stepper *s, double *values, const double *times, int first, int last, const long long *record,
-                int n_record, double *rows, int *reached) {
+/* Steps k = first .. last - 1 from times[k] to times[k + 1] (``h`` > 0: steps of h from times[k],
+ * as a caller stepping by a fixed size does), recording the slots ``record`` of the value vector
+ * after step k into row k + 1 of ``rows``. Returns -1, or the failed unit; the step reached is in
+ * *reached (the number of steps completed). */
+int stepper_run(Stepper *s, double *values, const double *times, int first, int last, double h,
+                const long long *record, int n_record, double *rows, int *reached) {
     for (int k = first; k < last; k++) {
-        int failed = stepper_step(s, values, times[k], times[k + 1] - times[k]);
+        int failed = stepper_step(s, values, times[k], h > 0.0 ? h : times[k + 1] - times[k]);
         *reached = k;
         if (failed >= 0) return failed;
         double *row = rows + (size_t)(k + 1) * (size_t)n_record;
