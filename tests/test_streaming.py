@@ -16,9 +16,19 @@ from integrator_fmu import build_integrator
 from misbehave_fmu import MODES, build_misbehave
 
 from rover_cosim.cli import main
-from rover_cosim.orchestrator import SystemBuilder, run
-from rover_cosim.orchestrator.recorder import CHUNK_ROWS
+from rover_cosim.orchestrator import SystemBuilder, recorder, run
 from rover_cosim.orchestrator.runs import table_bytes
+
+
+#: Rows per chunk in these tests: the recorder's own 8,192 asked for runs of 16,500 steps (5 s
+#: through a process-isolated FMU); chunking does not depend on the size.
+CHUNK_ROWS = 600
+
+
+@pytest.fixture(autouse=True)
+def small_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert recorder.CHUNK_ROWS > CHUNK_ROWS
+    monkeypatch.setattr(recorder, "CHUNK_ROWS", CHUNK_ROWS)
 
 
 @pytest.fixture(scope="module")
