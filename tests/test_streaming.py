@@ -19,7 +19,6 @@ from rover_cosim.cli import main
 from rover_cosim.orchestrator import SystemBuilder, recorder, run
 from rover_cosim.orchestrator.runs import table_bytes
 
-
 #: Rows per chunk in these tests: the recorder's own 8,192 asked for runs of 16,500 steps (5 s
 #: through a process-isolated FMU); chunking does not depend on the size.
 CHUNK_ROWS = 600
