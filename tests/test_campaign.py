@@ -104,3 +104,23 @@ def test_figures_drawn_side_by_side_are_the_figures_drawn_one_after_the_other():
     assert drawn(figures, workers=2) == drawn(figures, workers=1)
     assert list(drawn(figures, workers=2)) == list(figures)
     assert multiprocessing.active_children() == []
+
+
+def test_the_longest_runs_go_to_the_workers_first_and_the_results_keep_the_systems_order(fmus, monkeypatch):
+    from rover_cosim.jobs import campaign as campaign_module
+
+    dispatched: list[str] = []
+    real = campaign_module.parallel_map
+
+    def spy(function, arguments, *args, **kwargs):
+        dispatched.extend(key for key, _ in arguments)
+        return real(function, arguments, *args, **kwargs)
+
+    monkeypatch.setattr(campaign_module, "parallel_map", spy)
+    systems = {f"t{k}": wheel(fmus, k) for k in (10.0, 20.0, 30.0, 40.0)}
+    campaign = Campaign("test", len(systems))
+    together = campaign.run_all(systems, workers=2, longest=("t40.0", "t20.0"))
+    assert dispatched == ["t40.0", "t20.0", "t10.0", "t30.0"]
+    assert list(together) == list(campaign.ran) == list(campaign.systems) == list(systems)
+    with pytest.raises(ValueError, match=r"longest runs \['t50.0'\]: not among the systems"):
+        Campaign("test", 1).run_all(systems, workers=1, longest=("t50.0",))

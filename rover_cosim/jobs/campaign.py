@@ -18,7 +18,7 @@ import dataclasses
 import math
 import pickle
 import time
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -51,14 +51,20 @@ class Campaign:
         self.walls[key] = outcome.wall_seconds
         return outcome
 
-    def run_all(self, systems: Mapping[str, System], workers: int | None = None) -> dict[str, RunResult]:
+    def run_all(self, systems: Mapping[str, System], workers: int | None = None,
+                longest: Sequence[str] = ()) -> dict[str, RunResult]:
         """Run every system (recorded under its key), independent runs side by side in ``workers``
-        processes (default: the cores; one, or a single system: one after the other here). Each
+        processes (default: the cores; one, or a single system: one after the other here), the
+        keys ``longest`` given to the workers first (a long run started last finishes last, alone:
+        the job knows its long runs), the results and the record in the order of ``systems``. Each
         runs as it would alone, bit for bit (a run in a worker steps its FMUs on one thread: the
         runs share the cores); a block's state after its run (a report) is in ``self.ran[key]``,
         the system that ran. A system that cannot be sent to a worker (a block holding a local
         function: the adaptive controller) runs here first. The first run that fails raises its
         RunError (the others are ended)."""
+        unknown = [key for key in longest if key not in systems]
+        if unknown:
+            raise ValueError(f"longest runs {unknown}: not among the systems {list(systems)}")
         workers = min(workers or cores(), len(systems))
         if workers <= 1:
             return {key: self.run(key, system) for key, system in systems.items()}
@@ -76,7 +82,8 @@ class Campaign:
         stage = {key: first + k for k, key in enumerate(away)}
         for key, system in away.items():
             self.systems[key] = system_record(system)
-        arguments = [(key, packed[key]) for key in away]
+        dispatched = [key for key in longest if key in away] + [key for key in away if key not in longest]
+        arguments = [(key, packed[key]) for key in dispatched]
 
         def lost(arguments: tuple[Any, ...], reason: str) -> Any:
             raise RunError(f"run {arguments[0]!r}: {reason}")

@@ -379,7 +379,8 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
     fmu_dir = Path(fmu_dir).resolve()
     models, mismatch = checked_models(model, choice, allow_model_mismatch)
     campaign = Campaign("rover-cosim simulate --only legwheel", 3 + 2 * len(RUNS) + len(PATCH_RUNS), progress)
-    results = campaign.run_all(_systems(fmu_dir, models, choice, stop, length, slope_deg, climb_deg, patch_stop))
+    results = campaign.run_all(_systems(fmu_dir, models, choice, stop, length, slope_deg, climb_deg, patch_stop),
+                               longest=LONGEST)
     tables = {"straight": straight_table(results["straight"].data),
               "straight_cosim": straight_table(results["straight_cosim"].data, cosim=True),
               "straight_spring_damper": straight_trajectories(results["straight_spring_damper"].data, "monolithic")}
@@ -449,6 +450,11 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
                                                               "%.8g")
     written = campaign.write(out, files, stale=("legwheel_*",))
     return LegWheelResult(written, tables, rms_table, metrics, record)
+
+
+#: The runs that take longest (the posture controller's Python updates, the co-simulated rover's
+#: seven FMUs, the soft patch's stiff soil): the campaign starts them first.
+LONGEST = ("slope_posture", "climb_posture", "straight_cosim", "patch_roll", "patch_step")
 
 
 def _systems(fmu_dir: Path, models: ModelSet, choice: Choice, stop: float, length: float, slope_deg: float,
