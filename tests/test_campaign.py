@@ -124,3 +124,13 @@ def test_the_longest_runs_go_to_the_workers_first_and_the_results_keep_the_syste
     assert list(together) == list(campaign.ran) == list(campaign.systems) == list(systems)
     with pytest.raises(ValueError, match=r"longest runs \['t50.0'\]: not among the systems"):
         Campaign("test", 1).run_all(systems, workers=1, longest=("t50.0",))
+
+
+def test_a_campaign_freezes_the_imported_heap_out_of_the_garbage_collector():
+    import gc
+
+    before = gc.get_freeze_count()
+    made = [object() for _ in range(10)]  # tracked objects made since (lists are tracked)
+    Campaign("test", 1)
+    assert gc.get_freeze_count() > before and made
+    gc.unfreeze()  # back for the other tests of this process

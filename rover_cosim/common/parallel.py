@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar
 
+from .heap import freeze_imports
 from .scratch import remove_stale_folders
 
 Result = TypeVar("Result")
@@ -62,6 +63,7 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     workers = min(workers, len(arguments), cores())
     if not arguments:
         return
+    freeze_imports()  # the workers are forked from this heap: they share it unwritten
     pool = _Pool(function, workers)
     try:
         yield from pool.results(list(arguments), lost or _raise_lost, timeout)

@@ -22,6 +22,7 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from rover_cosim.common.heap import freeze_imports
 from rover_cosim.common.outputs import file_sha256, run_record, write_all
 from rover_cosim.common.parallel import cores, parallel_map
 from rover_cosim.orchestrator.master import RunError, run
@@ -36,6 +37,7 @@ class Campaign:
     """The runs of one job (``runs``: how many it plans, for the progress) and what they record."""
 
     def __init__(self, command: str, runs: int, progress: Callable[[float], None] | None = None):
+        freeze_imports()  # the job's modules are imported: its work's garbage collections skip them
         self.command = command
         self.started = time.perf_counter()
         self.stages = Stages(progress, runs)
