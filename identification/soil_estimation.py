@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize, stats
+from scipy import optimize
 
 from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.parameters import UNITS, xc_from_phi
@@ -608,6 +608,14 @@ def _bounds(prior: Soil, given: Mapping[str, tuple[float, float]] | None) -> dic
     return bounds
 
 
+def _t_quantile(probability: float, dof: float) -> float:
+    """Student's t quantile (scipy.stats imported here: a quarter of a second that the commands
+    which only import this module, every closed-loop one through the adaptive controller, skip)."""
+    from scipy import stats
+
+    return float(stats.t.ppf(probability, dof))
+
+
 def _fit(problem: _Problem, z: NDArray[np.float64], low: NDArray[np.float64],
          high: NDArray[np.float64]) -> tuple[NDArray[np.float64], str]:
     if not problem.names:
@@ -688,7 +696,7 @@ def _mark_unseen_pairs(correlation: NDArray[np.float64], null_directions: NDArra
 
 def _estimates(problem: _Problem, z: NDArray[np.float64], statistics: _Statistics, low: NDArray[np.float64],
                high: NDArray[np.float64], confidence: float) -> dict[str, ParameterEstimate]:
-    quantile = float(stats.t.ppf(0.5 + confidence / 2, statistics.dof))
+    quantile = _t_quantile(0.5 + confidence / 2, statistics.dof)
     out = {}
     for k, name in enumerate(problem.names):
         spec = SPECS[name]
@@ -874,7 +882,7 @@ def _bekker(problem: _Problem, z: NDArray[np.float64], statistics: _Statistics, 
     searched = bool(gradient.any())
     covariance = np.nan_to_num(statistics.covariance)
     error = float(np.sqrt(gradient @ covariance @ gradient)) if searched else 0.0
-    quantile = float(stats.t.ppf(0.5 + confidence / 2, statistics.dof))
+    quantile = _t_quantile(0.5 + confidence / 2, statistics.dof)
     unseen = bool(np.any(statistics.unseen & (gradient != 0)))
     low, high = value * math.exp(-quantile * error), value * math.exp(quantile * error)
     if unseen and np.count_nonzero(gradient) == 1:
