@@ -30,6 +30,8 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+from rover_cosim.common.scratch import cache_folder
+
 from . import catalog, codegen, description, description3, ode, prefix, source
 from .artifact import (
     BUILD_RECORD,
@@ -480,14 +482,54 @@ def _check_request(names: Sequence[str], backend: str, platforms: tuple[str, ...
     return backend, _check_platforms(backend, platforms)
 
 
+#: How long each FMU took to build on this machine the last time (seconds by name), in the user's
+#: cache folder: build_all starts the longest builds first (longest processing time first), so
+#: that the largest is not the last one started. Names not built here yet keep their order, first.
+BUILD_SECONDS = "build-seconds.json"
+
+
+def _build_seconds() -> dict[str, float]:
+    try:
+        found = json.loads((cache_folder() / BUILD_SECONDS).read_text())
+    except (OSError, ValueError):
+        return {}
+    if not isinstance(found, dict):
+        return {}
+    return {str(k): float(v) for k, v in found.items() if isinstance(v, (int, float))}
+
+
+def _remember_build_seconds(results: Sequence[BuildResult]) -> None:
+    """Add the FMUs just built (not those up to date) to BUILD_SECONDS; a cache that cannot be
+    written changes nothing."""
+    built = {r.name: round(r.seconds, 3) for r in results if r.rebuilt}
+    if not built:
+        return
+    target = cache_folder() / BUILD_SECONDS
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile("w", dir=target.parent, prefix=".build-seconds-", delete=False) as out:
+            json.dump({**_build_seconds(), **built}, out, indent=1, sort_keys=True)
+        os.replace(out.name, target)
+    except OSError:
+        pass
+
+
+def build_order(names: Sequence[str], seconds: dict[str, float]) -> list[str]:
+    """``names`` in the order to start their builds: those without a time first, as given, then
+    the others by their time, longest first."""
+    unknown = [n for n in names if n not in seconds]
+    return unknown + sorted((n for n in names if n in seconds), key=lambda n: -seconds[n])
+
+
 def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *, force: bool = False,
               jobs: int | None = None, backend: str = "builtin", platforms: Sequence[str] = (HOST,),
               report: Callable[[BuildResult], None] | None = None,
               step: StepReport | None = None, fmi_version: int = 2,
               elementary: str = ELEMENTARY_DEFAULT) -> list[BuildResult]:
-    """Build several FMUs, ``jobs`` at a time (default: the number of CPUs), each with binaries for
-    ``platforms`` (see :func:`build_fmu`; the CPUs left to each build compile its platforms in
-    parallel). The first failure is raised after the other builds finished; FMUs already built stay.
+    """Build several FMUs, ``jobs`` at a time (default: the number of CPUs; the longest builds of
+    the last time started first, BUILD_SECONDS), each with binaries for ``platforms`` (see
+    :func:`build_fmu`; the CPUs left to each build compile its platforms in parallel). The first
+    failure is raised after the other builds finished; FMUs already built stay.
     ``report`` hears of each FMU built or up to date, ``step`` of each stage of a build as it ends
     (from the workers, through a queue)."""
     backend, platforms = _check_request(names, backend, tuple(platforms), fmi_version, elementary)
@@ -513,16 +555,17 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
         with ExitStack() as stack:
             steps = _forward_steps(stack, context, step) if step else None
             pool = stack.enter_context(ProcessPoolExecutor(max_workers=jobs, mp_context=context))
-            tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, steps, fmi_version,
-                      elementary) for n in names]
-            futures = [pool.submit(_build_one, task) for task in tasks]
-            for future in futures:
+            futures = {n: pool.submit(_build_one, (n, Path(out_dir), force, backend, platforms, compile_jobs,
+                                                   steps, fmi_version, elementary))
+                       for n in build_order(names, _build_seconds())}
+            for future in (futures[n] for n in names):  # reported in the order asked
                 try:
                     results.append(future.result())
                     if report:
                         report(results[-1])
                 except Exception as error:  # noqa: BLE001
                     errors.append(error)
+    _remember_build_seconds(results)
     if errors:
         raise errors[0]
     return results

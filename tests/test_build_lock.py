@@ -8,6 +8,8 @@ import multiprocessing
 import time
 from pathlib import Path
 
+import pytest
+
 from rover_cosim.fmubuild.build import _one_build_at_a_time
 
 
@@ -34,3 +36,24 @@ def test_a_second_build_of_the_same_fmu_waits_for_the_first(tmp_path: Path):
     first.join(30)
     assert first.exitcode == 0
     assert log.read_text().splitlines() == ["first in", "first out", "second in"]
+
+
+@pytest.mark.fmu  # it builds two FMUs
+def test_the_longest_builds_of_the_last_time_start_first(tmp_path: Path, monkeypatch):
+    """build_all starts the FMUs that took longest here the last time first (those without a time
+    before them, as given), reports them in the order asked, and remembers what it built."""
+    import json
+
+    from rover_cosim.fmubuild import build
+
+    assert build.build_order(["A", "B", "C", "D"], {"A": 1.0, "C": 9.0, "D": 4.0}) == ["B", "C", "D", "A"]
+    monkeypatch.setenv("ROVER_COSIM_CACHE", str(tmp_path / "cache"))
+    (tmp_path / "cache").mkdir()
+    (tmp_path / "cache" / build.BUILD_SECONDS).write_text(json.dumps({"Wheel": 0.5, "Other": 3.0}))
+    results = build.build_all(["RoverBody", "Wheel"], tmp_path / "fmus", jobs=2)
+    assert [r.name for r in results] == ["RoverBody", "Wheel"] and all(r.rebuilt for r in results)
+    remembered = json.loads((tmp_path / "cache" / build.BUILD_SECONDS).read_text())
+    assert remembered["Other"] == 3.0 and remembered["Wheel"] > 0.5 and remembered["RoverBody"] > 0
+    again = build.build_all(["RoverBody", "Wheel"], tmp_path / "fmus", jobs=2)  # up to date: not remembered
+    assert not any(r.rebuilt for r in again)
+    assert json.loads((tmp_path / "cache" / build.BUILD_SECONDS).read_text()) == remembered

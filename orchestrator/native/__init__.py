@@ -35,18 +35,12 @@ from typing import Any
 
 import numpy as np
 
+from rover_cosim.common.scratch import cache_folder
+
 SOURCE = Path(__file__).with_name("stepper.c")
 #: What a failed unit's call was (stepper.c).
 CALLS = {1: "fmi2SetReal", 2: "fmi2DoStep", 3: "fmi2GetReal", 4: "finite outputs", 5: "fmi2SetRealInputDerivatives"}
 NOT_FINITE = 4
-
-
-def cache_folder() -> Path:
-    configured = os.environ.get("ROVER_COSIM_CACHE")
-    if configured:
-        return Path(configured)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "rover-cosim"
 
 
 def _compile(source: Path, target: Path) -> None:

@@ -21,6 +21,16 @@ UMASK = os.umask(0)
 os.umask(UMASK)
 
 
+def cache_folder() -> Path:
+    """The user's cache folder of rover-cosim (kept between commands: compiled native code, build
+    times): ``$ROVER_COSIM_CACHE``, else ``$XDG_CACHE_HOME/rover-cosim`` or ``~/.cache/rover-cosim``."""
+    configured = os.environ.get("ROVER_COSIM_CACHE")
+    if configured:
+        return Path(configured)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "rover-cosim"
+
+
 def folder_mode() -> int:
     """The mode of a folder of results: 0777 less the process's umask."""
     return 0o777 & ~UMASK
