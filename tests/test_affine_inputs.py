@@ -15,7 +15,7 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
-from fmpy.fmi2 import FMU2Slave
+from cs_slave import Slave
 
 from rover_cosim.fmubuild import codegen, ode, source
 
@@ -30,21 +30,13 @@ def test_the_exporter_marks_the_torques_and_nothing_the_contact_reads():
     assert {name for name, flag in zip(described, flags) if flag} == {f"tau[{i}]" for i in range(1, 7)}, described
 
 
-class _Rover:
+class _Rover(Slave):
     """Rover.fmu (Co-Simulation) stepped with torques that change every step."""
 
     watching: tuple[str, ...] = ("x", "v", "omega[1]", "omega[4]", "pitch")
 
     def __init__(self, fmu: Path, tmp: Path):
-        self.description = fmpy.read_model_description(str(fmu))
-        self.refs = {v.name: v.valueReference for v in self.description.modelVariables}
-        folder = fmpy.extract(str(fmu), unzipdir=str(tmp))
-        self.slave = FMU2Slave(guid=self.description.guid, unzipDirectory=folder,
-                               modelIdentifier=self.description.coSimulation.modelIdentifier, instanceName="r")
-        self.slave.instantiate()
-        self.slave.setupExperiment(startTime=0.0)
-        self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
+        super().__init__(fmu, tmp, "r")
         self.taus = [self.refs[f"tau[{i}]"] for i in range(1, 7)]
         self.watched = [self.refs[n] for n in self.watching]
 
@@ -65,13 +57,6 @@ class _Rover:
             self.slave.doStep(t, STEP)
             rows.append(self.slave.getReal(self.watched))
         return np.array(rows)
-
-    def statistic(self, name: str) -> float:
-        return self.slave.getReal([self.refs[f"statistics.{name}"]])[0]
-
-    def close(self) -> None:
-        self.slave.terminate()
-        self.slave.freeInstance()
 
 
 def test_updated_derivatives_follow_the_evaluated_ones_to_rounding_with_an_evaluation_fewer_per_step(fmus, tmp_path):

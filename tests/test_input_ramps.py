@@ -10,29 +10,20 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import fmpy
 import numpy as np
-from fmpy.fmi2 import FMU2Slave
+from cs_slave import Slave
 
 SWING, FREQUENCY = 0.02, 0.5  # knee set-points' amplitude [rad] and frequency [Hz]
 SETTLE, DURATION = 1.0, 1.0  # the rover settles on its wheels, then its knees swing [s]
 
 
-class _Legs:
+class _Legs(Slave):
     """LegWheelRover.fmu (Co-Simulation) with its knee set-points swinging, handed as ramps."""
 
     def __init__(self, fmu: Path, tmp: Path):
-        description = fmpy.read_model_description(str(fmu))
-        self.refs = {v.name: v.valueReference for v in description.modelVariables}
-        self.start = {v.name: float(v.start) for v in description.modelVariables
+        super().__init__(fmu, tmp, "legs")
+        self.start = {v.name: float(v.start) for v in self.description.modelVariables
                       if v.causality == "input" and v.name.startswith("kneePitch[")}
-        folder = fmpy.extract(str(fmu), unzipdir=str(tmp))
-        self.slave = FMU2Slave(guid=description.guid, unzipDirectory=folder,
-                               modelIdentifier=description.coSimulation.modelIdentifier, instanceName="legs")
-        self.slave.instantiate()
-        self.slave.setupExperiment(startTime=0.0)
-        self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
         self.knees = [self.refs[name] for name in self.start]
         self.watched = [self.refs[n] for n in ("z", "kneePitchAngle[1]", "kneePitchAngle[5]", "Fz[1]", "Fz[2]")]
 
@@ -52,12 +43,6 @@ class _Legs:
             rows.append(self.slave.getReal(self.watched))
         return np.array(rows)
 
-    def statistic(self, name: str) -> float:
-        return self.slave.getReal([self.refs[f"statistics.{name}"]])[0]
-
-    def close(self) -> None:
-        self.slave.terminate()
-        self.slave.freeInstance()
 
 
 def test_a_ramped_run_follows_a_ten_times_finer_one(fmus, tmp_path):

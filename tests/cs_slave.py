@@ -1,0 +1,33 @@
+"""An FMU file as an FMI 2.0 Co-Simulation slave (FMPy's FMU2Slave), instantiated and initialized
+at t = 0, for tests that drive one of our FMUs call by call; shared by test_affine_inputs.py and
+test_input_ramps.py."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import fmpy
+from fmpy.fmi2 import FMU2Slave
+
+
+class Slave:
+    """``fmu`` unpacked into ``tmp`` and initialized; ``refs``: value references by name."""
+
+    def __init__(self, fmu: Path, tmp: Path, name: str = "slave"):
+        self.description = fmpy.read_model_description(str(fmu))
+        self.refs = {v.name: v.valueReference for v in self.description.modelVariables}
+        folder = fmpy.extract(str(fmu), unzipdir=str(tmp))
+        self.slave = FMU2Slave(guid=self.description.guid, unzipDirectory=folder,
+                               modelIdentifier=self.description.coSimulation.modelIdentifier, instanceName=name)
+        self.slave.instantiate()
+        self.slave.setupExperiment(startTime=0.0)
+        self.slave.enterInitializationMode()
+        self.slave.exitInitializationMode()
+
+    def statistic(self, name: str) -> float:
+        """The runtime's statistic ``statistics.<name>``."""
+        return self.slave.getReal([self.refs[f"statistics.{name}"]])[0]
+
+    def close(self) -> None:
+        self.slave.terminate()
+        self.slave.freeInstance()
