@@ -94,6 +94,7 @@ def limbs(tables: dict[str, pd.DataFrame], title: str) -> bytes:
         ax.set_ylabel(label)
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
+        ax.locator_params(nbins=4)  # four or five ticks a panel: enough for 24 panels, and a third of the drawing
     axes[0][0].legend(fontsize=7, loc="best")
     axes[1][0].legend(fontsize=7, loc="best")
     fig.suptitle(f"Leg-wheel rover, {title}: per limb (line style: run)")
