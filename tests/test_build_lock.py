@@ -49,11 +49,12 @@ def test_the_longest_builds_of_the_last_time_start_first(tmp_path: Path, monkeyp
     assert build.build_order(["A", "B", "C", "D"], {"A": 1.0, "C": 9.0, "D": 4.0}) == ["B", "C", "D", "A"]
     monkeypatch.setenv("ROVER_COSIM_CACHE", str(tmp_path / "cache"))
     (tmp_path / "cache").mkdir()
-    (tmp_path / "cache" / build.BUILD_SECONDS).write_text(json.dumps({"Wheel": 0.5, "Other": 3.0}))
-    results = build.build_all(["RoverBody", "Wheel"], tmp_path / "fmus", jobs=2)
-    assert [r.name for r in results] == ["RoverBody", "Wheel"] and all(r.rebuilt for r in results)
+    (tmp_path / "cache" / build.BUILD_SECONDS).write_text(json.dumps({"SteerableRoverBody": 0.01, "Other": 3.0}))
+    names = ["RoverBody", "SteerableRoverBody"]  # the two quickest to build
+    results = build.build_all(names, tmp_path / "fmus", jobs=2)
+    assert [r.name for r in results] == names and all(r.rebuilt for r in results)
     remembered = json.loads((tmp_path / "cache" / build.BUILD_SECONDS).read_text())
-    assert remembered["Other"] == 3.0 and remembered["Wheel"] > 0.5 and remembered["RoverBody"] > 0
-    again = build.build_all(["RoverBody", "Wheel"], tmp_path / "fmus", jobs=2)  # up to date: not remembered
+    assert remembered["Other"] == 3.0 and remembered["SteerableRoverBody"] > 0.01 and remembered["RoverBody"] > 0
+    again = build.build_all(names, tmp_path / "fmus", jobs=2)  # up to date: not remembered
     assert not any(r.rebuilt for r in again)
     assert json.loads((tmp_path / "cache" / build.BUILD_SECONDS).read_text()) == remembered
