@@ -41,14 +41,13 @@ class _Rover(Slave):
         self.watched = [self.refs[n] for n in self.watching]
 
     def run(self, first: int, last: int, evaluate_again: bool, own_values: bool = False) -> np.ndarray:
-        """Steps ``first`` to ``last`` with torques that change every step; ``evaluate_again``: a
+        """Steps ``first`` to ``last`` with the inputs of :meth:`set_inputs`; ``evaluate_again``: a
         tunable solver parameter set to its own value with them (the derivatives are evaluated
         again); ``own_values``: a non-affine input (a rut depth) set to the bits it has."""
         rows = []
         for k in range(first, last):
             t = k * STEP
-            torque = 40.0 + 15.0 * math.sin(7.0 * t) + 0.01 * k
-            self.slave.setReal(self.taus, [torque, torque, torque, torque * 0.9, torque * 0.9, torque * 0.9])
+            self.set_inputs(k, t)
             if own_values:
                 share = self.refs["rutDepth[1]"]
                 self.slave.setReal([share], self.slave.getReal([share]))
@@ -57,6 +56,11 @@ class _Rover(Slave):
             self.slave.doStep(t, STEP)
             rows.append(self.slave.getReal(self.watched))
         return np.array(rows)
+
+    def set_inputs(self, k: int, t: float) -> None:
+        """Step ``k``'s inputs: torques that change every step."""
+        torque = 40.0 + 15.0 * math.sin(7.0 * t) + 0.01 * k
+        self.slave.setReal(self.taus, [torque, torque, torque, torque * 0.9, torque * 0.9, torque * 0.9])
 
 
 def test_updated_derivatives_follow_the_evaluated_ones_to_rounding_with_an_evaluation_fewer_per_step(fmus, tmp_path):
@@ -101,20 +105,14 @@ class _Steering(_Rover):
         front = 0.3 * math.sin(3.0 * k * STEP)
         return [front, 0.0, -front, front, 0.0, -front]
 
-    def run(self, first: int, last: int, evaluate_again: bool, own_values: bool = False) -> np.ndarray:
-        rows = []
-        for k in range(first, last):
-            t = k * STEP
-            torque = 40.0 + 15.0 * math.sin(7.0 * t)
-            start, end = self.steering(k), self.steering(k + 1)
-            self.slave.setReal(self.steers, start)
-            self.slave.setRealInputDerivatives(self.steers, [1] * 6, [(b - a) / STEP for a, b in zip(start, end)])
-            self.slave.setReal(self.taus, [torque, torque * 1.1, torque, torque * 0.9, torque, torque * 0.8])
-            if evaluate_again:
-                self.slave.setReal([self.refs["solver.maxStep"]], self.slave.getReal([self.refs["solver.maxStep"]]))
-            self.slave.doStep(t, STEP)
-            rows.append(self.slave.getReal(self.watched))
-        return np.array(rows)
+    def set_inputs(self, k: int, t: float) -> None:
+        """Step ``k``'s inputs: the steering at the step's start with its slope to the end, and
+        torques that change every step."""
+        torque = 40.0 + 15.0 * math.sin(7.0 * t)
+        start, end = self.steering(k), self.steering(k + 1)
+        self.slave.setReal(self.steers, start)
+        self.slave.setRealInputDerivatives(self.steers, [1] * 6, [(b - a) / STEP for a, b in zip(start, end)])
+        self.slave.setReal(self.taus, [torque, torque * 1.1, torque, torque * 0.9, torque, torque * 0.8])
 
 
 def test_ramped_set_points_keep_the_derivatives_and_the_gain_follows_them(fmus, tmp_path):
