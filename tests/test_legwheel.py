@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rover_cosim.control.posture import JOINT_INPUTS, Posture, PostureController, posture_joints
+from rover_cosim.control.posture import JOINT_INPUTS, Posture, PostureController, StepOver, posture_joints
 from rover_cosim.limbs import athlete_limbs, attitude, forward, holding_torques, static_loads
 
 LIMBS = athlete_limbs()
@@ -165,12 +165,34 @@ def test_the_posture_block_moves_its_corner_hubs_towards_the_loads_centre_along_
             np.testing.assert_allclose(moved, 0.0, atol=1e-12)
 
 
+def test_the_posture_blocks_rates_are_the_slopes_of_its_set_points_over_each_step():
+    """Every step, the rate outputs (``hipYawRate[i]`` ...) times the step are the set-points' change
+    over it (the steering's own changes aside), across the updates that start a new ramp too; a
+    block without control holds its posture: every rate 0."""
+    for control in (True, False):
+        block = PostureController("posture", control=control, step_over=StepOver() if control else None)
+        n, h = 6, 1e-3
+        names = [f"{joint}[{i}]" for joint in JOINT_INPUTS for i in range(1, n + 1)]
+        rates = [f"{joint}Rate[{i}]" for joint in JOINT_INPUTS for i in range(1, n + 1)]
+        sinkage = np.array([0.11, 0.02, 0.02, 0.02, 0.02, 0.02])  # limb 1 steps out
+        u = np.concatenate([[1.0, 0.0, 0.0, 0.0], [380.0, 420.0, 460.0] * 2, np.zeros(6), sinkage, np.ones(6)])
+        u = u[:len(block.inputs)]
+        before = dict(zip(block.outputs, block.start(0.0, u, h)))
+        largest = 0.0
+        for k in range(600):  # 0.6 s: six updates
+            after = dict(zip(block.outputs, block.step(k * h, h, u)))
+            change = np.array([after[name] - before[name] for name in names])
+            slope = np.array([after[name] for name in rates])
+            np.testing.assert_allclose(slope * h, change, atol=1e-12)
+            largest = max(largest, float(np.abs(slope).max()))
+            before = after
+        assert (largest > 0.01) == control, largest  # with control the hubs move: the lift, the balance
+
+
 def test_the_posture_block_steps_a_sunk_wheel_out_and_holds_its_motor_meanwhile():
     """With ``step_over``: a wheel past the trigger sinkage has its hub lifted, carried ``reach``
     ahead and set down (the forward kinematics of the outputs), its torque output 0 while it is
     in the air, the others' torques passed through; each limb steps once."""
-    from rover_cosim.control.posture import StepOver
-
     plan = StepOver(trigger_sinkage=0.06, lift=0.25, reach=1.0, lift_time=0.5, swing_time=1.0, lower_time=0.5)
     block = PostureController("posture", control=True, step_over=plan)
     sinkage = np.array([0.11, 0.024, 0.024, 0.024, 0.024, 0.024])
@@ -308,6 +330,90 @@ def test_at_rest_the_leg_wheel_rover_stays_put_carries_its_weight_and_holds_it_b
     angles = np.array([[last[f"{name}Angle[{i}]"] for name in JOINT_INPUTS] for i in range(1, 7)])
     for i, (limb, q) in enumerate(zip(LIMBS, angles), start=1):
         np.testing.assert_allclose([last[f"hub{a}[{i}]"] for a in "XYZ"], forward(limb, q).hub, atol=1e-9)
+
+
+def _slave(fmu: Path, tmp: Path, **start: float) -> tuple[Any, dict[str, int]]:
+    """``fmu`` as an initialized FMI 2.0 Co-Simulation slave with ``start`` values (FMPy), and its
+    value references by name."""
+    from cs_slave import Slave
+
+    slave = Slave(fmu, tmp, start=start)
+    return slave, slave.refs
+
+
+def test_the_set_points_rates_move_the_hubs_against_the_body_at_j_qdot(fmus, tmp_path):
+    """LegWheelRoverBody with its body rolled and pitched against the ground: the set-points' rates
+    add R J q_set' (numpy's Jacobian and attitude) to each hub's velocity, along the wheel's heading
+    (v_hub) and across it (v_lat) to 1e-12 m/s, and along the ground's normal load the limb through
+    the servos' damping: dW = -k_n d_joint / k_joint n.(R J q_set')."""
+    from rover_cosim.jobs.legwheel import settled_height
+    from rover_cosim.limbs import jacobian
+    from rover_cosim.terramechanics.library import choose
+
+    roll, pitch = 0.01, -0.005  # every wheel loaded, none to its limb's yield load
+    slave, refs = _slave(fmus["LegWheelRoverBody"], tmp_path, roll=roll, pitch=pitch, height0=settled_height(choose()))
+    parameters = {v.name: float(v.start) for v in slave.description.modelVariables if v.name.startswith("legs.")}
+    stiffness, damping = parameters["legs.kJoint"], parameters["legs.dJoint"]
+    joints = joints_of(posture_joints())
+    rates = np.random.default_rng(1).uniform(-0.02, 0.02, (6, 6))
+    names = [f"{joint}Rate[{i}]" for i in range(1, 7) for joint in JOINT_INPUTS]
+    outputs = [f"{name}[{i}]" for name in ("v_hub", "v_lat", "W", "steer") for i in range(1, 7)]
+
+    def read(values: np.ndarray) -> dict[str, float]:
+        slave.slave.setReal([refs[n] for n in names], list(values.reshape(-1)))
+        return dict(zip(outputs, slave.slave.getReal([refs[n] for n in outputs])))
+
+    moving, still = read(rates), read(np.zeros((6, 6)))
+    slave.close()
+    rotation = attitude(roll, pitch, 0.0)
+    normal = rotation[2]  # the ground's normal in the body frame
+    loaded = 0
+    for i, (limb, q) in enumerate(zip(LIMBS, joints), start=1):
+        linear = jacobian(limb, q)[:3]
+        velocity = rotation @ (linear @ rates[i - 1])
+        steer = still[f"steer[{i}]"]
+        along = velocity[0] * math.cos(steer) + velocity[1] * math.sin(steer)
+        across = velocity[1] * math.cos(steer) - velocity[0] * math.sin(steer)
+        assert moving[f"v_hub[{i}]"] - still[f"v_hub[{i}]"] == pytest.approx(along, abs=1e-12)
+        assert moving[f"v_lat[{i}]"] - still[f"v_lat[{i}]"] == pytest.approx(across, abs=1e-12)
+        if moving[f"W[{i}]"] > 0 and still[f"W[{i}]"] > 0:  # in the ground both ways, below the yield load
+            spring = stiffness / float(np.sum((normal @ linear) ** 2))
+            assert moving[f"W[{i}]"] - still[f"W[{i}]"] == pytest.approx(
+                -spring * damping / stiffness * velocity[2], rel=1e-9)
+            loaded += 1
+    assert loaded >= 4
+
+
+def test_a_limb_that_swings_its_hub_back_makes_its_free_wheel_roll_and_the_body_stay(fmus, tmp_path):
+    """LegWheelRover at rest, no motor torque: the front-left limb carries its hub straight back
+    at 0.2 m/s (its set-points ramped at q' = J^-1 (-0.2, 0, 0, 0, 0, 0), the rates given) for 0.5 s.
+    The wheel rolls back under its hub (r omega near -0.2 m/s, less its slip), the other wheels stay
+    still and the body stays put (free wheels pass no push to it); a hub moved without its rates is
+    not seen by its wheel (it would not spin)."""
+    from rover_cosim.jobs.legwheel import settled_height
+    from rover_cosim.limbs import jacobian
+    from rover_cosim.terramechanics.library import choose
+
+    joints = joints_of(posture_joints())
+    rate = np.linalg.solve(jacobian(LIMBS[0], joints[0]), [-0.2, 0.0, 0.0, 0.0, 0.0, 0.0])
+    spins = {}
+    for given in (True, False):
+        slave, refs = _slave(fmus["LegWheelRover"], tmp_path / str(given), height0=settled_height(choose()))
+        set_points = [refs[f"{joint}[1]"] for joint in JOINT_INPUTS]
+        rate_inputs = [refs[f"{joint}Rate[1]"] for joint in JOINT_INPUTS]
+        step = 1e-3
+        for k in range(500):
+            slave.slave.setReal(set_points, list(joints[0] + rate * k * step))
+            slave.slave.setReal(rate_inputs, list(rate if given else np.zeros(6)))
+            slave.slave.doStep(k * step, step)
+        radius = 0.355
+        spins[given] = np.array(slave.slave.getReal([refs[f"omega[{i}]"] for i in range(1, 7)])) * radius
+        x = slave.slave.getReal([refs["x"]])[0]
+        slave.close()
+        assert abs(x) < 1e-3
+    assert -0.2 < spins[True][0] < -0.17                    # rolls back with its hub, a little slip
+    assert np.abs(spins[True][1:]).max() < 1e-3
+    assert np.abs(spins[False]).max() < 1e-3                # without the rates: the wheel sees nothing
 
 
 def _drive(fmu: Path, torque: float, stop: float = 2.0, **start: float) -> np.ndarray:

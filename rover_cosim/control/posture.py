@@ -61,7 +61,12 @@ period (a first-order hold: a step of a few millimetres at a hub would load a st
 hundreds of newtons at once); the block declares them ``ramped_outputs``, so that under
 ``gauss-seidel-interpolated`` the FMU takes each step's set-points as the line they move on, not
 held at the step's end value (a joint servo fed a staircase of 1 ms steps makes the FMU's
-integrator reject and re-linearise: on the soft patch 2.5x the FMU's time). Without ``control``
+integrator reject and re-linearise: on the soft patch 2.5x the FMU's time). The ramps' slopes are outputs
+too (``hipYawRate[i]`` ...: over each step the slope of the ramp that ends there), for the FMU's
+inputs of the same names: the hubs move against the body at J q_set', and the wheels roll or slide
+over that (a corner hub carried ahead by the balance loop, a stepping hub set down). The shipped
+scenarios (``jobs.legwheel``) do not connect them yet: the loops were tuned on hub motion the
+wheels did not see (see the leg-wheel design page, "Not yet"). Without ``control``
 the block holds the posture it was made with (the paper's by default) and only steers.
 
 What runs every step (the hold, the steering, the torques through) has a C twin
@@ -202,8 +207,10 @@ class _Loops:
 class PostureController:
     """Orchestrator block: inputs ``z``, ``roll``, ``pitch``, ``yaw`` (m, rad), the loads
     ``W[1..6]`` (N) and the steering ``steer[1..6]`` (rad) the path follower asks for; outputs the 36
-    joint set-points (``hipYaw[i]`` ... ``ankleRoll[i]``, rad) and the commanded posture
-    (``height_cmd``, ``shift_x``, ``shift_y`` in m, ``roll_cmd``, ``pitch_cmd`` in rad). See the module docstring."""
+    joint set-points (``hipYaw[i]`` ... ``ankleRoll[i]``, rad), the commanded posture
+    (``height_cmd``, ``shift_x``, ``shift_y`` in m, ``roll_cmd``, ``pitch_cmd`` in rad) and the set-points'
+    rates (``hipYawRate[i]`` ... ``ankleRollRate[i]``, rad/s: the FMU moves the hubs against the body at
+    J q_set' with them). See the module docstring."""
 
     def __init__(self, name: str, *, posture: Posture = Posture(), control: bool = False,
                  slope: float = 0.0, downhill: float = 0.0, height: float | None = None,
@@ -240,11 +247,13 @@ class PostureController:
                          if stepping else []))
         self.outputs = (*[f"{joint}[{i}]" for joint in JOINT_INPUTS for i in range(1, n + 1)],
                         "height_cmd", "shift_x", "shift_y", "roll_cmd", "pitch_cmd",
-                        *([f"tau[{i}]" for i in range(1, n + 1)] if stepping else []))
+                        *([f"tau[{i}]" for i in range(1, n + 1)] if stepping else []),
+                        *[f"{joint}Rate[{i}]" for joint in JOINT_INPUTS for i in range(1, n + 1)])
         self.units = {"z": "m", "roll": "rad", "pitch": "rad", "yaw": "rad", "height_cmd": "m", "shift_x": "m",
                       "shift_y": "m", "roll_cmd": "rad", "pitch_cmd": "rad",
                       **{f"W[{i}]": "N" for i in range(1, n + 1)}, **{f"steer[{i}]": "rad" for i in range(1, n + 1)},
                       **{f"{joint}[{i}]": "rad" for joint in JOINT_INPUTS for i in range(1, n + 1)},
+                      **{f"{joint}Rate[{i}]": "rad/s" for joint in JOINT_INPUTS for i in range(1, n + 1)},
                       **{f"sinkage[{i}]": "m" for i in range(1, n + 1)},
                       **{f"{name}[{i}]": "N.m" for name in ("tau_cmd", "tau") for i in range(1, n + 1)}}
         self.units = {k: v for k, v in self.units.items() if k in self.inputs or k in self.outputs}
@@ -354,35 +363,43 @@ class PostureController:
             loops.stepped.append((step.limb + 1, step.began, t))
             loops.step = None
 
-    def _outputs(self, u: np.ndarray, now: float) -> np.ndarray:
+    def _rates(self) -> np.ndarray:
+        """The set-points' rates [rad/s] (a row per limb): the slope of the ramp from the last
+        update's joints to the new ones (the steering's changes not counted)."""
+        return (self.loops.joints - self.loops.previous) / self.period
+
+    def _outputs(self, u: np.ndarray, now: float, rates: np.ndarray) -> np.ndarray:
         """The set-points at ``now`` [s]: moving linearly from the last update's joints to the new
         ones over a period (a step of a few millimetres at a hub would load a stiff limb with
-        hundreds of newtons at once), the steering added."""
+        hundreds of newtons at once), the steering added; ``rates`` their slopes (see :meth:`step`)."""
         n, loops = len(self.limbs), self.loops
         fraction = min(max((now - (loops.next_update - self.period)) / self.period, 0.0), 1.0)
         joints = loops.previous + fraction * (loops.joints - loops.previous)
         joints[:, 4] -= np.asarray(u[4 + n:4 + 2 * n], float)  # a heading change of d is -d on the steer joint
         commands = [loops.height, loops.shift[0], loops.shift[1], loops.roll, loops.pitch]
         if self.step_over is None:
-            return np.concatenate([joints.T.reshape(-1), commands])
+            return np.concatenate([joints.T.reshape(-1), commands, rates.T.reshape(-1)])
         torques = np.asarray(u[4 + 3 * n:4 + 4 * n], float).copy()
         if loops.step is not None:
             torques[loops.step.limb] = 0.0  # a wheel in the air is not driven
-        return np.concatenate([joints.T.reshape(-1), commands, torques])
+        return np.concatenate([joints.T.reshape(-1), commands, torques, rates.T.reshape(-1)])
 
     # --- the block interface --------------------------------------------------------------------
     def start(self, t0: float, u0: np.ndarray, h: float | None = None) -> np.ndarray:
         self.loops = self._initial()
         self.loops.next_update = t0 + self.period
-        self._last = (np.array(u0, float), self._outputs(u0, t0))
+        self._last = (np.array(u0, float), self._outputs(u0, t0, self._rates()))
         return self._last[1]
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
+        """The outputs at t + h; the rates are the slopes over the step that ends there (taken
+        before an update at t + h starts the next ramp), as the set-points' ramp over the step is."""
         now = t + h
+        rates = self._rates()
         if self.control and now >= self.loops.next_update - 1e-12:
             self._update(now, u)
             self.loops.next_update += self.period
-        outputs = self._outputs(u, now)
+        outputs = self._outputs(u, now, rates)
         self._last = (u, outputs)
         return outputs
 

@@ -14,7 +14,9 @@
  * Inputs (value references 0 ..): z [m], roll, pitch, yaw [rad], W[1..n] [N], steer[1..n] [rad],
  * with step-over also sinkage[1..n] [m] and tau_cmd[1..n] [N.m]. Outputs: for each joint
  * (hipYaw, hipPitch, kneePitch, anklePitch, ankleSteer, ankleRoll) its n set-points [rad], then
- * height_cmd, shift_x, shift_y [m], roll_cmd, pitch_cmd [rad], with step-over tau[1..n] [N.m].
+ * height_cmd, shift_x, shift_y [m], roll_cmd, pitch_cmd [rad], with step-over tau[1..n] [N.m], then for
+ * each joint its n set-points' rates [rad/s]: the slope of the ramp over the step that ends at t + h
+ * (taken before an update there starts the next one).
  * The functions follow fmi2SetReal, fmi2GetReal and fmi2DoStep (status 0 ok, 3 error; the error's
  * text from posture_message). */
 #include <stdio.h>
@@ -85,10 +87,22 @@ static void outputs(Posture *c, double now) {
     }
 }
 
+/* The set-points' rates [rad/s], as PostureController._rates: the slope of the ramp from the last
+ * update's joints to the new ones. */
+static void rates(Posture *c) {
+    int n = c->limbs;
+    const double *previous = c->shared, *joints = c->shared + n * JOINTS;
+    double *rate = c->out + JOINTS * n + COMMANDS + (c->stepping ? n : 0);
+    for (int i = 0; i < n; i++)
+        for (int k = 0; k < JOINTS; k++)
+            rate[k * n + i] = (joints[i * JOINTS + k] - previous[i * JOINTS + k]) / c->period;
+}
+
 int posture_do_step(void *component, double t, double h, int no_prior_state) {
     Posture *c = component;
     double now = t + h;
     (void)no_prior_state;
+    rates(c); /* the slopes over this step, before an update at its end */
     if (c->control && now >= c->next_update - 1e-12) {
         if (c->update(now, c->in) != 0) {
             if (!c->message[0]) snprintf(c->message, sizeof c->message, "the posture update at t = %.17g failed", now);
@@ -129,7 +143,7 @@ void *posture_new(int limbs, int stepping, int control, double period, double ne
     c->shared = shared;
     c->update = update;
     c->n_inputs = BODY_INPUTS + (c->stepping ? 4 : 2) * limbs;
-    c->n_outputs = (JOINTS + (c->stepping ? 1 : 0)) * limbs + COMMANDS;
+    c->n_outputs = (2 * JOINTS + (c->stepping ? 1 : 0)) * limbs + COMMANDS;
     c->in = calloc((size_t)c->n_inputs, sizeof *c->in);
     c->out = calloc((size_t)c->n_outputs, sizeof *c->out);
     if (!c->in || !c->out) {

@@ -11,6 +11,12 @@ model LegWheelChassis "Leg-wheel rover body (x, y, yaw, heave, pitch, roll) on s
   input Real anklePitch[6](each unit="rad") "Set-points of the ankle pitch joints";
   input Real ankleSteer[6](each unit="rad") "Set-points of the ankle steer joints (the wheels' steering)";
   input Real ankleRoll[6](each unit="rad") "Set-points of the ankle roll joints (the wheels' camber)";
+  input Real hipYawRate[6](each unit="rad/s", each start=0) "Rates of the hip yaw set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real hipPitchRate[6](each unit="rad/s", each start=0) "Rates of the hip pitch set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real kneePitchRate[6](each unit="rad/s", each start=0) "Rates of the knee pitch set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real anklePitchRate[6](each unit="rad/s", each start=0) "Rates of the ankle pitch set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real ankleSteerRate[6](each unit="rad/s", each start=0) "Rates of the ankle steer set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real ankleRollRate[6](each unit="rad/s", each start=0) "Rates of the ankle roll set-points: with the others, the hubs' velocity against the body (0: held)";
   input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub, along the wheel's heading";
   input Real Fy[6](each unit="N") "Lateral force of each wheel on its hub, to the wheel's left";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the limb";
@@ -69,7 +75,15 @@ model LegWheelChassis "Leg-wheel rover body (x, y, yaw, heave, pitch, roll) on s
   Real hubSetY[6](each unit="m") "Hub at the set-points, y";
   Real hubSetZ[6](each unit="m") "Hub at the set-points, z";
   Real deflection[6](each unit="m") "Limb compression: how far below the ground the hub at the set-points would be";
-  Real deflectionRate[6](each unit="m/s") "Its rate from the body's motion";
+  Real deflectionRate[6](each unit="m/s") "Its rate from the body's motion and the set-points' rates";
+  Real jointRate[6, 6](each unit="rad/s") "Row i: the rates of limb i's set-points, joints 1-6";
+  Real hubRateX[6](each unit="m/s") "Hub velocity against the body from the set-points' rates (J q_set'), body frame x";
+  Real hubRateY[6](each unit="m/s") "Its y";
+  Real hubRateZ[6](each unit="m/s") "Its z";
+  Real yRolledRate[6](each unit="m/s") "The set-points' hub velocity turned by the roll, y";
+  Real zRolledRate[6](each unit="m/s") "The set-points' hub velocity turned by the roll, z";
+  Real xHubRate[6](each unit="m/s") "The set-points' hub velocity in the heading frame, ahead";
+  Real zHubRate[6](each unit="m/s") "The set-points' hub velocity in the heading frame, along the normal";
   Real yRolled[6](each unit="m");
   Real zRolled[6](each unit="m");
   Real xHubWorld[6](each unit="m") "Hub ahead of the centre of gravity (heading frame)";
@@ -150,6 +164,32 @@ equation
   limbSet6.q[4] = anklePitch[6];
   limbSet6.q[5] = ankleSteer[6];
   limbSet6.q[6] = ankleRoll[6];
+  for i in 1:6 loop
+    jointRate[i, 1] = hipYawRate[i];
+    jointRate[i, 2] = hipPitchRate[i];
+    jointRate[i, 3] = kneePitchRate[i];
+    jointRate[i, 4] = anklePitchRate[i];
+    jointRate[i, 5] = ankleSteerRate[i];
+    jointRate[i, 6] = ankleRollRate[i];
+  end for;
+  hubRateX[1] = sum(limbSet1.jacobian[1, k]*jointRate[1, k] for k in 1:6);
+  hubRateY[1] = sum(limbSet1.jacobian[2, k]*jointRate[1, k] for k in 1:6);
+  hubRateZ[1] = sum(limbSet1.jacobian[3, k]*jointRate[1, k] for k in 1:6);
+  hubRateX[2] = sum(limbSet2.jacobian[1, k]*jointRate[2, k] for k in 1:6);
+  hubRateY[2] = sum(limbSet2.jacobian[2, k]*jointRate[2, k] for k in 1:6);
+  hubRateZ[2] = sum(limbSet2.jacobian[3, k]*jointRate[2, k] for k in 1:6);
+  hubRateX[3] = sum(limbSet3.jacobian[1, k]*jointRate[3, k] for k in 1:6);
+  hubRateY[3] = sum(limbSet3.jacobian[2, k]*jointRate[3, k] for k in 1:6);
+  hubRateZ[3] = sum(limbSet3.jacobian[3, k]*jointRate[3, k] for k in 1:6);
+  hubRateX[4] = sum(limbSet4.jacobian[1, k]*jointRate[4, k] for k in 1:6);
+  hubRateY[4] = sum(limbSet4.jacobian[2, k]*jointRate[4, k] for k in 1:6);
+  hubRateZ[4] = sum(limbSet4.jacobian[3, k]*jointRate[4, k] for k in 1:6);
+  hubRateX[5] = sum(limbSet5.jacobian[1, k]*jointRate[5, k] for k in 1:6);
+  hubRateY[5] = sum(limbSet5.jacobian[2, k]*jointRate[5, k] for k in 1:6);
+  hubRateZ[5] = sum(limbSet5.jacobian[3, k]*jointRate[5, k] for k in 1:6);
+  hubRateX[6] = sum(limbSet6.jacobian[1, k]*jointRate[6, k] for k in 1:6);
+  hubRateY[6] = sum(limbSet6.jacobian[2, k]*jointRate[6, k] for k in 1:6);
+  hubRateZ[6] = sum(limbSet6.jacobian[3, k]*jointRate[6, k] for k in 1:6);
   hubSetX[1] = limbSet1.hub[1];
   hubX[1] = limb1.hub[1];
   hubSetX[2] = limbSet2.hub[1];
@@ -231,10 +271,14 @@ equation
     xHubWorld[i] = hubSetX[i]*cos(pitch) - zRolled[i]*sin(pitch);
     zHubWorld[i] = hubSetX[i]*sin(pitch) + zRolled[i]*cos(pitch);
     deflection[i] = groundHeight[i] - (z + zHubWorld[i]);
-    deflectionRate[i] = -heaveRate - pitchRate*xHubWorld[i] - rollRate*cos(pitch)*yRolled[i] + groundHeightRate[i];
+    yRolledRate[i] = hubRateY[i]*cos(roll) - hubRateZ[i]*sin(roll);
+    zRolledRate[i] = hubRateY[i]*sin(roll) + hubRateZ[i]*cos(roll);
+    xHubRate[i] = hubRateX[i]*cos(pitch) - zRolledRate[i]*sin(pitch);
+    zHubRate[i] = hubRateX[i]*sin(pitch) + zRolledRate[i]*cos(pitch);
+    deflectionRate[i] = -heaveRate - pitchRate*xHubWorld[i] - rollRate*cos(pitch)*yRolled[i] - zHubRate[i] + groundHeightRate[i];
     W[i] = noEvent(max(min(kz[i]*deflection[i] + kz[i]*legs.dJoint/legs.kJoint*deflectionRate[i], WLimit[i]), 0.0));
-    vxHub[i] = v - pitchRate*zHubWorld[i] - rollRate*sin(pitch)*yRolled[i] - yawRate*yRolled[i];
-    vyHub[i] = vy - rollRate*zRolled[i] + yawRate*xHubWorld[i];
+    vxHub[i] = v - pitchRate*zHubWorld[i] - rollRate*sin(pitch)*yRolled[i] - yawRate*yRolled[i] + xHubRate[i];
+    vyHub[i] = vy - rollRate*zRolled[i] + yawRate*xHubWorld[i] + yRolledRate[i];
     v_hub[i] = vxHub[i]*cos(steer[i]) + vyHub[i]*sin(steer[i]);
     v_lat[i] = vyHub[i]*cos(steer[i]) - vxHub[i]*sin(steer[i]);
     FxBody[i] = Fx[i]*cos(steer[i]) - Fy[i]*sin(steer[i]);
@@ -275,6 +319,15 @@ would be. W<sub>limit,i</sub> = &tau;<sub>max</sub> / max<sub>k</sub> |n&middot;
 the load at which its most loaded joint reaches the torque limit the limb yields (the servo holds its
 limit and gives way). The compliance across the normal is not modelled (the hubs' horizontal
 positions are the set-points').</p>
+<p><b>Moving limbs.</b> The set-points' rates (<code>hipYawRate</code> ... <code>ankleRollRate</code>
+[rad/s], the inputs' derivatives: a master that ramps the set-points gives their slopes, 0 holds
+them) move each hub against the body at J q&#775;<sub>set</sub> (body frame, J at the set-points). That
+velocity, turned into the heading frame by the roll and pitch, adds to the hub's velocity from the
+body's motion: what the wheel rolls or slides over (<code>v_hub</code>, <code>v_lat</code>) and, along
+the normal, the limb's compression rate d&delta;<sub>i</sub>/dt. So a limb that swings a planted
+hub back makes its wheel roll (or, braked, push the body ahead), and one that presses its hub down
+loads it through the servos' damping as well as their stiffness. A hub moved without its rate (rates
+left at 0) jumps relative to the ground as the body stays: the wheel does not see it.</p>
 <p><b>Joint torques and angles.</b> The wheel pushes on its hub with the force F (its loads
 W, F<sub>x</sub>, F<sub>y</sub> turned into the body frame) and the reaction M = -&tau; a of its
 motor (a the axle); the servos hold them with &tau;<sub>joint</sub> = -J<sup>T</sup> (F, M) (virtual

@@ -13,6 +13,12 @@ equation
   body.anklePitch = anklePitch;
   body.ankleSteer = ankleSteer;
   body.ankleRoll = zeros(6);
+  body.hipYawRate = zeros(6);
+  body.hipPitchRate = zeros(6);
+  body.kneePitchRate = zeros(6);
+  body.anklePitchRate = zeros(6);
+  body.ankleSteerRate = zeros(6);
+  body.ankleRollRate = zeros(6);
   body.Fx = zeros(6);
   body.Fy = zeros(6);
   body.tau = zeros(6);

@@ -19,6 +19,12 @@ model LegWheelRover "Leg-wheel rover: the body on six limbs of six joint servos 
   input Real anklePitch[6](each unit="rad", start = {-0.04767786382709138, -1.0539487652318102, -0.04767786382709138, -0.04767786382709138, -1.0539487652318102, -0.04767786382709138}) "Set-points of the ankle pitch joints (start: the paper's posture)";
   input Real ankleSteer[6](each unit="rad", start = {1.2071492427688926, 1.5707963267948974, 1.9344434108209012, -1.2071492427688926, -1.5707963267948974, -1.9344434108209012}) "Set-points of the ankle steer joints (start: the paper's posture)";
   input Real ankleRoll[6](each unit="rad", start = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}) "Set-points of the ankle roll joints (start: the paper's posture)";
+  input Real hipYawRate[6](each unit="rad/s", each start=0) "Rates of the hip yaw set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real hipPitchRate[6](each unit="rad/s", each start=0) "Rates of the hip pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real kneePitchRate[6](each unit="rad/s", each start=0) "Rates of the knee pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real anklePitchRate[6](each unit="rad/s", each start=0) "Rates of the ankle pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real ankleSteerRate[6](each unit="rad/s", each start=0) "Rates of the ankle steer set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real ankleRollRate[6](each unit="rad/s", each start=0) "Rates of the ankle roll set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel";
   input Real soilShare[6](each unit="1", each min=0, each max=1, each start=0) "Share of the second soil (soilB) in the soil under each wheel, from a soil map (0: soil)";
   input Real rutDepth[6](each unit="m", each min=0, each start=0) "Depth of the rut a previous wheel left under each wheel, from a rut participant (0: virgin soil)";
@@ -63,6 +69,12 @@ model LegWheelRover "Leg-wheel rover: the body on six limbs of six joint servos 
 equation
   for i in 1:6 loop
     body.hipYaw[i] = hipYaw[i];
+    body.hipYawRate[i] = hipYawRate[i];
+    body.hipPitchRate[i] = hipPitchRate[i];
+    body.kneePitchRate[i] = kneePitchRate[i];
+    body.anklePitchRate[i] = anklePitchRate[i];
+    body.ankleSteerRate[i] = ankleSteerRate[i];
+    body.ankleRollRate[i] = ankleRollRate[i];
     hipYawAngle[i] = body.hipYawAngle[i];
     hipYawTorque[i] = body.hipYawTorque[i];
     body.hipPitch[i] = hipPitch[i];
@@ -127,8 +139,9 @@ heave, pitch, roll against it; each limb's six joints position servos of stiffne
 torque limit, <code>Parameters.LegWheelParameters</code>); wheels: <code>Components.RigidWheel</code>,
 each fed its hub's velocity in its own frame (the heading its limb's joints give it), the load its
 compliant limb presses into the soil. Inputs: the 36 joint set-points (start: the paper's posture,
-hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity), the six drive
-torques <code>tau</code>, the soil and ground under each wheel (<code>soilShare</code>,
+hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity) and their rates
+(<code>hipYawRate</code> ... <code>ankleRollRate</code> [rad/s], default 0: the hubs' velocity against the
+body), the six drive torques <code>tau</code>, the soil and ground under each wheel (<code>soilShare</code>,
 <code>Interfaces.GroundContacts</code>). Outputs: joint angles and servo torques, hub positions
 (body frame) and headings, wheel loads, forces, slips, slip angles, sinkages and speeds, the body's
 pose and velocity. The contact causality and the limb model: <code>Components.LegWheelChassis</code>;

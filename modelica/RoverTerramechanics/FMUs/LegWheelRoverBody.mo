@@ -8,7 +8,8 @@ model LegWheelRoverBody "Leg-wheel rover body on six limbs of six joint servos f
 <code>Components.LegWheelChassis</code>, the body on six limbs of six joint servos. Inputs: the 36
 joint set-points (<code>hipYaw[1..6]</code>, <code>hipPitch</code>, <code>kneePitch</code>,
 <code>anklePitch</code>, <code>ankleSteer</code>, <code>ankleRoll</code> [rad]; start: the paper's
-posture, hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity), the hub
+posture, hubs at x = 1.5, 0, -1.5 m, y = &plusmn;1.5 m, 1.0 m below the centre of gravity) and their
+rates (<code>hipYawRate</code> ... <code>ankleRollRate</code> [rad/s], default 0), the hub
 forces <code>Fx[1..6]</code>, <code>Fy[1..6]</code> [N] from six <code>Wheel</code>s (in their
 frames), the drive torques <code>tau[1..6]</code> [N&middot;m] and the ground under each hub
 (<code>Interfaces.GroundContacts</code>). Outputs: to the wheels <code>W[1..6]</code> [N],

@@ -11,7 +11,9 @@ its users. For a Modelica user:</p>
 <code>Components.LegWheelChassis</code>, <code>Parameters.LimbParameters</code>,
 <code>Parameters.LegWheelParameters</code>, the FMUs <code>LegWheelRover</code> and
 <code>LegWheelRoverBody</code>, <code>Examples.LimbKinematics</code> and
-<code>Examples.LegWheelStance</code>. The other models are unchanged.</li>
+<code>Examples.LegWheelStance</code>. The other models are unchanged. <code>LegWheelChassis</code>
+takes the set-points' rates (<code>hipYawRate</code> ... <code>ankleRollRate</code>, start 0): a model
+that instantiates it binds them (<code>zeros(6)</code> where its limbs hold still).</li>
 <li>The models exported as FMUs moved into the sub-package <code>FMUs</code>, and
 <code>RoverReconnected</code> (not an FMU) into <code>Examples</code>. A model of your own that
 uses them changes its class names; the FMUs keep their file names, model identifiers and every
