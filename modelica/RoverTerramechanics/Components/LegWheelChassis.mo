@@ -11,12 +11,6 @@ model LegWheelChassis "Leg-wheel rover body (x, y, yaw, heave, pitch, roll) on s
   input Real anklePitch[6](each unit="rad") "Set-points of the ankle pitch joints";
   input Real ankleSteer[6](each unit="rad") "Set-points of the ankle steer joints (the wheels' steering)";
   input Real ankleRoll[6](each unit="rad") "Set-points of the ankle roll joints (the wheels' camber)";
-  input Real hipYawRate[6](each unit="rad/s", each start=0) "Rates of the hip yaw set-points: with the others, the hubs' velocity against the body (0: held)";
-  input Real hipPitchRate[6](each unit="rad/s", each start=0) "Rates of the hip pitch set-points: with the others, the hubs' velocity against the body (0: held)";
-  input Real kneePitchRate[6](each unit="rad/s", each start=0) "Rates of the knee pitch set-points: with the others, the hubs' velocity against the body (0: held)";
-  input Real anklePitchRate[6](each unit="rad/s", each start=0) "Rates of the ankle pitch set-points: with the others, the hubs' velocity against the body (0: held)";
-  input Real ankleSteerRate[6](each unit="rad/s", each start=0) "Rates of the ankle steer set-points: with the others, the hubs' velocity against the body (0: held)";
-  input Real ankleRollRate[6](each unit="rad/s", each start=0) "Rates of the ankle roll set-points: with the others, the hubs' velocity against the body (0: held)";
   input Real Fx[6](each unit="N") "Longitudinal force of each wheel on its hub, along the wheel's heading";
   input Real Fy[6](each unit="N") "Lateral force of each wheel on its hub, to the wheel's left";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel motor; its reaction acts on the limb";
@@ -51,6 +45,12 @@ model LegWheelChassis "Leg-wheel rover body (x, y, yaw, heave, pitch, roll) on s
   output Real heaveRate(unit="m/s", start=0, fixed=true) "Rate of z";
   output Real pitchRate(unit="rad/s", start=0, fixed=true) "Pitch rate";
   output Real rollRate(unit="rad/s", start=0, fixed=true) "Roll rate";
+  input Real hipYawRate[6](each unit="rad/s", each start=0) "Rates of the hip yaw set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real hipPitchRate[6](each unit="rad/s", each start=0) "Rates of the hip pitch set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real kneePitchRate[6](each unit="rad/s", each start=0) "Rates of the knee pitch set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real anklePitchRate[6](each unit="rad/s", each start=0) "Rates of the ankle pitch set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real ankleSteerRate[6](each unit="rad/s", each start=0) "Rates of the ankle steer set-points: with the others, the hubs' velocity against the body (0: held)";
+  input Real ankleRollRate[6](each unit="rad/s", each start=0) "Rates of the ankle roll set-points: with the others, the hubs' velocity against the body (0: held)";
   Real kz[6](each unit="N/m") "Spring of each limb along the ground's normal: kJoint over the squared normal components of its Jacobian's columns";
   Real WLimit[6](each unit="N") "Load at which the limb's most loaded joint reaches the servos' torque limit: the limb yields beyond it";
   Real normal[3](each unit="1") "The ground plane's normal in the body frame";

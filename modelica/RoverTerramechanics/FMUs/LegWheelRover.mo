@@ -19,12 +19,6 @@ model LegWheelRover "Leg-wheel rover: the body on six limbs of six joint servos 
   input Real anklePitch[6](each unit="rad", start = {-0.04767786382709138, -1.0539487652318102, -0.04767786382709138, -0.04767786382709138, -1.0539487652318102, -0.04767786382709138}) "Set-points of the ankle pitch joints (start: the paper's posture)";
   input Real ankleSteer[6](each unit="rad", start = {1.2071492427688926, 1.5707963267948974, 1.9344434108209012, -1.2071492427688926, -1.5707963267948974, -1.9344434108209012}) "Set-points of the ankle steer joints (start: the paper's posture)";
   input Real ankleRoll[6](each unit="rad", start = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}) "Set-points of the ankle roll joints (start: the paper's posture)";
-  input Real hipYawRate[6](each unit="rad/s", each start=0) "Rates of the hip yaw set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
-  input Real hipPitchRate[6](each unit="rad/s", each start=0) "Rates of the hip pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
-  input Real kneePitchRate[6](each unit="rad/s", each start=0) "Rates of the knee pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
-  input Real anklePitchRate[6](each unit="rad/s", each start=0) "Rates of the ankle pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
-  input Real ankleSteerRate[6](each unit="rad/s", each start=0) "Rates of the ankle steer set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
-  input Real ankleRollRate[6](each unit="rad/s", each start=0) "Rates of the ankle roll set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
   input Real tau[6](each unit="N.m") "Drive torque of each wheel";
   input Real soilShare[6](each unit="1", each min=0, each max=1, each start=0) "Share of the second soil (soilB) in the soil under each wheel, from a soil map (0: soil)";
   input Real rutDepth[6](each unit="m", each min=0, each start=0) "Depth of the rut a previous wheel left under each wheel, from a rut participant (0: virgin soil)";
@@ -64,6 +58,12 @@ model LegWheelRover "Leg-wheel rover: the body on six limbs of six joint servos 
   output Real slipAngle[6](each unit="rad") "Slip angle of each wheel's hub velocity";
   output Real sinkage[6](each unit="m") "Sinkage of each wheel";
   output Real omega[6](each unit="rad/s") "Angular velocity of each wheel";
+  input Real hipYawRate[6](each unit="rad/s", each start=0) "Rates of the hip yaw set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real hipPitchRate[6](each unit="rad/s", each start=0) "Rates of the hip pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real kneePitchRate[6](each unit="rad/s", each start=0) "Rates of the knee pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real anklePitchRate[6](each unit="rad/s", each start=0) "Rates of the ankle pitch set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real ankleSteerRate[6](each unit="rad/s", each start=0) "Rates of the ankle steer set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
+  input Real ankleRollRate[6](each unit="rad/s", each start=0) "Rates of the ankle roll set-points (0: held; the hubs move against the body at J q_set', see Components.LegWheelChassis)";
   RoverTerramechanics.Components.LegWheelChassis body(rover=rover, legs=legs, terrain=terrain, height0=height0) "Body and limbs";
   RoverTerramechanics.Components.RigidWheel wheels[6](each soil=soil, each soilB=soilB, each wheel=wheel, each nNodes=nNodes, each nIterations=nIterations, each vEps=vEps, each vHold=vHold, each vStick=vStick) "Wheels 1-6";
 equation
