@@ -106,6 +106,37 @@ def test_a_wheel_off_the_ground_gets_no_torque_and_the_twin_agrees(model):
     twin.made.close()
 
 
+def test_a_light_wheel_gets_the_lightest_loads_torque_scaled_by_its_load_and_the_twin_agrees(model):
+    """Between 1 N and the tables' lightest load the law does not extrapolate its torque tables in
+    1/W nor its Fx model (which turned the torque over: 26 N asked at 30 N gave -5.1 N·m): a wheel
+    at k times that load gets k times the lightest load's torque for the same force (to round-off):
+    continuous there, 0 towards no load, never turned over; a wheel lifting off through those loads
+    and set down again gets the same torques in Python and in C."""
+    block = InverseModelController("ctrl", str(model))
+    inverse = block.inverse
+    lightest = 1.0 / inverse.tables()[0][0]
+    assert lightest > 10.0
+    for force in (1.0, 26.0, 100.0):
+        for k in (0.999999, 0.5, 0.3, 0.1, 0.02):
+            load = k * lightest
+            light = inverse.torques(np.array([load]), np.array([force]), advance=False)[0]
+            at_lightest = inverse.torques(np.array([lightest]), np.array([force]), advance=False)[0]
+            assert light == pytest.approx(k * at_lightest, rel=1e-12), (force, k)
+            assert light > 0, (force, k)
+    u = np.array([0.0, 0.5, *[424.0] * 6])
+    block.start(0.0, u)
+    twin = Twin(block)
+    t = 0.0
+    for k in range(500):  # wheel 1 unloads over 0.1 s, 0.1 s in the air, loaded again over 0.1 s
+        u[2] = max(424.0 * min(abs(k - 250) - 50, 100) / 100, 0.001)
+        expected, got = block.step(t, 1e-3, u), twin.step(t, 1e-3, u)
+        assert np.array_equal(expected, got), f"step {k}: {expected - got}"
+        if u[2] < lightest:  # asked the loaded wheels' pull: driven ahead, never turned over
+            assert expected[0] >= 0.0
+        t += 1e-3
+    twin.made.close()
+
+
 def test_the_c_twin_refuses_what_the_python_block_refuses(model):
     block = InverseModelController("ctrl", str(model))
     u = np.array([0.0, 0.0, *[424.0] * 6])

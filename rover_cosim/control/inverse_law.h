@@ -60,7 +60,8 @@ static int clamp(int j, int low, int high) { return j < low ? low : j > high ? h
 /* _slip_for_force: the slip at which the Fx(W, slip) model gives ``force`` (the quadratic's root
  * nearest the linear solution; a force beyond its extremum: the extremum's slip). */
 static int slip_for_force(Law *c, double load, double force, double *slip) {
-    double k[3] = {0.0, 0.0, 0.0};
+    double k[3] = {0.0, 0.0, 0.0}, lightest = 1.0 / c->inverse[0];
+    if (load > 0 && load < lightest) load = lightest; /* a light wheel: the model at the lightest load */
     for (int i = 0; i <= c->degree && i < 3; i++) {
         const double *row = c->coefficients + 3 * i;
         k[i] = row[0] + row[1] * load + row[2] * load * load;
@@ -113,7 +114,8 @@ static double time_constant(const Law *c, double torque) {
 }
 
 /* A wheel under this load [N] or less is off the ground: no torque, its filter at rest
- * (LongitudinalInverse.NO_LOAD). */
+ * (LongitudinalInverse.NO_LOAD); between it and the tables' lightest load the torque for its target
+ * slip is read at the lightest load and scaled by W / W_lightest. */
 #define LAW_NO_LOAD 1.0
 
 /* The torque of wheel ``i`` for ``force`` at ``load``; ``advance``: the filter moves on by a
@@ -139,9 +141,14 @@ static int law_torque(Law *c, int i, double load, double force, int advance, con
     }
     c->filter[2 * i] = slip;
     c->filter[2 * i + 1] = rate;
-    if (rows_at(c, load) != OK) return ERROR;
+    double share = 1.0, lightest = 1.0 / c->inverse[0], table_load = load; /* lightest: the tables' [N] */
+    if (load > 0 && load < lightest) { /* a light wheel: the torque read at the lightest load, scaled */
+        share = load / lightest;
+        table_load = lightest;
+    }
+    if (rows_at(c, table_load) != OK) return ERROR;
     double constant = time_constant(c, torque_for(c, slip));
-    *torque = torque_for(c, slip + constant * rate);
+    *torque = share * torque_for(c, slip + constant * rate);
     return OK;
 }
 

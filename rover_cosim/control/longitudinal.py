@@ -27,6 +27,14 @@ from rover_cosim.identification.model_set import ModelFileError, ModelSet
 #: inverse model there would ask for any torque at all). The C twins' LAW_NO_LOAD (inverse_law.h).
 NO_LOAD = 1.0
 
+# Below the lightest load of the identified tables (and above NO_LOAD: a wheel lifting off or set
+# down) the law extrapolates neither its Fx model nor its torque tables, which turned the torque over
+# (on the paper's model 26 N asked at 30 N gave -5.1 N·m, and a leg-wheel rover's unloading wheel
+# spun up to -22,800 rad/s): the slip for a force is the model's at the lightest load, the torque
+# for the filtered slip the tables' at the lightest load, scaled by W / W_lightest (the resistance a
+# wheel's torque works against grows about as its load): continuous at W_lightest, 0 at no load.
+# The C twins' slip_for_force and law_torque do the same.
+
 def read_model(model: ModelSet | str | Path, name: str,
                label: str | None = None) -> tuple[ModelSet, IdentifiedModel, str]:
     """(the identified models, the longitudinal model ``label`` (default: the recommended one),
@@ -88,6 +96,8 @@ class LongitudinalInverse:
         law's first step up to round-off (the law evaluates c_k(W) term by term, this a matrix
         product); moving the path controller onto the law changes its results in the last printed
         digit, so that waits for its C twin."""
+        lightest = 1.0 / self._inverse[0]
+        loads = np.where((loads > 0) & (loads < lightest), lightest, loads)  # the light-load rule
         powers = np.vstack([np.ones_like(loads), loads, loads**2])
         c = self.model.fx_coefficients @ powers  # (degree + 1, wheels): c_k(W)
         linear = (forces - c[0]) / c[1]
@@ -111,11 +121,20 @@ class LongitudinalInverse:
         torques, extended linearly beyond them; T linear between them, held beyond)."""
         torques, constants = [], []
         for load, slip in zip(np.asarray(loads, float).tolist(), np.asarray(slips, float).tolist()):
+            share, load = self._light(load)
             settled, log_t = self._rows(load)
             torque = self._torque_for(settled, slip)
-            torques.append(torque)
+            torques.append(share * torque)
             constants.append(self._time_constant(torque, log_t))
         return np.array(torques), np.array(constants)
+
+    def _light(self, load: float) -> tuple[float, float]:
+        """(W / W_lightest, the load the tables are read at) of a wheel under the tables' lightest
+        load (see the module's light-load rule); (1, load) for the others."""
+        lightest = 1.0 / self._inverse[0]
+        if 0 < load < lightest:
+            return load / lightest, lightest
+        return 1.0, load
 
     def torques(self, loads: np.ndarray, forces: np.ndarray, advance: bool, step: float | None = None) -> np.ndarray:
         """The torques for ``forces`` at ``loads``; ``advance`` moves the filter one step on (else
@@ -139,10 +158,12 @@ class LongitudinalInverse:
             else:
                 slip, rate = target, 0.0
             state[i, 0], state[i, 1] = slip, rate
-            # The inverse of K/(T s + 1): tau = (slip + T slip') / K, with T at the torque for slip.
-            settled, log_t = self._rows(load)
+            # The inverse of K/(T s + 1): tau = (slip + T slip') / K, with T at the torque for slip; a
+            # light wheel's read at the tables' lightest load and scaled (the light-load rule above).
+            share, table_load = self._light(load)
+            settled, log_t = self._rows(table_load)
             constant = self._time_constant(self._torque_for(settled, slip), log_t)
-            result[i] = self._torque_for(settled, slip + constant * rate)
+            result[i] = share * self._torque_for(settled, slip + constant * rate)
         return result
 
     def slip_for_force(self, load: float, force: float) -> float:
@@ -156,6 +177,7 @@ class LongitudinalInverse:
         loaded wheels) gets the slip of the extremum, the most the model knows to give (before: the
         linear model's slip, which on the paper's model at 400 N asks 0.175 for 171 N where the
         peak, 152 N, is at 0.31: a rover that could climb stalled)."""
+        load = self._light(load)[1]  # a light wheel: the model at the lightest load (the light-load rule)
         c = [row[0] + row[1] * load + row[2] * load * load for row in self._coefficients]
         linear = (force - c[0]) / c[1]
         if self.model.degree == 1:
