@@ -18,12 +18,14 @@ from typing import Any
 
 import pytest
 
-distributed = pytest.importorskip("distributed", reason="dask.distributed not installed")
 psutil = pytest.importorskip("psutil", reason="psutil not installed")
 
 
 @pytest.fixture(scope="module")
 def cluster() -> Iterator[Any]:
+    # imported here, not at collection: dask.distributed takes a third of a second to import, in
+    # every test worker that collects this module (make test-fast collects it without running it)
+    distributed = pytest.importorskip("distributed", reason="dask.distributed not installed")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
                                   processes=True) as local, distributed.Client(local) as client:
         yield client
