@@ -15,6 +15,7 @@ import fmpy
 import numpy as np
 import pandas as pd
 import pytest
+from cs_slave import Slave
 
 from rover_cosim.control.posture import JOINT_INPUTS, Posture, PostureController, StepOver, posture_joints
 from rover_cosim.limbs import athlete_limbs, attitude, forward, holding_torques, static_loads
@@ -332,15 +333,6 @@ def test_at_rest_the_leg_wheel_rover_stays_put_carries_its_weight_and_holds_it_b
         np.testing.assert_allclose([last[f"hub{a}[{i}]"] for a in "XYZ"], forward(limb, q).hub, atol=1e-9)
 
 
-def _slave(fmu: Path, tmp: Path, **start: float) -> tuple[Any, dict[str, int]]:
-    """``fmu`` as an initialized FMI 2.0 Co-Simulation slave with ``start`` values (FMPy), and its
-    value references by name."""
-    from cs_slave import Slave
-
-    slave = Slave(fmu, tmp, start=start)
-    return slave, slave.refs
-
-
 def test_the_set_points_rates_move_the_hubs_against_the_body_at_j_qdot(fmus, tmp_path):
     """LegWheelRoverBody with its body rolled and pitched against the ground: the set-points' rates
     add R J q_set' (numpy's Jacobian and attitude) to each hub's velocity, along the wheel's heading
@@ -351,7 +343,9 @@ def test_the_set_points_rates_move_the_hubs_against_the_body_at_j_qdot(fmus, tmp
     from rover_cosim.terramechanics.library import choose
 
     roll, pitch = 0.01, -0.005  # every wheel loaded, none to its limb's yield load
-    slave, refs = _slave(fmus["LegWheelRoverBody"], tmp_path, roll=roll, pitch=pitch, height0=settled_height(choose()))
+    slave = Slave(fmus["LegWheelRoverBody"], tmp_path, start={"roll": roll, "pitch": pitch,
+                                                              "height0": settled_height(choose())})
+    refs = slave.refs
     parameters = {v.name: float(v.start) for v in slave.description.modelVariables if v.name.startswith("legs.")}
     stiffness, damping = parameters["legs.kJoint"], parameters["legs.dJoint"]
     joints = joints_of(posture_joints())
@@ -398,7 +392,8 @@ def test_a_limb_that_swings_its_hub_back_makes_its_free_wheel_roll_and_the_body_
     rate = np.linalg.solve(jacobian(LIMBS[0], joints[0]), [-0.2, 0.0, 0.0, 0.0, 0.0, 0.0])
     spins = {}
     for given in (True, False):
-        slave, refs = _slave(fmus["LegWheelRover"], tmp_path / str(given), height0=settled_height(choose()))
+        slave = Slave(fmus["LegWheelRover"], tmp_path / str(given), start={"height0": settled_height(choose())})
+        refs = slave.refs
         set_points = [refs[f"{joint}[1]"] for joint in JOINT_INPUTS]
         rate_inputs = [refs[f"{joint}Rate[1]"] for joint in JOINT_INPUTS]
         step = 1e-3

@@ -57,10 +57,13 @@ static int bisect_right(const double *a, int n, double x) {
 
 static int clamp(int j, int low, int high) { return j < low ? low : j > high ? high : j; }
 
+/* The tables' lightest load [N]: a wheel under it is read there (LongitudinalInverse's light-load rule). */
+static double lightest_load(const Law *c) { return 1.0 / c->inverse[0]; }
+
 /* _slip_for_force: the slip at which the Fx(W, slip) model gives ``force`` (the quadratic's root
  * nearest the linear solution; a force beyond its extremum: the extremum's slip). */
 static int slip_for_force(Law *c, double load, double force, double *slip) {
-    double k[3] = {0.0, 0.0, 0.0}, lightest = 1.0 / c->inverse[0];
+    double k[3] = {0.0, 0.0, 0.0}, lightest = lightest_load(c);
     if (load > 0 && load < lightest) load = lightest; /* a light wheel: the model at the lightest load */
     for (int i = 0; i <= c->degree && i < 3; i++) {
         const double *row = c->coefficients + 3 * i;
@@ -141,7 +144,7 @@ static int law_torque(Law *c, int i, double load, double force, int advance, con
     }
     c->filter[2 * i] = slip;
     c->filter[2 * i + 1] = rate;
-    double share = 1.0, lightest = 1.0 / c->inverse[0], table_load = load; /* lightest: the tables' [N] */
+    double share = 1.0, lightest = lightest_load(c), table_load = load;
     if (load > 0 && load < lightest) { /* a light wheel: the torque read at the lightest load, scaled */
         share = load / lightest;
         table_load = lightest;

@@ -59,6 +59,7 @@ class LongitudinalInverse:
         # The tables as plain Python floats (see the module docstring).
         self._inverse = [float(v) for v in 1.0 / np.asarray(model.loads, float)]   # decreasing
         self._negated_inverse = [-v for v in self._inverse]                          # increasing, for bisect
+        self._lightest = 1.0 / self._inverse[0]  # N, the tables' lightest load (the light-load rule)
         self._torques = [float(v) for v in model.torques]
         self._settled = [[float(v) for v in row] for row in np.asarray(model.gain) * model.torques[None, :]]
         self._log_t = [[float(v) for v in row] for row in np.log(np.asarray(model.time_constant, float))]
@@ -96,7 +97,7 @@ class LongitudinalInverse:
         law's first step up to round-off (the law evaluates c_k(W) term by term, this a matrix
         product); moving the path controller onto the law changes its results in the last printed
         digit, so that waits for its C twin."""
-        lightest = 1.0 / self._inverse[0]
+        lightest = self._lightest
         loads = np.where((loads > 0) & (loads < lightest), lightest, loads)  # the light-load rule
         powers = np.vstack([np.ones_like(loads), loads, loads**2])
         c = self.model.fx_coefficients @ powers  # (degree + 1, wheels): c_k(W)
@@ -131,7 +132,7 @@ class LongitudinalInverse:
     def _light(self, load: float) -> tuple[float, float]:
         """(W / W_lightest, the load the tables are read at) of a wheel under the tables' lightest
         load (see the module's light-load rule); (1, load) for the others."""
-        lightest = 1.0 / self._inverse[0]
+        lightest = self._lightest
         if 0 < load < lightest:
             return load / lightest, lightest
         return 1.0, load
