@@ -233,6 +233,7 @@ static void set_defaults(Instance *c) {
     c->has_stop = 0;
     c->mode = MODE_INSTANTIATED;
     c->solver.h = 0.0;
+    c->solver.h_entry = 0.0;
     c->solver.jac_valid = 0;
     c->solver.steps = c->solver.rejected = c->solver.jacobians = c->solver.rhs_calls = 0;
     c->eval.evaluations = c->eval.reused = 0;
@@ -360,6 +361,7 @@ Status rc_exit_initialization(Instance *c, int f) {
     if (status == STATUS_ERROR) return STATUS_ERROR;
     c->mode = c->kind == KIND_MODEL_EXCHANGE ? MODE_EVENT : MODE_STEP;
     c->solver.h = 0.0;
+    c->solver.h_entry = 0.0;
     c->solver.f0_valid = 0;
     c->solver.jac_valid = 0;
     return status;

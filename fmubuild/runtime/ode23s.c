@@ -23,6 +23,7 @@ int ode23s_alloc(Ode23s *s, int n, void *(*alloc)(size_t, size_t)) {
     s->tmp = alloc(m, sizeof(double));
     s->pivot = alloc(m, sizeof(int));
     s->h = 0.0;
+    s->h_entry = 0.0;
     s->f0_valid = 0;
     s->jac_valid = s->jac_current = s->jac_age = 0;
     s->jacobian_max_age = 100;
@@ -95,7 +96,9 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
     const double h_min = 16.0 * 2.220446049250313e-16 * fmax(fabs(*t), fabs(t_end));
     double h_max = s->max_step > 0.0 ? fmin(s->max_step, span) : span;
     double h = s->h > 0.0 ? fmin(s->h, h_max) : fmin(h_max, 1e-3 * span + 0.0);
+    if (s->h_entry > 0.0) h = fmin(h, s->h_entry); /* the transient at the last call's start */
     long attempts = 0;
+    int first = 1;
 
     if (!s->f0_valid) {
         if (s->rhs(s->ctx, *t, x, s->F0) || !all_finite(s->F0, n)) {
@@ -128,7 +131,12 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
         }
         double remaining = t_end - *t;
         double h_try = h;
-        if (h >= remaining || remaining - h < h_min) h = remaining;
+        if (h >= remaining || remaining - h < h_min) {
+            h = remaining;
+        } else { /* equal steps to t_end, none longer than h */
+            double k = ceil(remaining / h * (1.0 - 1e-9));
+            h = k <= 1.0 ? remaining : remaining / k;
+        }
         /* The last stage lands on t_end exactly: the model evaluated there is the one the
          * outputs after the step ask for. */
         const double t_new = (h == remaining) ? t_end : *t + h;
@@ -173,8 +181,11 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
             for (int i = 0; i < n; i++) { x[i] = s->xn[i]; s->F0[i] = s->F2[i]; }
             s->steps++;
             double grow = err > 0.0 ? fmin(5.0, 0.8 * pow(err, -1.0 / 3.0)) : 5.0;
-            /* A step shortened to land on t_end says little about the next one: keep the proposal. */
-            s->h = h < h_try ? h_try : h * grow;
+            /* A step shortened to land on t_end with a small error says little about the next one:
+             * it keeps the proposal; one whose error asks for shorter steps proposes its own. */
+            s->h = h < h_try && grow >= 1.0 ? fmax(h_try, h * grow) : h * grow;
+            if (first) s->h_entry = s->h;
+            first = 0;
             if (s->max_step > 0.0) s->h = fmin(s->h, s->max_step);
             h = fmin(s->h, h_max);
             s->jac_current = 0;

@@ -7,7 +7,18 @@
  * are equally accurate (the tolerance sets the error); 100 is 1.4x faster than 20 on Rover.fmu,
  * 1.55x on LegWheelRover.fmu, 200 no faster. A refresh whenever an accepted step's error
  * estimate passed half the tolerance bought no accuracy and made Wheel.fmu (inputs moving every
- * step) refresh at nearly every step. */
+ * step) refresh at nearly every step.
+ *
+ * Steps towards the end of a call: what is left is split into equal steps no longer than 1.25
+ * times the step size proposed (not a proposed step and a sliver after it, which costs two model
+ * evaluations for nothing), and a call begins with at most the step size its last call proposed
+ * after its first step (h_entry): the inputs an importer sets at a communication point start a
+ * transient there (a wheel's spin under a new torque) that the steps at the end of the last call,
+ * past their own, say nothing about. Measured on the leg-wheel rover's soft-patch run (the stuck
+ * wheel's spin the stiffest mode): each communication step used to begin with a rejected step
+ * and a new Jacobian (932 rejected steps and 973 Jacobians in 8 s), now 79 and 207, 1.6 -> 1.1 s;
+ * its error against a tolerance of 1e-10 the same (largest 2.5e-2 of a column's range against
+ * 3.7e-2). */
 #ifndef ROVER_COSIM_ODE23S_H
 #define ROVER_COSIM_ODE23S_H
 
@@ -32,6 +43,7 @@ typedef struct {
     double *J, *T, *W, *F0, *F1, *F2, *k1, *k2, *k3, *xn, *tmp;
     int *pivot;
     double h;            /* step size to try next (kept between calls) */
+    double h_entry;      /* step size proposed after the first step of the last call (0: none yet) */
     int f0_valid;        /* F0 = f(t, x) at the current point is known */
     int jac_valid;       /* J may be used; clear it when the model changes (parameters, reset) */
     int jac_current;     /* J was evaluated at the current point */

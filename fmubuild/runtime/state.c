@@ -6,7 +6,7 @@
 
 #include "core.h"
 
-#define FMU_STATE_MAGIC 0x524f5647u /* layout 5: the interface kind, input derivatives and statistics */
+#define FMU_STATE_MAGIC 0x524f5648u /* layout 6: the interface kind, input derivatives, statistics, h_entry */
 
 /* What a saved FMU state holds. */
 typedef struct {
@@ -15,7 +15,7 @@ typedef struct {
     int mode;
     int f0_valid, jac_valid, jac_current, jac_age;  /* integrator memory, so a restored run repeats exactly */
     int interpolating;  /* input derivatives set for the next step (u_der follows the inputs) */
-    double t, rtol, max_step, h, t_step;
+    double t, rtol, max_step, h, h_entry, t_step;
     long steps, rejected, jacobians, rhs_calls;    /* the statistics */
     unsigned long long evaluations, reused, updated;
     uint64_t checksum;  /* FNV-1a of the header (this field zero) and the doubles that follow */
@@ -60,6 +60,7 @@ static void state_write(const Instance *c, unsigned char *payload) {
     head.f0_valid = c->solver.f0_valid; head.jac_valid = c->solver.jac_valid;
     head.jac_current = c->solver.jac_current; head.jac_age = c->solver.jac_age;
     head.t = c->t; head.rtol = c->rtol; head.max_step = c->max_step; head.h = c->solver.h;
+    head.h_entry = c->solver.h_entry;
     memcpy(payload, &head, sizeof head);
     double *v = (double *)(payload + sizeof head);
     memcpy(v, c->x, sizeof(double) * model_info.nx); v += model_info.nx;
@@ -89,6 +90,7 @@ static const char *state_refusal(const unsigned char *payload, size_t size, Kind
                                               : "it was saved by a Co-Simulation instance, this one is Model Exchange";
     if (head.mode < 0 || head.mode >= MODE_COUNT || head.jac_age < 0 || !isfinite(head.t) ||
         !(head.rtol > 0.0 && head.rtol < 1.0) || !(head.max_step >= 0.0) || !(head.h >= 0.0) || !isfinite(head.h) ||
+        !(head.h_entry >= 0.0) || !isfinite(head.h_entry) ||
         !isfinite(head.t_step) || head.steps < 0 || head.rejected < 0 || head.jacobians < 0 || head.rhs_calls < 0)
         return "its values are out of range";
     return NULL;
@@ -119,6 +121,7 @@ static void state_read(Instance *c, const unsigned char *payload) {
     c->solver.jac_current = head.jac_current != 0;
     c->solver.jac_age = head.jac_age;
     c->solver.h = head.h;
+    c->solver.h_entry = head.h_entry;
     c->solver.steps = head.steps; c->solver.rejected = head.rejected;
     c->solver.jacobians = head.jacobians; c->solver.rhs_calls = head.rhs_calls;
     c->eval.evaluations = head.evaluations; c->eval.reused = head.reused; c->eval.updated = head.updated;
