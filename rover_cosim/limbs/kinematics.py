@@ -6,7 +6,8 @@ limb's joint vector is ``q = (q1 .. q6)`` [rad] in the order of ``geometry.JOINT
 driving posture hangs the ankle link along the world's vertical (down) with the wheel's axle
 horizontal; the wheel rolls along ``axle x up`` (its heading).
 
-- :func:`forward`: the joint frames and the hub (position, link and axle directions), 4x4 transforms.
+- :func:`forward`: the joint frames and the hub (position, link and axle directions), the frame turned
+  joint by joint about one of its axes.
 - :func:`jacobian`: d(hub position)/dq and the joints' axes (geometric Jacobian, 6 x 6).
 - :func:`inverse`: the joints that put the hub at a point with the ankle link vertical and the
   wheel rolling along a heading: closed form on a level body (the hip yaw from the plane of the
@@ -96,20 +97,52 @@ def _checked(q: ArrayLike) -> FloatArray:
     return joints
 
 
+Vector = tuple[float, float, float]
+
+
+def _frames(geometry: LimbGeometry, q: Sequence[float]) -> tuple[list[Vector], list[Vector], Vector, Vector, Vector]:
+    """The joints' origins and axes [m, 1], the hub, the link and the axle of :func:`forward`, in
+    floats: the frame's columns turned joint by joint (a 3 x 3 product with a rotation about one
+    axis changes two columns), a tenth of the cost of the matrices in numpy, which was the posture
+    controller's inverse kinematics."""
+    q1, q2, q3, q4, q5, q6 = q
+    c, s = math.cos(geometry.mount_yaw), math.sin(geometry.mount_yaw)
+    x_axis, y_axis, z_axis = (c, s, 0.0), (-s, c, 0.0), (0.0, 0.0, 1.0)  # the columns of rot_z(mount yaw)
+    position = (float(geometry.mount[0]), float(geometry.mount[1]), float(geometry.mount[2]))
+    origins: list[Vector] = []
+    axes: list[Vector] = []
+    for axis, angle, length in ((2, q1, 0.0), (1, q2, geometry.thigh), (1, q3, geometry.shank),
+                                (1, q4, geometry.ankle), (0, q5, 0.0), (2, q6, geometry.hub_offset)):
+        origins.append(position)
+        axes.append((x_axis, y_axis, z_axis)[axis])
+        c, s = math.cos(angle), math.sin(angle)
+        if axis == 2:    # rot_z: x' = c x + s y, y' = -s x + c y
+            x_axis, y_axis = _combine(c, x_axis, s, y_axis), _combine(-s, x_axis, c, y_axis)
+        elif axis == 1:  # rot_y: x' = c x - s z, z' = s x + c z
+            x_axis, z_axis = _combine(c, x_axis, -s, z_axis), _combine(s, x_axis, c, z_axis)
+        else:            # rot_x: y' = c y + s z, z' = -s y + c z
+            y_axis, z_axis = _combine(c, y_axis, s, z_axis), _combine(-s, y_axis, c, z_axis)
+        position = (position[0] + length * x_axis[0], position[1] + length * x_axis[1],
+                    position[2] + length * x_axis[2])
+    return origins, axes, position, x_axis, y_axis
+
+
+def _combine(a: float, u: Vector, b: float, v: Vector) -> Vector:
+    return a * u[0] + b * v[0], a * u[1] + b * v[1], a * u[2] + b * v[2]
+
+
+def _cross(a: Vector, b: Vector) -> Vector:
+    return a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+
+
+def _dot(a: Sequence[float], b: Sequence[float]) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
 def forward(geometry: LimbGeometry, q: ArrayLike) -> LimbPose:
     """The limb's frames and hub for the joint angles ``q`` [rad] (body frame, SI)."""
-    q1, q2, q3, q4, q5, q6 = _checked(q)
-    position = np.array(geometry.mount)
-    rotation = rot_z(geometry.mount_yaw)
-    origins, axes = [], []
-    steps = ((rot_z, q1, 0.0, 2), (rot_y, q2, geometry.thigh, 1), (rot_y, q3, geometry.shank, 1),
-             (rot_y, q4, geometry.ankle, 1), (rot_x, q5, 0.0, 0), (rot_z, q6, geometry.hub_offset, 2))
-    for turn, angle, length, axis in steps:
-        origins.append(position.copy())
-        axes.append(rotation[:, axis].copy())
-        rotation = rotation @ turn(angle)
-        position = position + length * rotation[:, 0]
-    return LimbPose(np.array(origins), np.array(axes), position, rotation[:, 0].copy(), rotation[:, 1].copy())
+    origins, axes, hub, link, axle = _frames(geometry, [float(v) for v in _checked(q)])
+    return LimbPose(np.array(origins), np.array(axes), np.array(hub), np.array(link), np.array(axle))
 
 
 def jacobian(geometry: LimbGeometry, q: ArrayLike) -> FloatArray:
@@ -214,13 +247,17 @@ def _conditions_and_slopes(geometry: LimbGeometry, q: FloatArray, hub: FloatArra
     axle normal to the heading (1), the axle level (1, camber 0); and their derivatives by the
     joints (7 x 6): the hub's by the geometric Jacobian, a direction d's by a_k x d (every joint
     turns the hub frame)."""
-    pose = forward(geometry, q)
-    linear = cross(pose.axes, pose.hub - pose.origins).T
-    link_turns, axle_turns = cross(pose.axes, pose.link), cross(pose.axes, pose.axle)
-    residual = np.concatenate([pose.hub - hub, [pose.link @ forward_dir, pose.link @ across,
-                                                pose.axle @ forward_dir, pose.axle @ up]])
-    slopes = np.vstack([linear, link_turns @ forward_dir, link_turns @ across, axle_turns @ forward_dir,
-                        axle_turns @ up])
+    origins, axes, position, link, axle = _frames(geometry, q.tolist())
+    heading, side, vertical = forward_dir.tolist(), across.tolist(), up.tolist()
+    slopes = np.empty((7, JOINTS))
+    for k, (origin, axis) in enumerate(zip(origins, axes)):
+        lever = (position[0] - origin[0], position[1] - origin[1], position[2] - origin[2])
+        link_turn, axle_turn = _cross(axis, link), _cross(axis, axle)
+        slopes[:, k] = (*_cross(axis, lever), _dot(link_turn, heading), _dot(link_turn, side),
+                        _dot(axle_turn, heading), _dot(axle_turn, vertical))
+    target = hub.tolist()
+    residual = np.array([position[0] - target[0], position[1] - target[1], position[2] - target[2],
+                         _dot(link, heading), _dot(link, side), _dot(axle, heading), _dot(axle, vertical)])
     return residual, slopes
 
 
