@@ -14,6 +14,10 @@ from rover_cosim.control.posture import JOINT_INPUTS
 from rover_cosim.identification.figures import png_bytes
 from rover_cosim.limbs import athlete_limbs, attitude, forward
 
+#: Points per line of a panel of :func:`limbs` (thinned: each of its six columns is about 330 pixels
+#: wide at 110 dpi, so 1000 points keep every pixel's extremes; the default 4000 cost a sixth of the
+#: figure's drawing more).
+PANEL_POINTS = 1000
 JOINT_LABELS = ("hip yaw", "hip pitch", "knee pitch", "ankle pitch", "ankle steer", "ankle roll")
 LIMB_NAMES = ("front left", "middle left", "rear left", "front right", "middle right", "rear right")
 
@@ -80,14 +84,13 @@ def limbs(tables: dict[str, pd.DataFrame], title: str) -> bytes:
     for column in range(6):
         i = column + 1
         for run, (label, table) in enumerate(tables.items()):
-            t = table["time"]
+            style, t = styles[run % 4], table["time"]
             for k, name in enumerate(JOINT_INPUTS):
-                axes[0][column].plot(*thinned(t, table[f"{name}Torque_{i}"]), styles[run % 4], color=f"C{k}", lw=1,
-                                     label=f"{JOINT_LABELS[k]}" if run == 0 else None)
-            axes[1][column].plot(*thinned(t, table[f"Fz_{i}"]), styles[run % 4], color="C0", lw=1.2, label=label)
-            axes[2][column].plot(*thinned(t, 1e3 * table[f"sinkage_{i}"]), styles[run % 4], color="C1", lw=1.2,
-                                 label=label)
-            axes[3][column].plot(*thinned(t, table[f"slip_{i}"]), styles[run % 4], color="C2", lw=1.2, label=label)
+                axes[0][column].plot(*thinned(t, table[f"{name}Torque_{i}"], PANEL_POINTS), style, color=f"C{k}",
+                                     lw=1, label=f"{JOINT_LABELS[k]}" if run == 0 else None)
+            for row, values, color in ((1, table[f"Fz_{i}"], "C0"), (2, 1e3 * table[f"sinkage_{i}"], "C1"),
+                                       (3, table[f"slip_{i}"], "C2")):
+                axes[row][column].plot(*thinned(t, values, PANEL_POINTS), style, color=color, lw=1.2, label=label)
         axes[0][column].set_title(f"limb {i} ({LIMB_NAMES[column]})")
         axes[3][column].set_xlabel("time [s]")
     for ax, label in zip(axes[:, 0], ("joint torque [N·m]", "load Fz [N]", "sinkage [mm]", "slip ratio [-]")):
