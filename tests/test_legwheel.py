@@ -288,6 +288,28 @@ def test_a_failing_posture_update_in_the_c_twin_fails_the_run_naming_the_block_a
         run(system)
 
 
+def test_posture_ramps_enter_the_integrators_dfdt_one_step_per_communication_step(fmus, identified, results_root):
+    """The side slope with posture control: its set-points ramp over every step (and the steering
+    on them), a braking wheel's spin the stiffest mode. With d xdot / d u times the ramps' slopes in
+    the Co-Simulation integrator's dfdt it takes one internal step per communication step once
+    settled (it took three: the Rosenbrock stages then missed how the right-hand side moves with
+    the inputs)."""
+    import dataclasses
+
+    from rover_cosim.jobs import legwheel
+    from rover_cosim.orchestrator.master import run
+    from rover_cosim.orchestrator.model import Port
+
+    model = results_root / "identification" / "model.json"
+    system = legwheel.slope_system(fmus["LegWheelRover"].parent, model, "posture")
+    system = dataclasses.replace(system, stop_time=2.0, record=[*system.record, Port.parse("rover.statistics.steps")])
+    data = run(system).data
+    steps = data["rover.statistics.steps"].to_numpy()
+    settled = np.searchsorted(data["time"].to_numpy(), 0.5)
+    communication = len(data) - 1 - settled
+    assert steps[-1] - steps[settled] <= 1.1 * communication, (steps[-1] - steps[settled], communication)
+
+
 def test_posture_settings_out_of_range_are_refused_with_their_value():
     with pytest.raises(ValueError, match=r"slope = 2.0 rad: expected \[0, pi/2\)"):
         PostureController("p", slope=2.0)

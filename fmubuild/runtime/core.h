@@ -87,6 +87,13 @@ struct Instance {
      * column-major (0 elsewhere), where the other inputs and the parameters are (gain_valid) */
     double *gain;
     int gain_valid;
+    /* The integrator's dfdt (solver.T) for the step: the model's explicit time derivative
+     * (t_explicit) plus d xdot / d u times the input derivatives while the inputs are interpolated:
+     * the right-hand side then moves with time through them too (a Rosenbrock method needs it).
+     * dfdu (nx x nu, column-major) holds the columns of the inputs that ramped when the Jacobian
+     * was taken (by forward differences: dfdu_valid[j] != 0), an input that starts to ramp
+     * later takes a new Jacobian. u_fd, fd_*: the differences' scratch. */
+    double *t_explicit, *dfdu, *dfdu_valid, *u_fd, *fd_xdot, *fd_y, *fd_holds, *fd_values;
     int f0_updated;  /* the integrator's derivatives were updated for such inputs since the last step */
     Evaluation eval;
     Ode23s solver;
@@ -139,6 +146,7 @@ Status rc_terminate(Instance *c);
 void rc_invalidate(Instance *c);        /* outputs and derivatives to be evaluated again */
 /* The inputs at t: the held values, or their linear interpolation within the step (u_step). */
 const double *rc_inputs_at(Instance *c, double t);
+void rc_input_rates(Instance *c);       /* solver.T for the input derivatives of the next step */
 void rc_forget_evaluation(Instance *c); /* the last evaluation is no longer reused (parameters changed) */
 void rc_remember(Instance *c);          /* after a completed step: the memories take their values */
 /* Outputs (need_y) and derivatives (need_xdot) at the current point, with the asserts. */

@@ -58,6 +58,7 @@ Status rc_do_step(Instance *c, int f, double currentCommunicationPoint, double c
     c->h_step = communicationStepSize;
     if (c->f0_updated && c->solver.f0_valid) c->eval.updated++; /* begun from updated derivatives */
     c->f0_updated = 0;
+    rc_input_rates(c); /* dfdt with this step's input derivatives (none: the model's own) */
     int status = ode23s_integrate(&c->solver, &t, c->x, t_end, message, sizeof message);
     c->t = t;
     c->xdot_valid = 0;

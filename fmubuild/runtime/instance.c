@@ -121,11 +121,69 @@ static int rhs(void *ctx, double t, const double *x, double *xdot) {
     return 0;
 }
 
+/* dfdt = t_explicit, plus dfdu . u_der while the inputs are interpolated (held: t_explicit, bit for bit). */
+static void rates_into(const Instance *c, double *dfdt) {
+    int nx = model_info.nx;
+    if (nx) memcpy(dfdt, c->t_explicit, sizeof(double) * (size_t)nx);
+    if (!c->interpolating) return;
+    for (int j = 0; j < model_info.nu; j++) {
+        double rate = c->u_der[j];
+        if (rate == 0.0) continue;
+        const double *column = c->dfdu + (size_t)nx * j;
+        for (int i = 0; i < nx; i++) dfdt[i] += column[i] * rate;
+    }
+}
+
+/* Relative step of the forward differences of dfdu: the sinkage solves converge to 1e-10, so a
+ * step of 1e-6 keeps their noise at 1e-4 of a column and its truncation error about as small. */
+#define INPUT_DIFFERENCE 1e-6
+
+/* dfdu's columns of the inputs that ramp (u_der != 0) at (t, x), by forward differences from the
+ * evaluation there; the others marked unknown. Leaves the instance's evaluation as it was. */
+static int input_columns(Instance *c, double t, const double *x) {
+    int nx = model_info.nx, nu = model_info.nu;
+    for (int j = 0; j < nu; j++) c->dfdu_valid[j] = 0.0;
+    if (!c->interpolating || nx == 0) return 0;
+    if (evaluate(c, t, x)) return -1;
+    const double *base = c->eval.xdot;
+    if (nu) memcpy(c->u_fd, rc_inputs_at(c, t), sizeof(double) * (size_t)nu);
+    for (int j = 0; j < nu; j++) {
+        if (c->u_der[j] == 0.0) continue;
+        double held = c->u_fd[j];
+        c->u_fd[j] = held + INPUT_DIFFERENCE * fmax(fabs(held), 1.0);
+        double delta = c->u_fd[j] - held;
+        c->arg[0] = &t; c->arg[1] = x; c->arg[2] = c->u_fd; c->arg[3] = c->p; c->arg[4] = c->m;
+        c->res[0] = c->fd_xdot; c->res[1] = c->fd_y; c->res[2] = c->fd_holds; c->res[3] = c->fd_values;
+        c->eval.evaluations++;
+        int failed = model_evaluate(c->arg, c->res, c->iw, c->w, 0);
+        c->u_fd[j] = held;
+        if (failed || !all_finite(c->fd_xdot, nx)) return -1;
+        double *column = c->dfdu + (size_t)nx * j;
+        for (int i = 0; i < nx; i++) column[i] = (c->fd_xdot[i] - base[i]) / delta;
+        c->dfdu_valid[j] = 1.0;
+    }
+    return 0;
+}
+
 static int jacobian(void *ctx, double t, const double *x, double *dfdx, double *dfdt) {
     Instance *c = ctx;
+    if (input_columns(c, t, x)) return -1;
     c->arg[0] = &t; c->arg[1] = x; c->arg[2] = rc_inputs_at(c, t); c->arg[3] = c->p; c->arg[4] = c->m;
-    c->res[0] = dfdx; c->res[1] = dfdt;
-    return model_ode_jacobian(c->arg, c->res, c->iw, c->w, 0);
+    c->res[0] = dfdx; c->res[1] = c->t_explicit;
+    if (model_ode_jacobian(c->arg, c->res, c->iw, c->w, 0)) return -1;
+    rates_into(c, dfdt);
+    return 0;
+}
+
+void rc_input_rates(Instance *c) {
+    if (!c->solver.jac_valid) return; /* the step begins with a new Jacobian, and dfdt with it */
+    if (c->interpolating)
+        for (int j = 0; j < model_info.nu; j++)
+            if (c->u_der[j] != 0.0 && c->dfdu_valid[j] == 0.0) {
+                c->solver.jac_valid = 0; /* an input that did not ramp at the last Jacobian now does */
+                return;
+            }
+    rates_into(c, c->solver.T);
 }
 
 /* States whose start value is an expression of the parameters, unless the user set them. */
@@ -248,7 +306,8 @@ void rc_free(Instance *c) {
     void (*release)(void *) = c->release;
     void *blocks[] = {c->name, c->p, c->x, c->m, c->u, c->u_der, c->u_step, c->xdot, c->y, c->x_set, c->holds, c->assert_values,
                       (void *)c->arg, c->res, c->iw, c->w, c->seed_x, c->seed_u, c->sens_x, c->sens_y, c->gain,
-                      c->eval.x, c->eval.u, c->eval.m, c->eval.xdot, c->eval.y, c->eval.holds, c->eval.values};
+                      c->t_explicit, c->dfdu, c->dfdu_valid, c->u_fd, c->fd_xdot, c->fd_y, c->fd_holds,
+                      c->fd_values, c->eval.x, c->eval.u, c->eval.m, c->eval.xdot, c->eval.y, c->eval.holds, c->eval.values};
     for (size_t i = 0; i < sizeof(blocks) / sizeof(blocks[0]); i++) if (blocks[i]) release(blocks[i]);
     ode23s_free(&c->solver, release);
     release(c);
@@ -292,6 +351,14 @@ static int allocate_work(Instance *c) {
     c->sens_x = alloc(nx, sizeof(double));
     c->sens_y = alloc(ny, sizeof(double));
     c->gain = alloc(nx * nu, sizeof(double));
+    c->t_explicit = alloc(nx, sizeof(double));
+    c->dfdu = alloc(nx * nu, sizeof(double));
+    c->dfdu_valid = alloc(nu, sizeof(double));
+    c->u_fd = alloc(nu, sizeof(double));
+    c->fd_xdot = alloc(nx, sizeof(double));
+    c->fd_y = alloc(ny, sizeof(double));
+    c->fd_holds = alloc(model_info.n_asserts ? (size_t)model_info.n_asserts : 1, sizeof(double));
+    c->fd_values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
     Evaluation *e = &c->eval;
     e->x = alloc(nx, sizeof(double));
     e->u = alloc(nu, sizeof(double));
@@ -302,7 +369,8 @@ static int allocate_work(Instance *c) {
     e->values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
     int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
     return c->p && c->m && c->x && c->u && c->u_der && c->u_step && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
-           c->seed_u && c->sens_x && c->sens_y && c->gain && e->x && e->u && e->xdot && e->y && e->holds && e->values &&
+           c->seed_u && c->sens_x && c->sens_y && c->gain && c->t_explicit && c->dfdu && c->dfdu_valid && c->u_fd && c->fd_xdot &&
+           c->fd_y && c->fd_holds && c->fd_values && e->x && e->u && e->xdot && e->y && e->holds && e->values &&
            e->m && !solver_failed;
 }
 

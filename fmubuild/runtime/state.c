@@ -6,7 +6,7 @@
 
 #include "core.h"
 
-#define FMU_STATE_MAGIC 0x524f5648u /* layout 6: the interface kind, input derivatives, statistics, h_entry */
+#define FMU_STATE_MAGIC 0x524f5648u /* layout 6: kind, input derivatives, statistics, h_entry, dfdt's parts */
 
 /* What a saved FMU state holds. */
 typedef struct {
@@ -19,7 +19,8 @@ typedef struct {
     long steps, rejected, jacobians, rhs_calls;    /* the statistics */
     unsigned long long evaluations, reused, updated;
     uint64_t checksum;  /* FNV-1a of the header (this field zero) and the doubles that follow */
-    /* followed by x[nx], u[nu], u_der[nu], p[np], x_set[nx], F0[nx], J[nx*nx], m[nm] (doubles) */
+    /* followed by x[nx], u[nu], u_der[nu], p[np], x_set[nx], F0[nx], J[nx*nx], t_explicit[nx], dfdu[nx*nu],
+     * dfdu_valid[nu], m[nm] (doubles) */
 } StateHeader;
 
 
@@ -27,8 +28,8 @@ typedef struct {
  * fmi2SerializeFMUstate hands out: a StateHeader and the doubles after it. */
 static size_t state_size(void) {
     return sizeof(StateHeader) +
-           sizeof(double) * (size_t)(3 * model_info.nx + 2 * model_info.nu + model_info.np +
-                                     model_info.nx * model_info.nx + model_info.nm);
+           sizeof(double) * (size_t)(4 * model_info.nx + 3 * model_info.nu + model_info.np +
+                                     model_info.nx * model_info.nx + model_info.nx * model_info.nu + model_info.nm);
 }
 
 static uint64_t fnv1a(uint64_t hash, const unsigned char *bytes, size_t n) {
@@ -70,6 +71,9 @@ static void state_write(const Instance *c, unsigned char *payload) {
     memcpy(v, c->x_set, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->solver.F0, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(v, c->solver.J, sizeof(double) * model_info.nx * model_info.nx); v += model_info.nx * model_info.nx;
+    memcpy(v, c->t_explicit, sizeof(double) * model_info.nx); v += model_info.nx;
+    memcpy(v, c->dfdu, sizeof(double) * model_info.nx * model_info.nu); v += model_info.nx * model_info.nu;
+    memcpy(v, c->dfdu_valid, sizeof(double) * model_info.nu); v += model_info.nu;
     memcpy(v, c->m, sizeof(double) * model_info.nm);
     head.checksum = state_checksum(payload, state_size());
     memcpy(payload, &head, sizeof head);
@@ -109,6 +113,9 @@ static void state_read(Instance *c, const unsigned char *payload) {
     memcpy(c->x_set, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->solver.F0, v, sizeof(double) * model_info.nx); v += model_info.nx;
     memcpy(c->solver.J, v, sizeof(double) * model_info.nx * model_info.nx); v += model_info.nx * model_info.nx;
+    memcpy(c->t_explicit, v, sizeof(double) * model_info.nx); v += model_info.nx;
+    memcpy(c->dfdu, v, sizeof(double) * model_info.nx * model_info.nu); v += model_info.nx * model_info.nu;
+    memcpy(c->dfdu_valid, v, sizeof(double) * model_info.nu); v += model_info.nu;
     memcpy(c->m, v, sizeof(double) * model_info.nm);
     c->mode = (Mode)head.mode;
     c->t = head.t;
