@@ -97,7 +97,8 @@ def drawn(figures: Mapping[Key, Callable[[], bytes]], workers: int | None = None
     """Each figure function's bytes by its key, drawn side by side in ``workers`` processes
     (default: the cores) where processes can be forked (the functions and what they draw are the
     parent's, not sent), else one after the other here. The same bytes either way: a figure
-    function is pure."""
+    function is pure (so is any other function of bytes given with them: a job's CSVs, made in the
+    figures' gaps)."""
     import multiprocessing
 
     from .parallel import cores, parallel_map

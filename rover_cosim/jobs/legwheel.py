@@ -48,6 +48,7 @@ results/simulation/
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -434,22 +435,25 @@ def run_legwheel(fmu_dir: Path, model: Path, out_dir: Path, choice: Choice | Soi
             {PATCH_LABELS[r]: tables[f"patch_{r}"] for r in PATCH_RUNS},
             f"front-left wheel in a soft patch, {float(PATCH['speed']):g} m/s"),  # type: ignore[arg-type]
     }
+    runs_csv = {out / "legwheel_straight.csv": tables["straight"],
+                **{out / f"legwheel_{scenario}_{run_}.csv": tables[f"{scenario}_{run_}"]
+                   for scenario in ("slope", "climb") for run_ in RUNS},
+                **{out / f"legwheel_patch_{run_}.csv": tables[f"patch_{run_}"] for run_ in PATCH_RUNS}}
+    made = drawn({**figures, **{path: functools.partial(_csv, table, record_interval)
+                                for path, table in runs_csv.items()}})  # side by side on the cores
     files = {
-        out / "legwheel_straight.csv": csv_bytes(every(tables["straight"], record_interval, STEP), "%.8g"),
+        **made,
         out / "legwheel_rms.csv": rms_table.to_csv(index=False, float_format="%.4f").encode(),
         out / "legwheel_metrics.csv": metrics.to_csv(index=False, float_format="%.6g").encode(),
-        **drawn(figures),  # side by side on the cores
         out / "legwheel.json": json_bytes(record),
     }
-    for scenario in ("slope", "climb"):
-        for run_ in RUNS:
-            files[out / f"legwheel_{scenario}_{run_}.csv"] = csv_bytes(
-                every(tables[f"{scenario}_{run_}"], record_interval, STEP), "%.8g")
-    for run_ in PATCH_RUNS:
-        files[out / f"legwheel_patch_{run_}.csv"] = csv_bytes(every(tables[f"patch_{run_}"], record_interval, STEP),
-                                                              "%.8g")
     written = campaign.write(out, files, stale=("legwheel_*",))
     return LegWheelResult(written, tables, rms_table, metrics, record)
+
+
+def _csv(table: pd.DataFrame, record_interval: float) -> bytes:
+    """A run's table as its CSV: a row every ``record_interval`` [s], eight digits."""
+    return csv_bytes(every(table, record_interval, STEP), "%.8g")
 
 
 #: The runs that take longest (the posture controller's Python updates, the co-simulated rover's
