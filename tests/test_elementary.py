@@ -7,22 +7,20 @@ from __future__ import annotations
 
 import ctypes
 import math
-import os
 import shutil
-import subprocess
 import zipfile
 from pathlib import Path
 
 import mpmath
 import numpy as np
 import pytest
+from c_harness import RUNTIME, compiled
 from fmpy.validation import validate_fmu
 
 from rover_cosim.fmubuild import build, elementary, elementary_constants
 from rover_cosim.fmubuild.artifact import stored_elementary
 
 HARNESS = Path(__file__).with_name("elementary_harness.c")
-RUNTIME = Path(elementary_constants.__file__).parent / "runtime"
 #: The harness's function numbers.
 NUMBER = {name: i for i, name in enumerate(("exp", "log", "pow", "sin", "cos", "tan", "asin", "acos", "atan",
                                             "atan2", "tanh"))}
@@ -31,13 +29,7 @@ mpmath.mp.prec = 130
 
 @pytest.fixture(scope="module")
 def harness(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if compiler is None:
-        pytest.skip("no C compiler ($CC, cc or gcc) on PATH")
-    library = tmp_path_factory.mktemp("elementary") / "harness.so"
-    subprocess.run([compiler, "-O2", "-fno-math-errno", "-std=c99", "-Wall", "-Wextra", "-Werror", "-shared", "-fPIC",
-                    "-I", str(RUNTIME), str(HARNESS), "-o", str(library), "-lm"], check=True)
-    return ctypes.CDLL(str(library))
+    return compiled(tmp_path_factory, "elementary", HARNESS)
 
 
 def apply(lib: ctypes.CDLL, name: str, ours: bool, x: np.ndarray, y: np.ndarray | None = None) -> np.ndarray:

@@ -7,17 +7,12 @@ step size proposed at the end of the last one, past its transient, was tried fir
 from __future__ import annotations
 
 import ctypes
-import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import pytest
-
-from rover_cosim.fmubuild import elementary_constants
+from c_harness import RUNTIME, compiled
 
 HARNESS = Path(__file__).with_name("ode23s_harness.c")
-RUNTIME = Path(elementary_constants.__file__).parent / "runtime"
 CALLS = 2000
 STEP = 1e-3  # s, the paper's communication step
 TOLERANCE = 1e-6  # the FMUs' default
@@ -25,14 +20,7 @@ TOLERANCE = 1e-6  # the FMUs' default
 
 @pytest.fixture(scope="module")
 def harness(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if compiler is None:
-        pytest.skip("no C compiler ($CC, cc or gcc) on PATH")
-    library = tmp_path_factory.mktemp("ode23s") / "harness.so"
-    subprocess.run([compiler, "-O2", "-fno-math-errno", "-std=c99", "-Wall", "-Wextra", "-Werror", "-shared", "-fPIC",
-                    "-I", str(RUNTIME), str(HARNESS), str(RUNTIME / "ode23s.c"), "-o", str(library), "-lm"],
-                   check=True)
-    return ctypes.CDLL(str(library))
+    return compiled(tmp_path_factory, "ode23s", HARNESS, RUNTIME / "ode23s.c")
 
 
 def integrate(harness: ctypes.CDLL, rate: float, jump: float) -> dict[str, float]:

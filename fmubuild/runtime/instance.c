@@ -316,6 +316,16 @@ void rc_free(Instance *c) {
 static casadi_work const WORKS[] = {model_evaluate_work, model_initial_work,
                                     model_ode_jacobian_work, model_directional_work, model_input_gain_work};
 
+/* What model_evaluate writes: the derivatives, the outputs, the asserts' conditions and values. */
+static void outputs_alloc(void *(*alloc)(size_t, size_t), double **xdot, double **y, double **holds,
+                          double **values) {
+    int n_values = model_info.assert_value_start[model_info.n_asserts];
+    *xdot = alloc(model_info.nx ? (size_t)model_info.nx : 1, sizeof(double));
+    *y = alloc(model_info.ny ? (size_t)model_info.ny : 1, sizeof(double));
+    *holds = alloc(model_info.n_asserts ? (size_t)model_info.n_asserts : 1, sizeof(double));
+    *values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
+}
+
 static int allocate_work(Instance *c) {
     casadi_int sz_arg = 7, sz_res = 4, sz_iw = 0, sz_w = 0;
     for (size_t i = 0; i < sizeof(WORKS) / sizeof(WORKS[0]); i++) {
@@ -355,18 +365,12 @@ static int allocate_work(Instance *c) {
     c->dfdu = alloc(nx * nu, sizeof(double));
     c->dfdu_valid = alloc(nu, sizeof(double));
     c->u_fd = alloc(nu, sizeof(double));
-    c->fd_xdot = alloc(nx, sizeof(double));
-    c->fd_y = alloc(ny, sizeof(double));
-    c->fd_holds = alloc(model_info.n_asserts ? (size_t)model_info.n_asserts : 1, sizeof(double));
-    c->fd_values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
+    outputs_alloc(alloc, &c->fd_xdot, &c->fd_y, &c->fd_holds, &c->fd_values);
     Evaluation *e = &c->eval;
     e->x = alloc(nx, sizeof(double));
     e->u = alloc(nu, sizeof(double));
     e->m = alloc(nm, sizeof(double));
-    e->xdot = alloc(nx, sizeof(double));
-    e->y = alloc(ny, sizeof(double));
-    e->holds = alloc(model_info.n_asserts ? (size_t)model_info.n_asserts : 1, sizeof(double));
-    e->values = alloc(n_values ? (size_t)n_values : 1, sizeof(double));
+    outputs_alloc(alloc, &e->xdot, &e->y, &e->holds, &e->values);
     int solver_failed = ode23s_alloc(&c->solver, model_info.nx, alloc);
     return c->p && c->m && c->x && c->u && c->u_der && c->u_step && c->xdot && c->y && c->x_set && c->holds && c->assert_values && c->arg && c->res && c->iw && c->w && c->seed_x &&
            c->seed_u && c->sens_x && c->sens_y && c->gain && c->t_explicit && c->dfdu && c->dfdu_valid && c->u_fd && c->fd_xdot &&
