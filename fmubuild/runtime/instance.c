@@ -139,7 +139,8 @@ static void rates_into(const Instance *c, double *dfdt) {
 #define INPUT_DIFFERENCE 1e-6
 
 /* dfdu's columns of the inputs that ramp (u_der != 0) at (t, x), by forward differences from the
- * evaluation there; the others marked unknown. Leaves the instance's evaluation as it was. */
+ * instance's evaluation there (the differences' own go to the fd_ scratch); the others marked
+ * unknown. */
 static int input_columns(Instance *c, double t, const double *x) {
     int nx = model_info.nx, nu = model_info.nu;
     for (int j = 0; j < nu; j++) c->dfdu_valid[j] = 0.0;
