@@ -11,7 +11,7 @@ calls is expanded to SX (faster generated code).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import casadi as ca
@@ -233,12 +233,41 @@ class FunctionLibrary:
         step = evaluate(rng["step"]) if rng.get("step") else 1
         if any(is_symbolic(v) for v in (start, end, step)):
             raise UnsupportedConstruct("for-loop whose range depends on run-time values", where)
+        values = []
         i = start
         while (step > 0 and i <= end) or (step < 0 and i >= end):
-            env[index["ident"]] = i
-            self._execute(body["equations"], env, where)
+            values.append(i)
             i += step
+        guarded = _guarded_body(body["equations"], index["ident"])
+        if guarded is not None:
+            self._guarded_iterations(guarded[0], guarded[1], index["ident"], values, env, where)
+        else:
+            for i in values:
+                env[index["ident"]] = i
+                self._execute(body["equations"], env, where)
         env.pop(index["ident"], None)
+
+    def _guarded_iterations(self, condition: Any, statements: list[Any], ident: str, values: list[Any],
+                            env: dict[str, Value], where: str) -> None:
+        """The iterations ``values`` of ``for ident loop if condition then statements end if; end
+        for`` where ``condition`` does not refer to ``ident``: an iteration whose condition is false
+        changes nothing, so every later one sees the same values and is false too. The rest of the
+        loop is therefore nested in the true branch, and a run-time false skips all of it in one
+        branch (a converged solve's remaining iterations cost one test, not one each)."""
+        if not values:
+            return
+        env[ident] = values[0]
+        value = Evaluator(lambda n: _lookup(env, n, where), self.call, where)(condition)
+
+        def taken(inner: dict[str, Value]) -> None:
+            self._execute(statements, inner, where)
+            self._guarded_iterations(condition, statements, ident, values[1:], inner, where)
+
+        if not is_symbolic(value):
+            if value:
+                taken(env)
+            return
+        self._switch(value, taken, lambda inner: None, env, where)
 
     def _if(self, body: Mapping[str, Any], env: dict[str, Value], where: str, evaluate: Evaluator) -> None:
         blocks = [(b["cond"], b["stmts"]) for b in body["cond_blocks"]]
@@ -260,7 +289,8 @@ class FunctionLibrary:
                 self._if_chain(blocks[1:], otherwise, env, where)
             return
         if _calls_function([statements, blocks[1:], otherwise]):
-            self._switch(condition, blocks, otherwise, env, where)
+            self._switch(condition, lambda inner: self._execute(statements, inner, where),
+                         lambda inner: self._if_chain(blocks[1:], otherwise, inner, where), env, where)
             return
         then_env, else_env = dict(env), dict(env)
         self._execute(statements, then_env, where)
@@ -268,17 +298,18 @@ class FunctionLibrary:
         for name in _merged(env, then_env, else_env):
             env[name] = select(condition, then_env[name], else_env[name])
 
-    def _switch(self, condition: ca.MX, blocks: list[tuple[Any, list[Any]]], otherwise: list[Any],
-                env: dict[str, Value], where: str) -> None:
+    def _switch(self, condition: ca.MX, then: Callable[[dict[str, Value]], None],
+                otherwise: Callable[[dict[str, Value]], None], env: dict[str, Value], where: str) -> None:
         """A run-time if-statement whose branches call Modelica functions: only the branch taken is
         evaluated (a CasADi Switch), e.g. the skipped iterations of a converged solve. Each branch
-        becomes a Function of the symbolic values it can see, so the graphs stay local."""
+        (``then`` and ``otherwise`` execute it on an environment) becomes a Function of the
+        symbolic values it can see, so the graphs stay local."""
         live = sorted(n for n, v in env.items() if is_symbolic(v))
         inner = {n: ca.MX.sym(_safe(n)) for n in live}
         then_env = {**env, **inner}
         else_env = {**env, **inner}
-        self._execute(blocks[0][1], then_env, where)
-        self._if_chain(blocks[1:], otherwise, else_env, where)
+        then(then_env)
+        otherwise(else_env)
         merged = _merged(env, then_env, else_env)
         if not merged:
             return
@@ -288,6 +319,31 @@ class FunctionLibrary:
         chosen = ca.Function.if_else("switch", branches[0], branches[1])(condition, *[env[n] for n in live])
         for i, name in enumerate(merged):
             env[name] = chosen[i]
+
+
+def _guarded_body(statements: list[Any], ident: str) -> tuple[Any, list[Any]] | None:
+    """(condition, statements) if a loop body is one ``if condition then statements end if``
+    (no elseif, no else) whose condition does not refer to the loop index ``ident``, else None."""
+    if len(statements) != 1 or "If" not in statements[0]:
+        return None
+    body = statements[0]["If"]
+    if len(body["cond_blocks"]) != 1 or body.get("else_block"):
+        return None
+    condition = body["cond_blocks"][0]["cond"]
+    return None if _refers_to(condition, ident) else (condition, body["cond_blocks"][0]["stmts"])
+
+
+def _refers_to(node: Any, name: str) -> bool:
+    """Whether a rumoca expression refers to the variable ``name``."""
+    if isinstance(node, dict):
+        if "VarRef" in node:
+            parts = node["VarRef"].get("name", {})
+            if parts.get("name") == name or any(_refers_to(s, name) for s in node["VarRef"].get("subscripts", [])):
+                return True
+        return any(_refers_to(v, name) for v in node.values())
+    if isinstance(node, (list, tuple)):
+        return any(_refers_to(v, name) for v in node)
+    return False
 
 
 def _assigned_outputs(definition: Mapping[str, Any], env: Mapping[str, Value]) -> list[Value]:

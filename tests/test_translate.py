@@ -172,3 +172,83 @@ if __name__ == "__main__":  # `python tests/test_translate.py NAME...`: pin the 
             for name, variables in FMU_VARIABLES.items()]
     (Path(__file__).parent / "fmu_variables.json").write_text("{\n" + ",\n".join(pins) + "\n}\n")
 
+
+
+GUARDED_LOOPS = """model Loops
+  function half "One Newton step of sqrt(a) from x (a function call inside the loop: a Switch)"
+    input Real x;
+    input Real a;
+    output Real y;
+  algorithm
+    y := 0.5*(x + a/x);
+  end half;
+  function root "sqrt(a) by Newton, the remaining iterations skipped once converged"
+    input Real a;
+    input Integer n = 12;
+    output Real x;
+    output Real steps;
+  protected
+    Boolean done;
+  algorithm
+    x := a;
+    steps := 0;
+    done := false;
+    for k in 1:n loop
+      if not done then
+        x := half(x, a);
+        steps := steps + 1;
+        done := noEvent(abs(x*x - a) <= 1e-12*a);
+      end if;
+    end for;
+  end root;
+  function counted "Steps from the third on: the guard refers to the loop index (not nested)"
+    input Real a;
+    input Integer n = 6;
+    output Real x;
+  algorithm
+    x := a;
+    for k in 1:n loop
+      if noEvent(k > 2 and x > 1.5) then
+        x := half(x, 2.0);
+      end if;
+    end for;
+  end counted;
+  input Real a;
+  output Real r;
+  output Real s;
+  output Real c;
+equation
+  (r, s) = root(a);
+  c = counted(a);
+end Loops;"""
+
+
+def test_loops_with_a_guard_skip_their_remaining_iterations_and_compute_the_same():
+    """A loop body ``if guard then ... end if`` whose guard does not refer to the index is
+    translated as nested branches (a false guard skips every later iteration at once); one whose
+    guard refers to the index is not. Both compute what the Modelica says, at every input."""
+    model = rumoca.Session().loads(GUARDED_LOOPS, model="Loops", filename="Loops.mo")
+    ode = translate(model, "Loops")
+    _, y = ode.at_memory_defaults()
+    outputs = ca.Function("g", [ode.u, ode.p], [y])
+    names = list(ode.observed)
+
+    def expected(a: float) -> tuple[float, float, float]:
+        x, steps = a, 0
+        for _ in range(12):
+            x = 0.5 * (x + a / x)
+            steps += 1
+            if abs(x * x - a) <= 1e-12 * a:
+                break
+        c = a
+        for k in range(1, 7):
+            if k > 2 and c > 1.5:
+                c = 0.5 * (c + 2.0 / c)
+        return x, steps, c
+
+    for a in (0.3, 2.0, 9.0, 1e4, 1e9):
+        values = np.array(outputs(ca.DM([a]), ca.DM([ode.parameter_values[n] for n in ode.parameters]))).ravel()
+        got = dict(zip(names, values))
+        x, steps, c = expected(a)
+        assert got["r"] == x and got["s"] == steps and got["c"] == c, (a, got, (x, steps, c))
+    assert expected(1e9)[1] == 12 and expected(2.0)[1] < 12  # both ends of the loop are exercised
