@@ -96,6 +96,23 @@ def test_a_rut_makes_the_wheel_fmu_sink_deeper_in_total_but_less_below_the_rut(w
     assert np.all(rutted["sinkage"] - 0.02 < fresh["sinkage"])
 
 
+@pytest.mark.parametrize("rut", [0.0, 0.02])
+def test_the_closed_form_of_n_1_joins_the_power_law_on_either_side(wheel_model, rut: float):
+    """Soil n = 1 without slip-sinkage takes the normal stress's closed form (no exp/log); n a hair
+    either side takes the power law: the contact moves by about that hair, not by a step. With
+    slip-sinkage (n_slip > 0) n = 1 takes the power law (the exponent then varies with the slip)."""
+    wheel = Wheel()
+    at_one = contact_at_states(wheel_model, wheel, Soil(n=1.0), rut)
+    for n in (1.0 - 1e-9, 1.0 + 1e-9):
+        near = contact_at_states(wheel_model, wheel, Soil(n=n), rut)
+        for name in ("sinkage", "Fx", "Tx"):
+            scale = np.abs(at_one[name]).max()
+            assert np.abs(near[name] - at_one[name]).max() <= 1e-7 * scale, (n, name)
+    sinking = contact_at_states(wheel_model, wheel, Soil(n=1.0, n_slip=1e-12), rut)
+    for name in ("sinkage", "Fx", "Tx"):
+        assert np.abs(sinking[name] - at_one[name]).max() <= 1e-9 * np.abs(at_one[name]).max(), name
+
+
 def test_the_fmus_take_the_new_parameters_and_the_rovers_a_rut_input(fmus):
     for name in ("Wheel", "SingleWheel", "Rover", "SteerableRover", "LegWheelRover"):
         variables = {v.name: v for v in fmpy.read_model_description(fmus[name]).modelVariables}
