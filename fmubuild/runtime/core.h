@@ -51,6 +51,7 @@ typedef struct {
     double t;
     double *x, *u, *m, *xdot, *y, *holds, *values;
     unsigned long long evaluations, reused;
+    int outputs_fresh;  /* y, holds and values are this evaluation's and not yet handed to the instance */
     unsigned long long updated;  /* steps begun from derivatives updated for affine inputs (rc_set_real) */
 } Evaluation;
 

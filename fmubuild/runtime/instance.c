@@ -101,7 +101,14 @@ static int evaluate(Instance *c, double t, const double *x) {
     if (model_info.nu) memcpy(e->u, u, sizeof(double) * (size_t)model_info.nu);
     if (model_info.nm) memcpy(e->m, c->m, sizeof(double) * (size_t)model_info.nm);
     e->valid = 1;
+    e->outputs_fresh = 1;
     return 0;
+}
+
+static void swap_buffers(double **a, double **b) {
+    double *kept = *a;
+    *a = *b;
+    *b = kept;
 }
 
 void rc_forget_evaluation(Instance *c) {
@@ -242,12 +249,17 @@ Status rc_update(Instance *c, int f, int need_xdot, int need_y) {
     if ((need_y && !c->y_valid) || (need_xdot && !c->xdot_valid)) {
         int failed = evaluate(c, c->t, c->x);
         Evaluation *e = &c->eval;
-        size_t n_values = (size_t)model_info.assert_value_start[model_info.n_asserts];
         if (!failed) {
-            if (model_info.ny) memcpy(c->y, e->y, sizeof(double) * (size_t)model_info.ny);
+            /* The evaluation's outputs become the instance's by exchanging the buffers (a leg-wheel
+             * rover's 2033 values each step); asked again at the same point, the instance holds them
+             * already. The buffers have the same sizes (outputs_alloc). */
+            if (e->outputs_fresh) {
+                swap_buffers(&c->y, &e->y);
+                swap_buffers(&c->holds, &e->holds);
+                swap_buffers(&c->assert_values, &e->values);
+                e->outputs_fresh = 0;
+            }
             if (model_info.nx) memcpy(c->xdot, e->xdot, sizeof(double) * (size_t)model_info.nx);
-            if (model_info.n_asserts) memcpy(c->holds, e->holds, sizeof(double) * (size_t)model_info.n_asserts);
-            if (n_values) memcpy(c->assert_values, e->values, sizeof(double) * n_values);
         }
         Status checked = failed ? STATUS_OK : check_asserts(c, f);
         if (checked == STATUS_ERROR) return STATUS_ERROR;

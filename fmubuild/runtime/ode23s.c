@@ -26,6 +26,8 @@ int ode23s_alloc(Ode23s *s, int n, void *(*alloc)(size_t, size_t)) {
     s->h_entry = 0.0;
     s->f0_valid = 0;
     s->jac_valid = s->jac_current = s->jac_age = 0;
+    s->w_valid = 0;
+    s->w_h = 0.0;
     s->jacobian_max_age = 100;
     s->steps = s->rejected = s->jacobians = s->rhs_calls = 0;
     return (s->J && s->W && s->T && s->F0 && s->F1 && s->F2 && s->k1 && s->k2 && s->k3 && s->xn &&
@@ -128,6 +130,7 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
             s->jacobians++;
             s->jac_valid = s->jac_current = 1;
             s->jac_age = 0;
+            s->w_valid = 0;
         }
         double remaining = t_end - *t;
         double h_try = h;
@@ -145,10 +148,15 @@ int ode23s_integrate(Ode23s *s, double *t, double *x, double t_end, char *msg, s
                      s->max_steps, *t, t_end, h);
             return -1;
         }
-        /* W = I - h d J */
-        for (int j = 0; j < n; j++)
-            for (int i = 0; i < n; i++) s->W[i + j * n] = (i == j ? 1.0 : 0.0) - h * D_GAMMA * s->J[i + j * n];
-        int ok = lu_factor(s->W, n, s->pivot) == 0;
+        /* W = I - h d J, factored again only when h or J changed (steps of one size, one Jacobian:
+         * the same factors, bit for bit) */
+        if (!s->w_valid || s->w_h != h) {
+            for (int j = 0; j < n; j++)
+                for (int i = 0; i < n; i++) s->W[i + j * n] = (i == j ? 1.0 : 0.0) - h * D_GAMMA * s->J[i + j * n];
+            s->w_valid = lu_factor(s->W, n, s->pivot) == 0;
+            s->w_h = h;
+        }
+        int ok = s->w_valid;
         double err = INFINITY;
         if (ok) {
             for (int i = 0; i < n; i++) s->k1[i] = s->F0[i] + h * D_GAMMA * s->T[i];

@@ -49,6 +49,8 @@ typedef struct {
     int jac_valid;       /* J may be used; clear it when the model changes (parameters, reset) */
     int jac_current;     /* J was evaluated at the current point */
     int jac_age;         /* accepted steps since J was evaluated */
+    int w_valid;         /* W and pivot hold the LU factors of I - h d J for h = w_h and this J */
+    double w_h;
     long steps, rejected, jacobians, rhs_calls;  /* counters since allocation */
 } Ode23s;
 

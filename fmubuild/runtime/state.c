@@ -125,6 +125,7 @@ static void state_read(Instance *c, const unsigned char *payload) {
     rc_invalidate(c);
     c->solver.f0_valid = head.f0_valid != 0;
     c->solver.jac_valid = head.jac_valid != 0;
+    c->solver.w_valid = 0; /* W's factors are not saved: taken again from the restored J */
     c->solver.jac_current = head.jac_current != 0;
     c->solver.jac_age = head.jac_age;
     c->solver.h = head.h;
