@@ -323,14 +323,18 @@ class FunctionLibrary:
 
 def _guarded_body(statements: list[Any], ident: str) -> tuple[Any, list[Any]] | None:
     """(condition, statements) if a loop body is one ``if condition then statements end if``
-    (no elseif, no else) whose condition does not refer to the loop index ``ident``, else None."""
+    (no elseif, no else) whose statements call a Modelica function (a Switch: without a call both
+    branches are computed anyway) and whose condition does not refer to the loop index ``ident``,
+    else None."""
     if len(statements) != 1 or "If" not in statements[0]:
         return None
     body = statements[0]["If"]
     if len(body["cond_blocks"]) != 1 or body.get("else_block"):
         return None
-    condition = body["cond_blocks"][0]["cond"]
-    return None if _refers_to(condition, ident) else (condition, body["cond_blocks"][0]["stmts"])
+    condition, guarded = body["cond_blocks"][0]["cond"], body["cond_blocks"][0]["stmts"]
+    if not _calls_function(guarded) or _refers_to(condition, ident):
+        return None
+    return condition, guarded
 
 
 def _refers_to(node: Any, name: str) -> bool:

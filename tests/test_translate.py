@@ -213,20 +213,38 @@ GUARDED_LOOPS = """model Loops
       end if;
     end for;
   end counted;
+  function inline "root's loop without a function call: both branches computed, not nested"
+    input Real a;
+    output Real x;
+  protected
+    Boolean done;
+  algorithm
+    x := a;
+    done := false;
+    for k in 1:12 loop
+      if not done then
+        x := 0.5*(x + a/x);
+        done := noEvent(abs(x*x - a) <= 1e-12*a);
+      end if;
+    end for;
+  end inline;
   input Real a;
   output Real r;
   output Real s;
   output Real c;
+  output Real q;
 equation
   (r, s) = root(a);
   c = counted(a);
+  q = inline(a);
 end Loops;"""
 
 
 def test_loops_with_a_guard_skip_their_remaining_iterations_and_compute_the_same():
-    """A loop body ``if guard then ... end if`` whose guard does not refer to the index is
-    translated as nested branches (a false guard skips every later iteration at once); one whose
-    guard refers to the index is not. Both compute what the Modelica says, at every input."""
+    """A loop body ``if guard then ... end if`` that calls a function, with a guard that does not
+    refer to the index, is translated as nested branches (a false guard skips every later iteration
+    at once); one whose guard refers to the index, or without a call, is not. All compute what the
+    Modelica says, at every input."""
     model = rumoca.Session().loads(GUARDED_LOOPS, model="Loops", filename="Loops.mo")
     ode = translate(model, "Loops")
     _, y = ode.at_memory_defaults()
@@ -251,4 +269,5 @@ def test_loops_with_a_guard_skip_their_remaining_iterations_and_compute_the_same
         got = dict(zip(names, values))
         x, steps, c = expected(a)
         assert got["r"] == x and got["s"] == steps and got["c"] == c, (a, got, (x, steps, c))
+        assert got["q"] == x, (a, got["q"], x)
     assert expected(1e9)[1] == 12 and expected(2.0)[1] < 12  # both ends of the loop are exercised
