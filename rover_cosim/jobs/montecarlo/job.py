@@ -17,6 +17,7 @@ results/montecarlo/
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import time
@@ -28,6 +29,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rover_cosim.common.figures import drawn
 from rover_cosim.common.outputs import file_sha256, json_bytes, run_record, summary_repr, write_all
 from rover_cosim.common.parallel import parallel_map
 from rover_cosim.identification.cache import discard, remove_partial_files
@@ -298,25 +300,29 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
              out / "failures.csv": failures.to_csv(index=False).encode(),
              out / "sensitivity.csv": ranking.to_csv(index=False).encode(),
              out / "summary.json": json_bytes(summary)}
-    files.update({out / name: png for name, png in _figures(study, straight, ranking).items()})
+    to_draw = _figures(study, straight, ranking)
     if "straight_adapted" in study.scenarios and len(straight):
         adapted = runs[(runs["scenario"] == "straight_adapted") & (runs["status"] == "ok")]
         if len(adapted):
-            files[out / "fig_adaptation.png"] = figures.adaptation(straight, adapted, study.calibration.duration)
+            to_draw["fig_adaptation.png"] = functools.partial(figures.adaptation, straight, adapted,
+                                                              study.calibration.duration)
+    # side by side on the cores (the scatter, about half of the drawing, first), the same bytes
+    files.update({out / name: png for name, png in drawn(to_draw).items()})
     write_all(files, folder=out, stale=("fig_*",))
     return MonteCarloResult(sorted(files), runs, failures, ranking, summary, len(missing),
                             len(specs) - len(missing), rejected)
 
 
-def _figures(study: Study, straight: pd.DataFrame, ranking: pd.DataFrame) -> dict[str, bytes]:
-    """fig_*.png of the completed straight runs (none without any)."""
+def _figures(study: Study, straight: pd.DataFrame, ranking: pd.DataFrame) -> dict[str, Callable[[], bytes]]:
+    """What draws each fig_*.png of the completed straight runs (none without any)."""
     if not len(straight):
         return {}
     labels = {p.name: f"{p.name} [{p.unit}]" if p.unit else p.name for p in study.parameters}
     nominal = straight[straight["nominal"]].iloc[0] if straight["nominal"].any() else None
     logarithmic = {p.name for p in study.parameters if p.kind == "lognormal"}
-    out: dict[str, bytes] = {"fig_distributions.png": figures.distributions(straight, nominal),
-                             "fig_scatter.png": figures.scatter(straight, study.names, labels, nominal, logarithmic)}
+    out: dict[str, Callable[[], bytes]] = {
+        "fig_scatter.png": functools.partial(figures.scatter, straight, study.names, labels, nominal, logarithmic),
+        "fig_distributions.png": functools.partial(figures.distributions, straight, nominal)}
     if len(ranking) and ranking["rank"].notna().any():
-        out["fig_sensitivity.png"] = figures.ranking(ranking, labels)
+        out["fig_sensitivity.png"] = functools.partial(figures.ranking, ranking, labels)
     return out
