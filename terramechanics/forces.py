@@ -98,6 +98,9 @@ def _shear_reversal_angles(theta_f: FloatArray, theta_r: FloatArray, slip: Float
     so j (zero at θf) has at most one root in (-θ*, θ*) and one in (θr, -θ*).
     """
     skid = slip < 0
+    if not skid.any():  # a driving or rolling wheel: no reversal (the common case, without the search)
+        none = np.full(slip.shape, np.nan)
+        return none, none.copy()
     theta_star = np.arccos(1.0 / (1.0 - np.minimum(slip, 0.0)))
     # jx > 0 just behind θf only if θf > θ*; otherwise jx <= 0 on the whole patch.
     low1 = np.maximum(theta_r, -theta_star)

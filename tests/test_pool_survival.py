@@ -76,3 +76,23 @@ def test_more_workers_than_cores_are_said_and_capped(capsys, tmp_path):
         capsys.readouterr().err
     assert main(["identify", "--run-timeout", "nan", "--out", str(tmp_path / "id")]) == 2
     assert "--run-timeout nan: expected a time limit > 0 s" in capsys.readouterr().err
+
+
+def _pid(_k: int) -> int:
+    return os.getpid()
+
+
+def _nested(k: int) -> tuple[int, list[int]]:
+    """In a pool's worker: its pid and the pids of a one-worker map with ``lost`` nested in it (an
+    adaptive run's identification sweep inside a Monte Carlo run)."""
+    return os.getpid(), list(parallel_map(_pid, [(k,), (k + 1,)], workers=1, lost=_lost))
+
+
+def test_a_one_worker_map_nested_in_a_worker_runs_in_that_worker_and_elsewhere_in_a_process_of_its_own():
+    """Nested in a pool's worker, a one-worker map with ``lost`` needs no process of its own (the
+    outer pool already survives its crash); called from a command it still gets one."""
+    outer = list(parallel_map(_nested, [(1,), (5,)], workers=2, lost=_lost))
+    assert len(outer) == 2
+    for worker, inner in outer:
+        assert worker != os.getpid() and inner == [worker, worker]
+    assert set(parallel_map(_pid, [(0,), (1,)], workers=1, lost=_lost)) - {os.getpid()}

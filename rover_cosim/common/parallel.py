@@ -35,7 +35,7 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     """``function(*a)`` for every ``a`` of ``arguments``: on the Dask cluster at ``scheduler``
     (``tcp://host:port``) when given, else on ``workers`` local processes (default and at most:
     the cores; 1 with ``lost`` given runs in a worker process too, so that a crash cannot end the
-    caller; without, serially here). Results in the order they complete. A call whose worker
+    caller, except inside a pool's worker, whose own pool survives it; without, serially here). Results in the order they complete. A call whose worker
     dies (a crash inside an FMU, exit()) or that runs longer than ``timeout`` seconds (None: 20 x
     the slowest call so far once three completed, at least 120 s) gives ``lost(a, reason)``
     instead (the worker is replaced; without ``lost``, RuntimeError)."""
@@ -57,7 +57,9 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     workers = workers or os.cpu_count() or 1
     if workers < 1:
         raise ValueError(f"workers = {workers!r}: expected >= 1")
-    if lost is None and (workers == 1 or len(arguments) <= 1):  # nothing to survive: serially, here
+    if (lost is None or _IN_WORKER) and (workers == 1 or len(arguments) <= 1):
+        # nothing to survive, or already in a worker of a pool (whose pool reports the call lost if
+        # this one crashes): serially, here, without a process of its own
         yield from (function(*a) for a in arguments)
         return
     workers = min(workers, len(arguments), cores())
@@ -99,6 +101,11 @@ def cores() -> int:
 def _raise_lost(arguments: tuple[Any, ...], reason: str) -> Any:
     raise RuntimeError(f"a worker process was lost: {reason}")
 
+
+#: True in a worker process of a local pool: a map of one worker nested in its call (an adaptive
+#: run's identification sweep inside a Monte Carlo run) runs serially in it, not in a process of
+#: its own; a crash there ends the worker's call, which its pool reports as lost.
+_IN_WORKER = False
 
 #: s, the time limit of a call when none is given, once some calls have completed: so many times the
 #: slowest of them, and at least RUN_TIMEOUT_FLOOR.
@@ -221,6 +228,8 @@ class _Pool:
 
 def _work(conn: Any, function: Callable[..., Any], parent: int) -> None:
     """A worker's loop: call ``function`` with each task's arguments until told to end."""
+    global _IN_WORKER
+    _IN_WORKER = True
     _end_with_parent(parent)
     while True:
         try:
