@@ -521,10 +521,10 @@ def test_the_ground_participants_twin_gives_its_outputs_bit_for_bit():
         block = GroundBlock("ground", height_map)
         block.start(0.0, np.zeros(6))
         twin = Twin(block, "ground")  # type: ignore[arg-type]
-        for k in range(1000):
+        for k in range(300):
             u = np.array([rng.uniform(-25, 35), rng.uniform(-25, 20), rng.uniform(-4, 4), rng.normal(0.5, 0.5),
                           rng.normal(0, 0.1), rng.normal(0, 0.2)])
-            if k == 999:
+            if k == 299:
                 u[0] = np.nan
             expected, got = block.step(0.0, 1e-3, u), twin.step(0.0, 1e-3, u)
             assert np.array_equal(expected, got, equal_nan=True), f"{height_map.source}, pose {k}"

@@ -82,10 +82,14 @@ def _pid(_k: int) -> int:
     return os.getpid()
 
 
+def _no_pid(_arguments: tuple[int], _reason: str) -> int:
+    return -1
+
+
 def _nested(k: int) -> tuple[int, list[int]]:
     """In a pool's worker: its pid and the pids of a one-worker map with ``lost`` nested in it (an
     adaptive run's identification sweep inside a Monte Carlo run)."""
-    return os.getpid(), list(parallel_map(_pid, [(k,), (k + 1,)], workers=1, lost=_lost))
+    return os.getpid(), list(parallel_map(_pid, [(k,), (k + 1,)], workers=1, lost=_no_pid))
 
 
 def test_a_one_worker_map_nested_in_a_worker_runs_in_that_worker_and_elsewhere_in_a_process_of_its_own():
@@ -95,4 +99,4 @@ def test_a_one_worker_map_nested_in_a_worker_runs_in_that_worker_and_elsewhere_i
     assert len(outer) == 2
     for worker, inner in outer:
         assert worker != os.getpid() and inner == [worker, worker]
-    assert set(parallel_map(_pid, [(0,), (1,)], workers=1, lost=_lost)) - {os.getpid()}
+    assert set(parallel_map(_pid, [(0,), (1,)], workers=1, lost=_no_pid)) - {os.getpid()}

@@ -125,7 +125,7 @@ def test_an_output_folder_that_cannot_be_written_is_named_before_the_work(tmp_pa
                 pytest.skip("running as root without setpriv: a read-only folder is writable for root")
             command = ["/usr/bin/setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", *command]
         done = subprocess.run(command, capture_output=True, text=True, timeout=120, cwd="/")
-        assert done.returncode == 2, done.stderr  # (the lines before: matplotlib's, on a home nobody may write)
+        assert done.returncode == 2, done.stderr
         assert done.stderr.strip().splitlines()[-1] == (
             f"rover-cosim fig3: --out {folder / 'figures'}: the folder {folder} cannot be written (Permission denied)")
         assert not any(folder.iterdir())

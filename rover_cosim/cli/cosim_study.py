@@ -15,13 +15,13 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.cosim_study import systems, write_cosim_study
-    from rover_cosim.orchestrator.master import RunError
-    from rover_cosim.orchestrator.system import SystemFileError
-
     if not output_folder(args.out, "cosim-study", COMMAND.needs_bytes) or not fmu_dir_exists(args.fmu_dir,
                                                                                              "cosim-study"):
         return 2
+    from rover_cosim.jobs.cosim_study import systems, write_cosim_study  # pandas, matplotlib: after the checks
+    from rover_cosim.orchestrator.master import RunError
+    from rover_cosim.orchestrator.system import SystemFileError
+
     try:
         systems(args.fmu_dir)  # its FMUs there
     except SystemFileError as error:

@@ -62,11 +62,11 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.estimate_soil import FILES, run_estimate_soil
-    from rover_cosim.terramechanics.library import choose
-
     if not output_folder(args.out, "estimate-soil", COMMAND.needs_bytes):
         return 2
+    from rover_cosim.jobs.estimate_soil import FILES, run_estimate_soil  # scipy, matplotlib: after the check
+    from rover_cosim.terramechanics.library import choose
+
     mine = None if args.overwrite else foreign_results([args.out / name for name in FILES], args.out / "estimate.json",
                                                        "estimate-soil")
     if mine:

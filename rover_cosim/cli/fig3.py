@@ -54,11 +54,11 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from rover_cosim.common.figures import SETTINGS
-    from rover_cosim.jobs.fig3 import PAPER_LOADS, file_names, slip_grid, write_fig3
 
     choice = choice_of(args, "fig3")
     if choice is None or not output_folder(args.out, "fig3", COMMAND.needs_bytes):
         return 2
+    from rover_cosim.jobs.fig3 import PAPER_LOADS, file_names, slip_grid, write_fig3  # matplotlib: after the checks
     names = file_names(choice)
     extra = [args.out / f"{Path(names['png']).stem}.{kind}" for kind in SETTINGS.formats if kind != "png"]
     mine = None if args.overwrite else foreign_results(

@@ -85,11 +85,11 @@ def plan_of(args: argparse.Namespace, choice: Any) -> Any:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rover_cosim.jobs.identify import check_record_interval, run_identification
-
     if not output_folder(args.out, "identify", COMMAND.needs_bytes) or (
             args.cache and not output_folder(args.cache, "identify", 0, "--cache")):
         return 2
+    from rover_cosim.jobs.identify import check_record_interval, run_identification  # after the folder checks
+
     if not workers_ok("identify", args) or not option_ok(
             "identify", "--record-interval", lambda: check_record_interval(args.record_interval)):
         return 2

@@ -35,9 +35,10 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     """``function(*a)`` for every ``a`` of ``arguments``: on the Dask cluster at ``scheduler``
     (``tcp://host:port``) when given, else on ``workers`` local processes (default and at most:
     the cores; 1 with ``lost`` given runs in a worker process too, so that a crash cannot end the
-    caller, except inside a pool's worker, whose own pool survives it; without, serially here). Results in the order they complete. A call whose worker
-    dies (a crash inside an FMU, exit()) or that runs longer than ``timeout`` seconds (None: 20 x
-    the slowest call so far once three completed, at least 120 s) gives ``lost(a, reason)``
+    caller, except inside a pool's worker, whose own pool survives it; without, serially here).
+    Results in the order they complete. A call whose worker dies (a crash inside an FMU, exit())
+    or that runs longer than ``timeout`` seconds (None: 20 x the slowest call so far once three
+    completed, at least 120 s) gives ``lost(a, reason)``
     instead (the worker is replaced; without ``lost``, RuntimeError)."""
     if scheduler is not None:
         from dask.distributed import Client
