@@ -106,6 +106,8 @@ UNCARRIED_RESIDUAL = 1e3
 SOLVE_RTOL = 1e-12
 FIT_TOL = 1e-10
 METHOD = "dogbox"
+#: Why an optional parameter kept the prior's value when the estimate was asked for the plan's only.
+NOT_SEARCHED = "not searched: the estimate was asked for the plan's parameters only (optional ones off)"
 #: Measurements per estimated parameter at least.
 MEASUREMENTS_PER_PARAMETER = 2
 
@@ -797,14 +799,17 @@ def _rejection(problem: _Problem, statistics: _Statistics, estimates: Mapping[st
 
 def estimate_soil(data: TestBedData, wheel: Wheel = Wheel(), prior: Soil = Soil(),
                   parameters: Sequence[str] | None = None, *, noise: Mapping[str, float] | None = None,
-                  bounds: Mapping[str, tuple[float, float]] | None = None, confidence: float = 0.95) -> SoilEstimate:
+                  bounds: Mapping[str, tuple[float, float]] | None = None, confidence: float = 0.95,
+                  optional: bool = True) -> SoilEstimate:
     """The soil whose reference wheel best explains ``data`` (weighted least squares, see the module
     docstring).
 
     The plan's parameters are searched first; then each optional one in turn (a1, a0, λ, k_x,β,
     k_y,β) is added, searched from the previous values, and kept only if the data determine it
     beside the others (no |correlation| above 0.95, not on a bound, an interval within its
-    resolution); otherwise it keeps the prior's value, and the reason is recorded.
+    resolution); otherwise it keeps the prior's value, and the reason is recorded. ``optional``
+    False searches the plan's parameters only (the optional ones keep the prior's values, said so):
+    each optional one costs a search of its own, several times the first one's evaluations.
 
     Args:
         data: steady-state single-wheel measurements.
@@ -830,8 +835,9 @@ def estimate_soil(data: TestBedData, wheel: Wheel = Wheel(), prior: Soil = Soil(
     problem = _Problem(data, wheel, prior, plan.estimated, scales)
     found = _search(problem, {}, limits, given, confidence)
     evaluations = problem.evaluations
-    dropped: list[FixedParameter] = []
-    for name in plan.optional:
+    dropped: list[FixedParameter] = [FixedParameter(name, getattr(prior, name), NOT_SEARCHED)
+                                     for name in plan.optional if not optional]
+    for name in plan.optional if optional else ():
         trial = _Problem(data, wheel, prior, (*problem.names, name), problem.scales)
         attempt = _search(trial, dict(zip(problem.names, (float(v) for v in found[0]))), limits, given, confidence)
         evaluations += trial.evaluations

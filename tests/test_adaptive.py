@@ -15,6 +15,7 @@ import pytest
 
 from rover_cosim.control.calibration import Calibration
 from rover_cosim.identification import online
+from rover_cosim.identification.soil_estimation import NOT_SEARCHED
 from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.jobs import simulate
 from rover_cosim.jobs.montecarlo import run_montecarlo
@@ -54,8 +55,11 @@ def test_a_study_reads_its_calibration_table_and_names_bad_keys():
     study = parse_study({**base, "calibration": {"duration": 2.0, "sinkage_sensor": True}}, "s")
     assert study.calibration == Calibration(duration=2.0, sinkage_sensor=True)
     assert study.adapted().scenarios == ("straight", "straight_adapted")
+    optional = parse_study({**base, "calibration": {"optional_parameters": True}}, "s")
+    assert optional.calibration == Calibration(optional_parameters=True)
     for table, message in (({"duratoin": 2.0}, "calibration = "), ({"duration": -1.0}, "duration = -1.0"),
-                           ({"sinkage_sensor": "yes"}, "sinkage_sensor = 'yes'")):
+                           ({"sinkage_sensor": "yes"}, "sinkage_sensor = 'yes'"),
+                           ({"optional_parameters": 1}, "optional_parameters = 1: expected true or false")):
         with pytest.raises(StudyError, match=message):
             parse_study({**base, "calibration": table}, "s")
 
@@ -81,7 +85,8 @@ def adaptive_run(fmu_dir, identified, sweep_cache):
 
     def spy(data: TestBedData, *args: object) -> online.Adaptation:
         seen["data"] = data
-        return online.adapt_model(data, *args)  # type: ignore[arg-type]
+        seen["adaptation"] = online.adapt_model(data, *args)  # type: ignore[arg-type]
+        return seen["adaptation"]  # type: ignore[return-value]
 
     system = simulate.adaptive_system(fmu_dir, model, truth, calibration=SHORT_CALIBRATION, cache_dir=sweep_cache)
     system = SystemBuilder.from_system(system, "adaptive, short").simulation(stop_time=2.0).build()
@@ -119,6 +124,9 @@ def test_the_rover_estimates_the_soil_it_is_on_and_switches_at_the_end_of_the_ca
     b = truth.wheel.b
     assert estimated["kc"] / b + estimated["kphi"] == pytest.approx(truth.soil.kc / b + truth.soil.kphi, rel=0.05)
     assert isinstance(seen["data"], TestBedData) and seen["data"].sinkage_m is None  # no sinkage sensor
+    # the plan's parameters only (Calibration.optional_parameters off): a1, a0, λ kept, said so
+    fixed = seen["adaptation"].estimate.fixed
+    assert all(fixed[name].reason == NOT_SEARCHED for name in ("a1", "a0", "lam"))
     # after the switch the torques are the law's alone (no excitation): the wheels of a side agree
     data = outcome.data
     late = data[data["time"] > 1.6]

@@ -91,7 +91,7 @@ def _repository_files() -> list[Path]:
     """The repository's files, not descending into the folders of tools and results (the virtual
     environment alone has tens of thousands)."""
     skipped = {".git", ".venv", "results", "site", "fmus", "node_modules", ".pytest_cache", ".mypy_cache", ".cache"}
-    files = []
+    files: list[Path] = []
     for folder, subfolders, names in os.walk(REPOSITORY):
         subfolders[:] = [d for d in subfolders if d not in skipped]
         files.extend(Path(folder) / name for name in names)

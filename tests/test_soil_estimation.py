@@ -15,7 +15,13 @@ import pytest
 
 from rover_cosim.cli import build_parser, main
 from rover_cosim.common.outputs import file_sha256
-from rover_cosim.identification.soil_estimation import SoilEstimate, estimate_soil, plan_parameters, soil_toml
+from rover_cosim.identification.soil_estimation import (
+    NOT_SEARCHED,
+    SoilEstimate,
+    estimate_soil,
+    plan_parameters,
+    soil_toml,
+)
 from rover_cosim.identification.testbed_data import (
     TestBedData,
     generate_testbed_data,
@@ -54,6 +60,22 @@ def test_noise_free_data_give_back_the_truth(exact_fit: SoilEstimate, lunar: Soi
     held = generate_testbed_data(lunar, loads=HELD_LOADS, slips=HELD_SLIPS)
     for error in prediction_error(exact_fit.predict(held.load_N, held.slip), held).values():
         assert error.max_percent < 1e-4, error
+
+
+def test_without_the_optional_parameters_the_plans_own_are_searched_and_the_others_said_kept(
+        exact_fit: SoilEstimate, lunar: Soil):
+    """``optional=False`` (the online adaptation's default): a1, a0 and λ keep the prior's values,
+    each with the reason, in fewer evaluations; the plan's parameters still come back from
+    noise-free data (the lunar soil has the paper's a0, a1, λ)."""
+    data = generate_testbed_data(lunar)
+    plain = estimate_soil(data, Wheel(), Soil(), optional=False)
+    for name in ("a1", "a0", "lam"):
+        assert name not in plain.parameters and plain.fixed[name].reason == NOT_SEARCHED, name
+        assert plain.fixed[name].value == getattr(Soil(), name)
+    for name in ("c", "phi", "kx", "n"):
+        assert plain.parameters[name].value == pytest.approx(getattr(lunar, name), rel=1e-6), name
+    assert set(plain.parameters) == set(exact_fit.parameters) - {"a1", "a0", "lam"}
+    assert plain.evaluations < exact_fit.evaluations / 2
 
 
 def test_noisy_data_hold_the_truth_in_the_intervals_and_predict_held_out_points(lunar: Soil):

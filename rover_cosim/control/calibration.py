@@ -24,12 +24,16 @@ class Calibration:
         segment: how long each excitation level is held [s].
         amplitude: the excitation torque A [N·m] added to and taken from the law's.
         sinkage_sensor: the rover measures each wheel's sinkage (else the estimate uses the torques only).
+        optional_parameters: the soil estimate also tries the stress distribution's a1, a0, λ in
+            turn, as ``estimate-soil`` does (else they keep the prior's values: several times
+            faster; see :mod:`rover_cosim.identification.online`).
     """
 
     duration: float = 3.0
     segment: float = 0.25
     amplitude: float = 20.0
     sinkage_sensor: bool = False
+    optional_parameters: bool = False
 
     def __post_init__(self) -> None:
         for key in ("duration", "segment", "amplitude"):

@@ -154,7 +154,8 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, scenario: str, choice
     wheels = hubs(plant)
     start = {"v": speed, **{f"omega[{i}]": speed / _radius(choice) for i in wheels}}
     add_plant_fmu(builder, "rover", plant, choice, start)
-    block = AdaptivePathController("ctrl", models, adapter_for(models, fmu_dir, cache_dir, lateral=True),
+    adapter = adapter_for(models, fmu_dir, cache_dir, lateral=True, optional=calibration.optional_parameters)
+    block = AdaptivePathController("ctrl", models, adapter,
                                    radius=wheel.r, inertia=wheel.J, calibration=calibration,
                                    path=scenario_path(scenario, straight), v_target=speed,
                                    **rover_geometry(choice))

@@ -120,21 +120,22 @@ def soil_and_wheel_of(models: ModelSet) -> tuple[Soil, Wheel]:
     return (Soil(**soil) if soil else Soil()), (Wheel(**wheel) if wheel else Wheel())
 
 
-def adapter_for(models: ModelSet, fmu_dir: Path, cache_dir: Path | None,
-                lateral: bool = False) -> Callable[[TestBedData], Adaptation]:
+def adapter_for(models: ModelSet, fmu_dir: Path, cache_dir: Path | None, lateral: bool = False,
+                optional: bool = False) -> Callable[[TestBedData], Adaptation]:
     """What an adaptive block calls at the end of its calibration: the soil estimated from the data
-    starting from the soil ``models`` were identified on (their wheel: the rover's own), the models
-    identified again on SingleWheel.fmu of ``fmu_dir`` (the sweeps' cache in ``cache_dir``; None: a
-    temporary folder), the lateral one too with ``lateral``."""
+    starting from the soil ``models`` were identified on (their wheel: the rover's own; the
+    optional parameters too with ``optional``), the models identified again on SingleWheel.fmu of
+    ``fmu_dir`` (the sweeps' cache in ``cache_dir``; None: a temporary folder), the lateral one too
+    with ``lateral``."""
     prior, wheel = soil_and_wheel_of(models)
     degree = models.model().degree
     single_wheel = Path(fmu_dir) / "SingleWheel.fmu"
 
     def adapter(data: TestBedData) -> Adaptation:
         if cache_dir is not None:
-            return adapt_model(data, single_wheel, wheel, prior, Path(cache_dir), degree, lateral)
+            return adapt_model(data, single_wheel, wheel, prior, Path(cache_dir), degree, lateral, optional)
         with tempfile.TemporaryDirectory(prefix="rover-cosim-adapt-") as folder:
-            return adapt_model(data, single_wheel, wheel, prior, Path(folder), degree, lateral)
+            return adapt_model(data, single_wheel, wheel, prior, Path(folder), degree, lateral, optional)
 
     return adapter
 
@@ -149,7 +150,7 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
     folder), then the paper's law with it."""
     models = models_of(model)
     wheel = soil_and_wheel_of(models)[1]
-    adapter = adapter_for(models, fmu_dir, cache_dir)
+    adapter = adapter_for(models, fmu_dir, cache_dir, optional=calibration.optional_parameters)
     builder = _closed_loop("closed loop (adaptive)")
     plant = rover_fmu(fmu_dir, "Rover", choice)
     add_plant_fmu(builder, "rover", plant, choice)

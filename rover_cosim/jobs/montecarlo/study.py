@@ -24,6 +24,7 @@
     segment = 0.25              # s, each excitation level
     amplitude = 20.0            # N·m, the excitation torque
     sinkage_sensor = false      # the rover measures its wheels' sinkage
+    optional_parameters = false # the soil estimate also tries a1, a0, lambda (several times slower)
 
     [correlation]               # optional: the correlation of the parameters' normal scores
     parameters = ["soil.kc", "soil.kphi"]
@@ -224,12 +225,14 @@ def _calibration(where: str, table: Any) -> Calibration:
     names = {f.name for f in fields(Calibration)}
     if not isinstance(table, dict) or set(table) - names:
         raise StudyError(f"{where}: calibration = {table!r}: expected a table of {', '.join(sorted(names))}")
-    sensor = table.get("sinkage_sensor", False)
-    if not isinstance(sensor, bool):
-        raise StudyError(f"{where}: calibration.sinkage_sensor = {sensor!r}: expected true or false")
-    numbers = {k: _number(where, f"calibration.{k}", v) for k, v in table.items() if k != "sinkage_sensor"}
+    switches: dict[str, Any] = {}
+    for key in ("sinkage_sensor", "optional_parameters"):
+        switches[key] = table.get(key, False)
+        if not isinstance(switches[key], bool):
+            raise StudyError(f"{where}: calibration.{key} = {switches[key]!r}: expected true or false")
+    numbers: dict[str, Any] = {k: _number(where, f"calibration.{k}", v) for k, v in table.items() if k not in switches}
     try:
-        return Calibration(**numbers, sinkage_sensor=sensor)
+        return Calibration(**numbers, **switches)
     except ValueError as error:
         raise StudyError(f"{where}: {error}") from None
 
