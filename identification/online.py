@@ -11,8 +11,9 @@ controller's longitudinal model identified again on that soil (issue 33, the onl
    (starting from the soil the controller was identified on, the prior);
 2. the paper's identification sweep (step torques on ``SingleWheel.fmu``, the torques of
    ``SweepPlan``, loads over the rover's own range: ``sweep_loads``) runs on the estimated soil
-   and the wheel, in this process, with the sweep's cache (a soil estimated again to the same
-   values is not run again), and ``fits.identify`` makes the model of the same degree the
+   and the wheel, in this process, its runs kept in memory (or in a sweep cache where the caller
+   gives one: a soil estimated again to the same values is then not run again), and
+   ``fits.identify`` makes the model of the same degree the
    controller used, its Fx fit through the torques the closed loop drives with
    (``ADAPTED_FIT_TORQUE_MAX``).
 
@@ -102,24 +103,25 @@ def sweep_loads(loads: FloatArray) -> tuple[float, ...]:
     return tuple(float(round(w)) for w in np.linspace(max(low, 1.0), max(high, low + LOAD_POINTS), LOAD_POINTS))
 
 
-def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path, degree: int,
+def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path | None, degree: int,
                      plan: SweepPlan | None = None, torque_max: float = ADAPTED_FIT_TORQUE_MAX,
                      workers: int | None = 1) -> tuple[IdentifiedModel, int]:
     """The paper's longitudinal model (LUTs and the Fx fit of ``degree``) identified by the sweep on
-    ``fmu_path`` (SingleWheel.fmu) with ``soil`` and ``wheel`` as its parameters, the Fx fit through
+    ``fmu_path`` (SingleWheel.fmu) with ``soil`` and ``wheel`` as its parameters (the runs cached in
+    ``cache_dir``; None: kept in memory), the Fx fit through
     the points up to ``torque_max`` [N·m] (ADAPTED_FIT_TORQUE_MAX for the paper's wheel; a plan
     scaled to another wheel scales it too); the sweep in this process (``workers`` 1: an adaptive
     run inside a Monte Carlo worker) or on ``workers`` processes (None: every core; a command's own
     identification); (the model, the runs computed)."""
     plan = replace(plan or SweepPlan(), soil=soil, wheel=wheel)
-    sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=workers)
+    sweep = run_sweep(Path(fmu_path), plan, cache_dir, workers=workers)
     if not sweep.runs:
         raise RuntimeError(f"every run of the sweep on the estimated soil failed; first error: "
                            f"{next(iter(sweep.failures.values()))}")
     return identify(step_table(sweep.at_slip_angle(0.0)), degree, torque_max), sweep.computed
 
 
-def identify_lateral_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path,
+def identify_lateral_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path | None,
                              loads: tuple[float, ...], torques: tuple[float, ...] | None = None,
                              torque_max: float = FIT_TORQUE_MAX, workers: int | None = 1) -> tuple[LateralModel, int]:
     """The lateral model (the recommended form) identified by the lateral sweep on ``fmu_path``
@@ -130,14 +132,14 @@ def identify_lateral_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir
                      soil=soil, wheel=wheel)
     if torques is not None:
         plan = replace(plan, torques=tuple(torques))
-    sweep = run_sweep(Path(fmu_path), plan, Path(cache_dir), workers=workers)
+    sweep = run_sweep(Path(fmu_path), plan, cache_dir, workers=workers)
     if not sweep.runs:
         raise RuntimeError(f"every run of the lateral sweep on the estimated soil failed; first error: "
                            f"{next(iter(sweep.failures.values()))}")
     return identify_lateral(lateral_table(sweep.runs), torque_max=torque_max), sweep.computed
 
 
-def adapt_model(data: TestBedData, fmu_path: Path, wheel: Wheel, prior: Soil, cache_dir: Path,
+def adapt_model(data: TestBedData, fmu_path: Path, wheel: Wheel, prior: Soil, cache_dir: Path | None,
                 degree: int, lateral: bool = False, optional: bool = False) -> Adaptation:
     """The soil estimated from ``data`` (from ``prior``), and the longitudinal model of ``degree``
     identified on it with ``fmu_path`` (SingleWheel.fmu); with ``lateral``, the lateral model too

@@ -4,7 +4,9 @@ serially (``workers=1``) or on a Dask cluster (``scheduler="tcp://host:port"``).
 
 Each run is cached as one CSV with a checksum under ``cache_dir/<FMU SHA-256>/<plan digest>/``
 (``identification.cache``): a re-run takes only whole files and computes what is missing or
-damaged (with a warning naming the file). A run that fails is reported with its error; the
+damaged (with a warning naming the file). Without a cache folder the runs stay in memory, at full
+precision (a cached run is read back at the 12 digits its file keeps): an adaptive run's sweep on
+the soil it has just estimated, which no other run shares. A run that fails is reported with its error; the
 others go on. The worker processes end with the sweep: on an error, Ctrl-C or SIGTERM the pool
 is cancelled and its workers terminated, and each worker asks Linux to end it when its parent
 dies (PR_SET_PDEATHSIG), so a killed sweep leaves no workers behind.
@@ -114,7 +116,7 @@ class SweepOutcome:
     computed: int
     cached: int
     wall_seconds: float
-    cache_folder: Path
+    cache_folder: Path | None  # None: the runs were kept in memory
     run_seconds: dict[Case, float] = field(default_factory=dict)
     rejected: dict[Path, str] = field(default_factory=dict)  # cache files not whole, computed again (why)
 
@@ -131,12 +133,12 @@ def run_file(folder: Path, load: float, torque: float, slip_angle_deg: float = 0
 
 
 def compute_run(fmu_path: str | None, case: Case, stop_time: float, sample_time: float,
-                tolerance: float, start_speed: float, target: str, soil: Soil | None = None,
-                wheel: Wheel | None = None) -> tuple[Case, str | None, float]:
+                tolerance: float, start_speed: float, target: str | None, soil: Soil | None = None,
+                wheel: Wheel | None = None) -> Result:
     """Run one case on the ``soil`` and ``wheel`` (None: the plant's own) and write it to
-    ``target`` atomically. Returns (case, error, seconds); never raises, so one failing case does
-    not stop the others (runs in worker processes). ``fmu_path`` None runs the numpy reference
-    test bed instead of the FMU."""
+    ``target`` atomically (None: return it instead). Returns (case, error, seconds, the run where
+    ``target`` is None); never raises, so one failing case does not stop the others (runs in
+    worker processes). ``fmu_path`` None runs the numpy reference test bed instead of the FMU."""
     started = time.perf_counter()
     case = Case(*case)
     try:
@@ -154,10 +156,12 @@ def compute_run(fmu_path: str | None, case: Case, stop_time: float, sample_time:
             data = shared_test_bed(Path(fmu_path)).run(case.load, profile, stop_time, sample_time, tolerance,
                                                        start_speed=start_speed, slip_angle=slip_angle,
                                                        parameters=plan.parameters)
+        if target is None:
+            return case, None, time.perf_counter() - started, data
         write_run(Path(target), data)
-        return case, None, time.perf_counter() - started
+        return case, None, time.perf_counter() - started, None
     except Exception as error:  # noqa: BLE001 - reported per run, the sweep goes on
-        return case, f"{type(error).__name__}: {error}", time.perf_counter() - started
+        return case, f"{type(error).__name__}: {error}", time.perf_counter() - started, None
 
 
 def _plant_key(fmu_path: Path | None) -> str:
@@ -170,8 +174,10 @@ def _plant_key(fmu_path: Path | None) -> str:
     return "reference-" + hashlib.sha256(b"".join(p.read_bytes() for p in sources)).hexdigest()[:12]
 
 
-Arguments = tuple[str | None, Case, float, float, float, float, str, Soil | None, Wheel | None]
-Result = tuple[Case, str | None, float]
+Arguments = tuple[str | None, Case, float, float, float, float, str | None, Soil | None, Wheel | None]
+#: A run's outcome: its case, the error (None: it ran), wall seconds, and the run itself where it
+#: was kept in memory (None where it went to its cache file, or failed).
+Result = tuple[Case, str | None, float, pd.DataFrame | None]
 
 
 def _results(arguments: list[Arguments], workers: int | None, scheduler: str | None,
@@ -184,7 +190,7 @@ def _results(arguments: list[Arguments], workers: int | None, scheduler: str | N
 
 def _lost(arguments: Arguments, reason: str) -> Result:
     """The failure of a run whose worker process was lost (``reason``)."""
-    return Case(*arguments[1]), f"lost: {reason}", 0.0
+    return Case(*arguments[1]), f"lost: {reason}", 0.0, None
 
 
 def _cached(folder: Path, plan: SweepPlan) -> tuple[dict[Case, pd.DataFrame], dict[Path, str]]:
@@ -217,23 +223,26 @@ def _read_computed(folder: Path, plan: SweepPlan, cases: list[Case], runs: dict[
             runs[c] = data
 
 
-def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, workers: int | None = None,
+def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path | None, *, workers: int | None = None,
               scheduler: str | None = None, progress: Callable[[float], None] | None = None,
               run_timeout: float | None = None) -> SweepOutcome:
     """Run (or take from the cache) every case of ``plan`` on the FMU, or on the numpy reference
-    test bed when ``fmu_path`` is None."""
+    test bed when ``fmu_path`` is None; ``cache_dir`` None: every case run and kept in memory."""
     started = time.perf_counter()
     if fmu_path is not None:
         fmu_path = Path(fmu_path).resolve()
         if not fmu_path.is_file():
             raise FileNotFoundError(f"FMU {fmu_path} not found (build them with `rover-cosim build-fmus`)")
-    folder = Path(cache_dir) / _plant_key(fmu_path) / plan.digest()
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / "plan.json").write_text(json.dumps({**asdict(plan), "plant": str(fmu_path or "numpy reference")},
-                                                 indent=2) + "\n")
-    remove_partial_files(folder)
+    folder = None if cache_dir is None else Path(cache_dir) / _plant_key(fmu_path) / plan.digest()
+    runs: dict[Case, pd.DataFrame] = {}
+    rejected: dict[Path, str] = {}
+    if folder is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "plan.json").write_text(json.dumps({**asdict(plan), "plant": str(fmu_path or "numpy reference")},
+                                                     indent=2) + "\n")
+        remove_partial_files(folder)
+        runs, rejected = _cached(folder, plan)
     cases = plan.cases()
-    runs, rejected = _cached(folder, plan)
     missing = [c for c in cases if c not in runs]
     failures: dict[Case, str] = {}
     run_seconds: dict[Case, float] = {}
@@ -241,15 +250,19 @@ def run_sweep(fmu_path: Path | None, plan: SweepPlan, cache_dir: Path, *, worker
     if progress:
         progress(done / len(cases))
     arguments = [(str(fmu_path) if fmu_path else None, c, plan.stop_time, plan.sample_time, plan.tolerance,
-                  plan.start_speed, str(run_file(folder, *c)), plan.soil, plan.wheel) for c in missing]
-    for case, error, seconds in _results(arguments, workers, scheduler, run_timeout):
+                  plan.start_speed, None if folder is None else str(run_file(folder, *c)), plan.soil, plan.wheel)
+                 for c in missing]
+    for case, error, seconds, data in _results(arguments, workers, scheduler, run_timeout):
         case = Case(*case)
         run_seconds[case] = seconds
         if error is not None:
             failures[case] = error
+        elif data is not None:
+            runs[case] = data
         done += 1
         if progress:
             progress(done / len(cases))
-    _read_computed(folder, plan, [c for c in missing if c not in failures], runs, failures)
+    if folder is not None:
+        _read_computed(folder, plan, [c for c in missing if c not in failures], runs, failures)
     return SweepOutcome({c: runs[c] for c in cases if c in runs}, failures, len(missing), len(cases) - len(missing),
                         time.perf_counter() - started, folder, run_seconds, rejected)

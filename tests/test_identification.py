@@ -52,6 +52,7 @@ def test_first_order_fit_recovers_gain_and_time_constant():
 def test_sweep_caches_runs_and_recomputes_only_what_is_missing(single_wheel, tmp_path):
     first = run_sweep(single_wheel, SMALL, tmp_path, workers=2)
     assert (first.computed, first.cached, first.failures) == (4, 0, {})
+    assert first.cache_folder is not None
     run_file(first.cache_folder, 600.0, 30.0).unlink()
     again = run_sweep(single_wheel, SMALL, tmp_path, workers=2)
     assert (again.computed, again.cached) == (1, 3)
@@ -61,6 +62,21 @@ def test_sweep_caches_runs_and_recomputes_only_what_is_missing(single_wheel, tmp
     assert list(run.columns) == ["time", "tau", "slip", "Fx", "Fz", "Tx", "sinkage", "omega", "v", "Fy", "beta"]
     assert len(run) == 21
     assert not list(first.cache_folder.glob("*.part"))
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_sweep_without_a_cache_keeps_its_runs_in_memory_at_full_precision(single_wheel, tmp_path, workers):
+    """No cache folder (an adaptive run's sweep on its own soil): the same runs as a cached sweep's,
+    to the 12 digits a cache file keeps, from the worker process or this one, and no file written."""
+    cached = run_sweep(single_wheel, SMALL, tmp_path / "cache", workers=2)
+    before = set(tmp_path.rglob("*"))
+    kept = run_sweep(single_wheel, SMALL, None, workers=workers)
+    assert set(tmp_path.rglob("*")) == before and kept.cache_folder is None
+    assert (kept.computed, kept.cached, kept.failures) == (4, 0, {}) and set(kept.runs) == set(cached.runs)
+    for case, run in cached.runs.items():
+        assert list(kept.runs[case].columns) == list(run.columns)
+        np.testing.assert_allclose(kept.runs[case].to_numpy(), run.to_numpy(), rtol=1e-11, atol=1e-300)
+        assert not kept.runs[case].equals(run) or case.torque == 0  # full precision, not the file's 12 digits
 
 
 def test_a_failing_run_is_recorded_and_the_sweep_goes_on(single_wheel, tmp_path, monkeypatch):
@@ -77,6 +93,7 @@ def test_a_failing_run_is_recorded_and_the_sweep_goes_on(single_wheel, tmp_path,
     assert set(outcome.failures) == {(600.0, 10.0, 0.0), (600.0, 30.0, 0.0)}
     assert "the carriage fell off" in outcome.failures[Case(600.0, 10.0)]
     assert set(outcome.runs) == {(300.0, 10.0, 0.0), (300.0, 30.0, 0.0)}
+    assert outcome.cache_folder is not None
     assert sorted(p.name for p in outcome.cache_folder.glob("*.csv.gz")) == ["W300_tau10.csv.gz", "W300_tau30.csv.gz"]
 
 
@@ -101,7 +118,7 @@ def test_an_interrupted_write_leaves_no_file(single_wheel, tmp_path, monkeypatch
     monkeypatch.setattr(pd.DataFrame, "to_csv", interrupted)  # the writer of tables with NaN
     monkeypatch.setattr(cache, "_csv", interrupted)  # the run's fast writer
     target = tmp_path / "W300_tau10.csv"
-    _case, error, _ = compute_run(str(single_wheel), Case(300.0, 10.0), 0.01, 1e-3, 1e-8, 1.0, str(target))
+    _case, error, _, _ = compute_run(str(single_wheel), Case(300.0, 10.0), 0.01, 1e-3, 1e-8, 1.0, str(target))
     assert error is not None and "disk full" in error
     assert list(tmp_path.iterdir()) == []
 

@@ -88,7 +88,7 @@ def test_slip_angle_sweep_caches_per_angle_and_shares_the_longitudinal_runs(fmus
     lateral_plan = SweepPlan(loads=(300.0,), torques=(10.0,), stop_time=0.02, sample_time=1e-3,
                              slip_angles_deg=(0.0, 10.0, 20.0))
     lateral = run_sweep(fmus["SingleWheel"], lateral_plan, tmp_path, workers=2)
-    assert (lateral.computed, lateral.cached) == (2, 1)
+    assert (lateral.computed, lateral.cached) == (2, 1) and lateral.cache_folder is not None
     assert run_file(lateral.cache_folder, 300.0, 10.0).exists()
     assert run_file(lateral.cache_folder, 300.0, 10.0, 20.0).name == "W300_tau10_beta20.csv.gz"
     pd.testing.assert_frame_equal(longitudinal.runs[Case(300.0, 10.0)], lateral.runs[Case(300.0, 10.0)])

@@ -56,7 +56,7 @@ def test_without_lost_one_worker_runs_here_and_a_lost_call_is_an_error():
 
 def test_the_jobs_record_a_lost_run_as_a_failed_one():
     case = Case(100.0, 10.0, 0.0)
-    assert sweep_lost((None, case, 1.0, 0.01, 1e-6, 0.0, "x", None, None), "why") == (case, "lost: why", 0.0)
+    assert sweep_lost((None, case, 1.0, 0.01, 1e-6, 0.0, "x", None, None), "why") == (case, "lost: why", 0.0, None)
 
     class Spec:
         sample, scenario = 7, "straight"

@@ -13,7 +13,6 @@ results/simulation/
 
 from __future__ import annotations
 
-import tempfile
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -125,17 +124,15 @@ def adapter_for(models: ModelSet, fmu_dir: Path, cache_dir: Path | None, lateral
     """What an adaptive block calls at the end of its calibration: the soil estimated from the data
     starting from the soil ``models`` were identified on (their wheel: the rover's own; the
     optional parameters too with ``optional``), the models identified again on SingleWheel.fmu of
-    ``fmu_dir`` (the sweeps' cache in ``cache_dir``; None: a temporary folder), the lateral one too
-    with ``lateral``."""
+    ``fmu_dir`` (the sweeps' cache in ``cache_dir``; None: their runs kept in memory), the lateral
+    one too with ``lateral``."""
     prior, wheel = soil_and_wheel_of(models)
     degree = models.model().degree
     single_wheel = Path(fmu_dir) / "SingleWheel.fmu"
+    cache = None if cache_dir is None else Path(cache_dir)
 
     def adapter(data: TestBedData) -> Adaptation:
-        if cache_dir is not None:
-            return adapt_model(data, single_wheel, wheel, prior, Path(cache_dir), degree, lateral, optional)
-        with tempfile.TemporaryDirectory(prefix="rover-cosim-adapt-") as folder:
-            return adapt_model(data, single_wheel, wheel, prior, Path(folder), degree, lateral, optional)
+        return adapt_model(data, single_wheel, wheel, prior, cache, degree, lateral, optional)
 
     return adapter
 
@@ -146,8 +143,8 @@ def adaptive_system(fmu_dir: Path, model: ModelSet | Path, choice: Choice | None
     """The closed loop on Rover.fmu (on the soil and wheel of ``choice``) with the adaptive
     controller: a calibration phase, the soil estimated from the rover's telemetry starting from
     the soil the model was identified on (the wheel is that one too: the rover's own), the model
-    identified again on SingleWheel.fmu (the sweep's cache in ``cache_dir``; None: a temporary
-    folder), then the paper's law with it."""
+    identified again on SingleWheel.fmu (the sweep's cache in ``cache_dir``; None: its runs kept
+    in memory), then the paper's law with it."""
     models = models_of(model)
     wheel = soil_and_wheel_of(models)[1]
     adapter = adapter_for(models, fmu_dir, cache_dir, optional=calibration.optional_parameters)

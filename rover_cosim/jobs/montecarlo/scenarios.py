@@ -49,10 +49,11 @@ class RunScenario:
 
         return path_stop_time or path_following.stop_time(PATH_SCENARIO)
 
-    def system(self, fmu_dir: Path, model: ModelSet, choice: Choice, calibration: Calibration, cache: Path) -> System:
+    def system(self, fmu_dir: Path, model: ModelSet, choice: Choice, calibration: Calibration,
+               cache: Path | None) -> System:
         """The run's system before the sample's FMU parameters: the plant of ``fmu_dir`` and the
         controller with ``model`` on the sample's soil and wheel (``choice``); an adaptive one with
-        ``calibration``, its sweeps cached in ``cache``."""
+        ``calibration``, its sweeps cached in ``cache`` (None: in memory)."""
         from rover_cosim.jobs import path_following, simulate
 
         if self.straight and self.adapted_from:
