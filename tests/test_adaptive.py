@@ -256,7 +256,8 @@ def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identi
                                                                   scenario):
     """Once calibrated, an adaptive block steps its law alone and offers that law's C twin: the
     engine hands the block over to the native stepper at that step (once), and the run equals
-    the one stepped in Python throughout, to the bit."""
+    the one stepped in Python throughout, to the bit. While calibrating, the straight run's block
+    steps its law through the law's twin from Python: the same bits as the Python law."""
     from rover_cosim.jobs import path_following
     from rover_cosim.orchestrator import master
     from rover_cosim.orchestrator.builder import replace_settings
@@ -281,6 +282,16 @@ def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identi
         return after
 
     monkeypatch.setattr(master, "_handed_over", counted)
+    from rover_cosim.control.controller import LawTwin
+
+    through_twin: list[float] = []
+    step_at = LawTwin.step_at
+
+    def counted_step(self: Any, t: float, h: float, u: Any) -> Any:
+        through_twin.append(t)
+        return step_at(self, t, h, u)
+
+    monkeypatch.setattr(LawTwin, "step_at", counted_step)
     python = run(system(False))
     assert not handovers  # native stepping off: nothing to hand over
     ours = system(True)
@@ -289,3 +300,9 @@ def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identi
     assert block.switched_at is not None and block.switched_at < 1.9 and len(handovers) == 1  # (a crawling rover
     # calibrates a little longer)
     pd.testing.assert_frame_equal(python.data, native.data, check_exact=True)
+    if scenario == "straight":
+        # the law's twin stepped every calibrating step of both runs (from Python) and was freed at the switch
+        assert len(through_twin) >= 2 * 1400 and block._stepping is None
+        plain = system(False)
+        next(b.block for b in plain.blocks if b.name == "ctrl")._stepping_tried = True  # the Python law throughout
+        pd.testing.assert_frame_equal(run(plain).data, native.data, check_exact=True)

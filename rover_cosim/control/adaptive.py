@@ -50,7 +50,7 @@ from rover_cosim.identification.testbed_data import TestBedData
 from rover_cosim.orchestrator import native as native_code
 
 from .calibration import Calibration
-from .controller import InverseModelController
+from .controller import InverseModelController, LawTwin
 from .longitudinal import LongitudinalInverse
 from .path import Path as ReferencePath
 from .path_controller import PathFollowingController
@@ -221,6 +221,8 @@ class AdaptiveController(Calibrating, InverseModelController):
         self.x_hub = np.array([*x_limb, *x_limb], float)  # limbs 1-3 front to rear, 4-6 the same
         self.h_cog = float(h_cog)
         self._rates = _Rates(1)
+        self._stepping: LawTwin | None = None  # the law's C twin while calibrating (made at the first step)
+        self._stepping_tried = False
 
     def _apply(self, adaptation: Adaptation) -> None:
         self.model = adaptation.model
@@ -243,19 +245,42 @@ class AdaptiveController(Calibrating, InverseModelController):
             if self._calibrate(t, h, v, np.asarray(u[2:2 + WHEELS], float), v - pitch_rate * z_hub,
                                np.asarray(u[2 + WHEELS:2 + 2 * WHEELS], float), self.torque, sinkages):
                 advance = False  # the law (re)starts settled at its targets, as it does at t = 0
-        out = InverseModelController._outputs(self, t, u, advance, step)
+        out = self._law(t, u, advance, step)
         if self.calibrated_until is None:
             self.torque = self.torque + self.calibration.excitation(t)
             out[:WHEELS] = self.torque
         return out
 
+    def _law(self, t: float, u: np.ndarray, advance: bool, step: float | None) -> np.ndarray:
+        """The paper's law at ``t``: while calibrating (this block steps in Python then) through its
+        C twin, the same bits in a tenth of the time; at the start, the switch-over and after, the
+        Python law (whose filter restarts there)."""
+        stepping = self._stepping
+        if advance and self.calibrated_until is None:
+            if stepping is None and not self._stepping_tried:
+                self._stepping_tried = True
+                stepping = self._stepping = self.law_twin()
+            if stepping is not None:
+                out = stepping.step_at(t, step or self.step_size, u)
+                self.torque = out[:WHEELS].copy()
+                return out
+        if stepping is not None:  # the phase is over: the Python law takes the filter from the twin
+            self.inverse.filter_state = stepping.filter()
+            stepping.close()
+            self._stepping = None
+        return InverseModelController._outputs(self, t, u, advance, step)
+
     def get_state(self) -> tuple[Any, ...]:
         """The paper's block's state and the calibration's (for masters that repeat a step; a
         repeated step after the switch-over keeps the new model)."""
+        if self._stepping is not None:  # the filter lives in the law's twin while calibrating
+            self.inverse.filter_state = self._stepping.filter()
         return (*InverseModelController.get_state(self), self._calibration_state(), self._rates.last.copy())
 
     def set_state(self, state: tuple[Any, ...]) -> None:
         InverseModelController.set_state(self, (state[0], state[1]))
+        if self._stepping is not None:
+            self._stepping.set_filter(self.inverse.filter_state)
         self._restore_calibration(state[2])
         self._rates.last = state[3].copy()
 

@@ -73,6 +73,26 @@ int controller_do_step(void *component, double t, double h, int no_prior_state) 
     return outputs(c, t + h, 1, h);
 }
 
+/* The step's outputs at ``t`` itself (not t + h): what the Python block computes when a block
+ * built on it steps the law from its own step (the adaptive controller's calibration), bit for bit. */
+int controller_step_at(void *component, double t, double h) {
+    Controller *c = component;
+    if (law_step_allowed(c->message, h, c->settings[STEP]) != OK) return ERROR;
+    return outputs(c, t, 1, h);
+}
+
+/* The filter's state (per wheel slip_f, slip_f' [1/s]) out of and into ``filter`` (2 x wheels):
+ * a block that steps the law through its twin keeps its own state with it (masters that repeat a step). */
+void controller_get_filter(void *component, double *filter) {
+    Controller *c = component;
+    memcpy(filter, c->law.filter, 2 * (size_t)c->wheels * sizeof(double));
+}
+
+void controller_set_filter(void *component, const double *filter) {
+    Controller *c = component;
+    memcpy(c->law.filter, filter, 2 * (size_t)c->wheels * sizeof(double));
+}
+
 /* Accept ``count`` inputs after the law's (value references 2 + wheels ..) and ignore them: the
  * inputs of a block that steps this law after a phase of its own (the adaptive controller). */
 void controller_ignore_inputs(void *component, int count) { ((Controller *)component)->ignored = count > 0 ? count : 0; }

@@ -272,7 +272,10 @@ def run_montecarlo(study: Study, fmu_dir: Path, model: Path, out_dir: Path, *, w
     remove_partial_files(cache)
     specs = _specs(study, samples, fmu_dir, models, nominal_choice, cache, hashes)
     results, rejected = _cached(specs)
-    missing = [s for s in specs if (s.sample, s.scenario) not in results]
+    # the adaptive runs (3x as long) first: the workers then end close together, not one of them
+    # alone on a long run at the end
+    missing = sorted((s for s in specs if (s.sample, s.scenario) not in results),
+                     key=lambda s: RUN_SCENARIOS[s.scenario].adapted_from is None)
     compute_started = time.perf_counter()
     computed, errors = _compute(missing, workers, scheduler, progress, len(specs) - len(missing), len(specs),
                                 run_timeout)
