@@ -253,8 +253,8 @@ class AdaptiveController(Calibrating, InverseModelController):
 
     def _law(self, t: float, u: np.ndarray, advance: bool, step: float | None) -> np.ndarray:
         """The paper's law at ``t``: while calibrating (this block steps in Python then) through its
-        C twin, the same bits in a tenth of the time; at the start, the switch-over and after, the
-        Python law (whose filter restarts there)."""
+        C twin, the same bits several times faster; at the start, the switch-over (where the
+        filter restarts settled) and after it, the Python law."""
         stepping = self._stepping
         if advance and self.calibrated_until is None:
             if stepping is None and not self._stepping_tried:
@@ -264,7 +264,7 @@ class AdaptiveController(Calibrating, InverseModelController):
                 out = stepping.step_at(t, step or self.step_size, u)
                 self.torque = out[:WHEELS].copy()
                 return out
-        if stepping is not None:  # the phase is over: the Python law takes the filter from the twin
+        if stepping is not None:  # the phase is over: the twin is freed, its filter handed back
             self.inverse.filter_state = stepping.filter()
             stepping.close()
             self._stepping = None
