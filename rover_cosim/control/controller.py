@@ -181,7 +181,10 @@ class LawTwin:
         self.made.library.controller_set_filter(self.made.component, values.ctypes.data)
 
     def close(self) -> None:
-        self.made.close()
+        """Free the twin (once; later calls do nothing)."""
+        made = getattr(self, "made", None)  # None: __init__ did not get that far
+        if made is not None:
+            made.close()
 
     def __del__(self) -> None:
         self.close()
