@@ -11,10 +11,11 @@ controller's longitudinal model identified again on that soil (issue 33, the onl
    (starting from the soil the controller was identified on, the prior);
 2. the paper's identification sweep (step torques on ``SingleWheel.fmu``, the torques of
    ``SweepPlan``, loads over the rover's own range: ``sweep_loads``) runs on the estimated soil
-   and the wheel, in this process, its runs kept in memory (or in a sweep cache where the caller
-   gives one: a soil estimated again to the same values is then not run again), and
-   ``fits.identify`` makes the model of the same degree the
-   controller used, its Fx fit through the torques the closed loop drives with
+   and the wheel, in this process inside a pool's worker (a Monte Carlo run), else in a process
+   of its own that a crash cannot take the caller down with, its runs kept in memory (or in a
+   sweep cache where the caller gives one: a soil estimated again to the same values is then not
+   run again), and ``fits.identify`` makes the model of the same degree the controller used, its
+   Fx fit through the torques the closed loop drives with
    (``ADAPTED_FIT_TORQUE_MAX``).
 
 The estimate searches the plan's parameters (c, φ, k_x, k_φ, n from the torques) and, unless asked
@@ -110,9 +111,9 @@ def identify_on_soil(fmu_path: Path, soil: Soil, wheel: Wheel, cache_dir: Path |
     ``fmu_path`` (SingleWheel.fmu) with ``soil`` and ``wheel`` as its parameters (the runs cached in
     ``cache_dir``; None: kept in memory), the Fx fit through
     the points up to ``torque_max`` [N·m] (ADAPTED_FIT_TORQUE_MAX for the paper's wheel; a plan
-    scaled to another wheel scales it too); the sweep in this process (``workers`` 1: an adaptive
-    run inside a Monte Carlo worker) or on ``workers`` processes (None: every core; a command's own
-    identification); (the model, the runs computed)."""
+    scaled to another wheel scales it too); the sweep on one process (``workers`` 1: an adaptive
+    run; in this process where it is a pool's worker, a Monte Carlo run) or on ``workers``
+    processes (None: every core; a command's own identification); (the model, the runs computed)."""
     plan = replace(plan or SweepPlan(), soil=soil, wheel=wheel)
     sweep = run_sweep(Path(fmu_path), plan, cache_dir, workers=workers)
     if not sweep.runs:

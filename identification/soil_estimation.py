@@ -106,6 +106,10 @@ UNCARRIED_RESIDUAL = 1e3
 SOLVE_RTOL = 1e-12
 FIT_TOL = 1e-10
 METHOD = "dogbox"
+#: The plan's statement about the optional stress-distribution parameters (left out of an estimate
+#: that did not search them).
+PATCH_STATEMENT = ("a0, a1 (the angle of the largest normal stress) and λ (the exit angle) are estimated only if "
+                   "the data determine them; otherwise kept at the prior's values with the reason.")
 #: Why an optional parameter kept the prior's value when the estimate was asked for the plan's only.
 NOT_SEARCHED = "not searched: the estimate was asked for the plan's parameters only (optional ones off)"
 #: Measurements per estimated parameter at least.
@@ -222,8 +226,7 @@ def _plan_pressure(facts: _Facts, estimated: list[str], fixed: dict[str, str], s
 def _plan_patch(facts: _Facts, optional: list[str], fixed: dict[str, str], statements: list[str]) -> None:
     if facts.force or facts.sinkage:
         optional += ["a1", "a0", "lam"]
-        statements.append("a0, a1 (the angle of the largest normal stress) and λ (the exit angle) are estimated only "
-                          "if the data determine them; otherwise kept at the prior's values with the reason.")
+        statements.append(PATCH_STATEMENT)
     else:  # only Fy: plan_parameters adds the lateral ones
         for name in ("a0", "a1", "lam"):
             fixed[name] = "no Fx_N, Tx_Nm or sinkage_m column"
@@ -754,8 +757,11 @@ def _identifiability(problem: _Problem, statistics: _Statistics, estimates: Mapp
         direction = direction * (1 if direction[np.argmax(np.abs(direction))] > 0 else -1)
         weakest = {(f"log {n}" if SPECS[n].log else n): round(float(v), 4)
                    for n, v in zip(names, direction) if abs(v) > 0.1}
-    statements = list(plan.statements)
-    statements += [f"{f.name} was tried and is kept at the prior's value: {f.reason}." for f in dropped]
+    searched = not any(f.reason == NOT_SEARCHED for f in dropped)
+    statements = [s for s in plan.statements if searched or s != PATCH_STATEMENT]
+    statements += [f"{f.name} was tried and is kept at the prior's value: {f.reason}." if f.reason != NOT_SEARCHED
+                   else f"{f.name} was not searched (optional parameters off) and is kept at the prior's value."
+                   for f in dropped]
     statements += [p.statement for p in pairs]
     for e in estimates.values():
         if e.determined == "not":
@@ -821,6 +827,8 @@ def estimate_soil(data: TestBedData, wheel: Wheel = Wheel(), prior: Soil = Soil(
             channel's unit); channels not given get theirs from the fit's residuals.
         bounds: search bounds [SI] replacing those of :data:`BOUNDS`.
         confidence: level of the intervals, in (0, 1).
+        optional: search the plan's optional parameters in turn (else they keep the prior's values,
+            each recorded as not searched).
 
     Raises ValueError with a message for data that cannot be fitted (a sinkage beyond the wheel's
     radius, too few measurements for the parameters, a parameter the columns cannot show).

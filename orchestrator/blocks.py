@@ -19,7 +19,10 @@ an FMU after the block that can interpolate its inputs as that line; ``get_state
 and ``set_state(state)`` for the iterative master, which repeats a step (without them the
 master keeps a deep copy of the block's attributes); ``native() -> native.NativeBlock | None``:
 the block's C twin, made from its state after ``start``, which the Jacobi and Gauss-Seidel masters
-step from C with the FMUs (see ``orchestrator.native``; the closed-loop controller has one).
+step from C with the FMUs (see ``orchestrator.native``; the closed-loop controller has one);
+``use_native(enabled)``: told before the run steps whether C code may step for it (the system's
+``native`` setting under an explicit master), for a block that calls C of its own from its Python
+step (the adaptive controller's law while it calibrates).
 
 Sources ignore their inputs (they have none). A user block is any class with this interface;
 ``type = "python"`` in a system file loads it from ``factory = "module:callable"`` (the module

@@ -36,6 +36,10 @@ class Execution:
         self.stages = algorithm.stages(self.participants, self.inputs, self.outputs, threads)
         #: Whether participants may be stepped from C at all (explicit algorithm, native stepping on).
         self.native_enabled = algorithm.explicit and use_native
+        for participant in self.participants:  # blocks that step C of their own from Python learn it too
+            told = getattr(getattr(participant, "block", None), "use_native", None)
+            if isinstance(participant, BlockParticipant) and callable(told):
+                told(self.native_enabled)
         self.native = self._native(threads) if self.native_enabled else None
         self.natively: frozenset[int] = self.native.members if self.native is not None else frozenset()
         self.python: PythonExecutor

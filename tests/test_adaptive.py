@@ -293,7 +293,7 @@ def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identi
 
     monkeypatch.setattr(LawTwin, "step_at", counted_step)
     python = run(system(False))
-    assert not handovers  # native stepping off: nothing to hand over
+    assert not handovers and not through_twin  # native stepping off: nothing to hand over, no twin stepped
     ours = system(True)
     native = run(ours)
     block: Any = next(b.block for b in ours.blocks if b.name == "ctrl")
@@ -301,8 +301,6 @@ def test_after_the_switch_the_laws_c_twin_takes_over_bit_for_bit(fmu_dir, identi
     # calibrates a little longer)
     pd.testing.assert_frame_equal(python.data, native.data, check_exact=True)
     if scenario == "straight":
-        # the law's twin stepped every calibrating step of both runs (from Python) and was freed at the switch
-        assert len(through_twin) >= 2 * 1400 and block._stepping is None
-        plain = system(False)
-        next(b.block for b in plain.blocks if b.name == "ctrl")._stepping_tried = True  # the Python law throughout
-        pd.testing.assert_frame_equal(run(plain).data, native.data, check_exact=True)
+        # the native run's law stepped through its twin (from Python) every calibrating step, freed at the
+        # switch; the run stepped in Python (native off) never: they agree to the bit, as above
+        assert len(through_twin) >= 1400 and all(t < 1.6 for t in through_twin) and block._stepping is None

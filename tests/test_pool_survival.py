@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import signal
 import time
+from typing import Any
 
 import pytest
 from processes import children
@@ -100,3 +101,23 @@ def test_a_one_worker_map_nested_in_a_worker_runs_in_that_worker_and_elsewhere_i
     for worker, inner in outer:
         assert worker != os.getpid() and inner == [worker, worker]
     assert set(parallel_map(_pid, [(0,), (1,)], workers=1, lost=_no_pid)) - {os.getpid()}
+
+
+def _nested_in_a_daemon(conn: Any) -> None:
+    conn.send((os.getpid(), list(parallel_map(_pid, [(0,), (1,)], workers=1, lost=_no_pid))))
+    conn.close()
+
+
+def test_a_daemonic_worker_like_dasks_runs_a_nested_one_worker_map_in_itself():
+    """A Dask worker is a daemonic process, which may not start processes of its own: a nested
+    one-worker map with ``lost`` runs in it (before: the pool's Process.start failed there)."""
+    import multiprocessing
+
+    context = multiprocessing.get_context("fork")
+    mine, theirs = context.Pipe()
+    daemon = context.Process(target=_nested_in_a_daemon, args=(theirs,), daemon=True)
+    daemon.start()
+    assert mine.poll(30), "the daemonic process did not answer"
+    pid, inner = mine.recv()
+    daemon.join(10)
+    assert pid == daemon.pid and inner == [pid, pid]

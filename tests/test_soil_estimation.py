@@ -17,6 +17,7 @@ from rover_cosim.cli import build_parser, main
 from rover_cosim.common.outputs import file_sha256
 from rover_cosim.identification.soil_estimation import (
     NOT_SEARCHED,
+    PATCH_STATEMENT,
     SoilEstimate,
     estimate_soil,
     plan_parameters,
@@ -76,6 +77,9 @@ def test_without_the_optional_parameters_the_plans_own_are_searched_and_the_othe
         assert plain.parameters[name].value == pytest.approx(getattr(lunar, name), rel=1e-6), name
     assert set(plain.parameters) == set(exact_fit.parameters) - {"a1", "a0", "lam"}
     assert plain.evaluations < exact_fit.evaluations / 2
+    said = plain.identifiability.statements
+    assert "a1 was not searched (optional parameters off) and is kept at the prior's value." in said
+    assert PATCH_STATEMENT not in said and PATCH_STATEMENT in exact_fit.identifiability.statements
 
 
 def test_noisy_data_hold_the_truth_in_the_intervals_and_predict_held_out_points(lunar: Soil):

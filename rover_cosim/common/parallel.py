@@ -58,7 +58,7 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     workers = workers or os.cpu_count() or 1
     if workers < 1:
         raise ValueError(f"workers = {workers!r}: expected >= 1")
-    if (lost is None or _IN_WORKER) and (workers == 1 or len(arguments) <= 1):
+    if (lost is None or _in_a_worker()) and (workers == 1 or len(arguments) <= 1):
         # nothing to survive, or already in a worker of a pool (whose pool reports the call lost if
         # this one crashes): serially, here, without a process of its own
         yield from (function(*a) for a in arguments)
@@ -73,6 +73,14 @@ def parallel_map(function: Callable[..., Result], arguments: Sequence[tuple[Any,
     finally:  # done, or Ctrl-C, SIGTERM (raised as KeyboardInterrupt by the CLI), the consumer closing
         pool.stop()
         remove_stale_folders()  # the workers' temporary folders (they exit without clean-ups)
+
+
+def _in_a_worker() -> bool:
+    """Whether this process is a worker of a pool: a local pool's, or a daemonic one (a Dask
+    worker's, which may not start processes of its own)."""
+    import multiprocessing
+
+    return _IN_WORKER or bool(multiprocessing.current_process().daemon)
 
 
 def scheduler_timeout() -> float:

@@ -223,6 +223,7 @@ class AdaptiveController(Calibrating, InverseModelController):
         self._rates = _Rates(1)
         self._stepping: LawTwin | None = None  # the law's C twin while calibrating (made at the first step)
         self._stepping_tried = False
+        self._native_allowed = True  # the run's native setting (use_native); True for a block stepped alone
 
     def _apply(self, adaptation: Adaptation) -> None:
         self.model = adaptation.model
@@ -256,7 +257,7 @@ class AdaptiveController(Calibrating, InverseModelController):
         C twin, the same bits several times faster; at the start, the switch-over (where the
         filter restarts settled) and after it, the Python law."""
         stepping = self._stepping
-        if advance and self.calibrated_until is None:
+        if advance and self.calibrated_until is None and self._native_allowed:
             if stepping is None and not self._stepping_tried:
                 self._stepping_tried = True
                 stepping = self._stepping = self.law_twin()
@@ -269,6 +270,11 @@ class AdaptiveController(Calibrating, InverseModelController):
             stepping.close()
             self._stepping = None
         return InverseModelController._outputs(self, t, u, advance, step)
+
+    def use_native(self, enabled: bool) -> None:
+        """Whether the run lets C code step (the system's ``native`` setting under an explicit
+        master): without, the law steps in Python while calibrating too."""
+        self._native_allowed = bool(enabled)
 
     def get_state(self) -> tuple[Any, ...]:
         """The paper's block's state and the calibration's (for masters that repeat a step; a

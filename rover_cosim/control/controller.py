@@ -131,7 +131,10 @@ class InverseModelController:
         """The law alone stepped through the C twin from this block's state now (None where the
         twin cannot be compiled): for a block built on this one that steps the law from its own
         Python step, bit for bit and several times faster than the Python law."""
-        made = InverseModelController.native(self)  # the law's own twin, whatever a subclass steps natively
+        try:
+            made = InverseModelController.native(self)  # the law's own twin, whatever a subclass steps natively
+        except MemoryError:  # tables it cannot take: the Python law steps (and says what is wrong, if anything)
+            return None
         return None if made is None else LawTwin(made, self.wheels)
 
     def step(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
@@ -148,7 +151,8 @@ class LawTwin:
     (``filter``, ``set_filter``: for masters that repeat a step)."""
 
     def __init__(self, made: native_code.NativeBlock, wheels: int):
-        self.made, self.wheels = made, wheels
+        self.made: native_code.NativeBlock | None = made
+        self.wheels = wheels
         library, pointer = made.library, ctypes.c_void_p
         for name in ("controller_set_real", "controller_get_real"):
             getattr(library, name).argtypes = [pointer, pointer, ctypes.c_size_t, pointer]
@@ -160,31 +164,40 @@ class LawTwin:
         self._outputs = (ctypes.c_uint * (2 * wheels + 1))(*range(2 * wheels + 1))
         self._values = np.zeros(2 * wheels + 1)
 
+    def _twin(self) -> native_code.NativeBlock:
+        if self.made is None:
+            raise RuntimeError("the law's C twin was freed")
+        return self.made
+
     def step_at(self, t: float, h: float, u: np.ndarray) -> np.ndarray:
         """The law's outputs (tau[1..n], Fx_des[1..n], F_all) at ``t`` [s], the filter moved on by ``h`` [s]."""
-        library, component = self.made.library, self.made.component
+        made = self._twin()
+        library, component = made.library, made.component
         inputs = np.ascontiguousarray(u[:2 + self.wheels], dtype=float)
         library.controller_set_real(component, self._inputs, inputs.size, inputs.ctypes.data)
         if library.controller_step_at(component, t, h) != 0:
-            raise ValueError(self.made.message())
+            raise ValueError(made.message())
         library.controller_get_real(component, self._outputs, self._values.size, self._values.ctypes.data)
         return self._values.copy()
 
     def filter(self) -> np.ndarray:
         """The filter's state, (wheels, 2): slip_f, slip_f' [1/s]."""
+        made = self._twin()
         state = np.zeros((self.wheels, 2))
-        self.made.library.controller_get_filter(self.made.component, state.ctypes.data)
+        made.library.controller_get_filter(made.component, state.ctypes.data)
         return state
 
     def set_filter(self, state: np.ndarray) -> None:
+        made = self._twin()
         values = np.ascontiguousarray(state, dtype=float).reshape(self.wheels, 2)
-        self.made.library.controller_set_filter(self.made.component, values.ctypes.data)
+        made.library.controller_set_filter(made.component, values.ctypes.data)
 
     def close(self) -> None:
-        """Free the twin (once; later calls do nothing)."""
-        made = getattr(self, "made", None)  # None: __init__ did not get that far
+        """Free the twin (once; later calls do nothing, using it raises)."""
+        made = getattr(self, "made", None)  # None: __init__ did not get that far, or freed
         if made is not None:
             made.close()
+            self.made = None
 
     def __del__(self) -> None:
         self.close()

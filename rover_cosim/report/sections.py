@@ -459,7 +459,7 @@ def adaptation_section(montecarlo: Path, summary: dict) -> list[str]:
             f"±{amplitude:g} N·m per level of {segment:g} s, "
             f"sinkage sensor: {'yes' if calibration.get('sinkage_sensor') else 'no'}), the soil estimated from the "
             "rover's wheel torques, spins, loads and speed ("
-            f"{'a1, a0 and λ tried too' if calibration.get('optional_parameters') else 'a1, a0 and λ kept'}), "
+            f"{'a1, a0 and λ tried too' if calibration.get('optional_parameters', True) else 'a1, a0 and λ kept'}), "
             "the controller's model identified again on "
             "SingleWheel.fmu with the estimated soil, then the paper's law. The whole-run share counts the "
             "calibration's own excitation (its cost); the estimate and the sweep took "
