@@ -64,6 +64,22 @@ def test_a_study_reads_its_calibration_table_and_names_bad_keys():
             parse_study({**base, "calibration": table}, "s")
 
 
+def test_a_runs_cache_key_holds_the_calibration_it_depends_on():
+    """An adaptive run's key holds its whole calibration; another run's only the duration (its RMS
+    window after the calibration): a sensor or the optional parameters do not run it again."""
+    from rover_cosim.jobs.montecarlo.runs import cache_key
+
+    shared = {"fmus": {"Rover.fmu": "r", "SingleWheel.fmu": "s", "SteerableRover.fmu": "p"}, "model": "m"}
+
+    def key(scenario: str, calibration: Calibration) -> str:
+        return cache_key(shared, scenario, 20.0, (), (), calibration)
+
+    plain, sensing, searching = Calibration(), Calibration(sinkage_sensor=True), Calibration(optional_parameters=True)
+    assert key("straight", plain) == key("straight", sensing) == key("straight", searching)
+    assert key("straight", plain) != key("straight", Calibration(duration=2.0))
+    assert len({key("straight_adapted", c) for c in (plain, sensing, searching)}) == 3
+
+
 #: The calibration of the module's short adaptive runs: the runs of a scenario on TRUTH estimate the
 #: same soil from the same telemetry, so their sweeps are computed once (sweep_cache).
 SHORT_CALIBRATION = Calibration(duration=1.5, segment=0.25)

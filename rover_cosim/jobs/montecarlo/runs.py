@@ -117,12 +117,16 @@ def split(values: dict[str, float], nominal: bool) -> tuple[Values, Values]:
 
 def cache_key(fingerprint: dict[str, Any], scenario: str, stop_time: float,
               changes: Values, parameters: Values, calibration: Calibration = Calibration()) -> str:
-    """The run's cache key (hex): ``fingerprint`` holds the FMUs', the model's and the nominal soil's."""
+    """The run's cache key (hex): ``fingerprint`` holds the FMUs', the model's and the nominal soil's;
+    of the calibration, an adaptive run's whole, another run's the duration alone (its "after the
+    calibration" RMS window), so that the other settings of the calibration do not run it again."""
+    adaptive = RUN_SCENARIOS[scenario].adapted_from is not None
     content = {"fingerprint": fingerprint, "scenario": scenario,
                "fmu": fingerprint["fmus"][RUN_SCENARIOS[scenario].fmu],
                "extra_fmus": [fingerprint["fmus"].get(name) for name in RUN_SCENARIOS[scenario].extra_fmus],
                "stop_time": stop_time, "step": simulate.STEP, "changes": [list(c) for c in changes],
-               "parameters": [list(p) for p in parameters], "calibration": asdict(calibration),
+               "parameters": [list(p) for p in parameters],
+               "calibration": asdict(calibration) if adaptive else {"duration": calibration.duration},
                "metrics_version": METRICS_VERSION}
     return hashlib.sha256(json.dumps(content, sort_keys=True, default=str).encode()).hexdigest()
 
