@@ -135,7 +135,7 @@ class WheelTestBed:
         rows[0] = self._start(load, float(taus[0]), float(turns[0]), tolerance, start_speed, slip_angle,
                               self.parameters if parameters is None else parameters, float(times[-1]))
         fmu = self.fmu
-        changes = [k for k in range(1, n) if taus[k] != taus[k - 1] or turns[k] != turns[k - 1]]
+        changes = (np.flatnonzero((taus[1:n] != taus[:n - 1]) | (turns[1:n] != turns[:n - 1])) + 1).tolist()
         stepper = self._stepper()
         try:
             for first, last in zip([0, *changes], [*changes, n]):
@@ -148,10 +148,7 @@ class WheelTestBed:
             if stepper is not None:
                 stepper.close()
         fmu.terminate()
-        data = pd.DataFrame(rows, columns=list(RECORDED))
-        data.insert(0, "tau", taus)
-        data.insert(0, "time", times)
-        return data
+        return pd.DataFrame(np.column_stack([times, taus, rows]), columns=["time", "tau", *RECORDED])
 
 
     def _stepper(self) -> native.NativeStepper | None:
