@@ -64,6 +64,18 @@ def test_a_study_reads_its_calibration_table_and_names_bad_keys():
             parse_study({**base, "calibration": table}, "s")
 
 
+def test_simulate_adapt_takes_the_calibrations_switches_from_the_command_line():
+    from rover_cosim.cli import build_parser
+    from rover_cosim.cli.simulate import _calibration
+
+    parser = build_parser()
+    assert _calibration(parser.parse_args(["simulate", "--adapt"])) == Calibration()
+    given = parser.parse_args(["simulate", "--adapt", "--calibration", "2", "--sinkage-sensor",
+                               "--optional-parameters"])
+    assert _calibration(given) == Calibration(duration=2.0, sinkage_sensor=True, optional_parameters=True)
+    assert _calibration(parser.parse_args(["simulate", "--optional-parameters"])) is None  # no adaptive run
+
+
 def test_a_runs_cache_key_holds_the_calibration_it_depends_on():
     """An adaptive run's key holds its whole calibration; another run's only the duration (its RMS
     window after the calibration): a sensor or the optional parameters do not run it again."""

@@ -52,6 +52,9 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --adapt: the calibration phase's length [s] (default 3)")
     parser.add_argument("--sinkage-sensor", action="store_true",
                         help="with --adapt: the rover measures its wheels' sinkage (the estimate uses it)")
+    parser.add_argument("--optional-parameters", action="store_true",
+                        help="with --adapt: the soil estimate also tries a1, a0 and lambda, as estimate-soil does "
+                        "(several times slower; default: they keep the model's soil's values)")
     parser.add_argument("--record-interval", type=float, default=0.01,
                         help="rows kept in the trajectory files [s] (a whole number of 1 ms steps; default 0.01; "
                         "0.001: every step); metrics and figures use every step")
@@ -66,10 +69,12 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _calibration(args: argparse.Namespace) -> Any:
-    """The adaptive run's Calibration of --calibration and --sinkage-sensor (None without --adapt)."""
+    """The adaptive run's Calibration of --calibration, --sinkage-sensor and --optional-parameters
+    (None without --adapt)."""
     from rover_cosim.control.calibration import Calibration
 
-    return Calibration(duration=args.calibration, sinkage_sensor=args.sinkage_sensor) if args.adapt else None
+    return Calibration(duration=args.calibration, sinkage_sensor=args.sinkage_sensor,
+                       optional_parameters=args.optional_parameters) if args.adapt else None
 
 
 def _crossing_soils_known(args: argparse.Namespace) -> bool:
