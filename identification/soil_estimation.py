@@ -740,7 +740,8 @@ def _pair_statement(first: str, second: str, r: float, wheel: Wheel, data: TestB
 
 
 def _identifiability(problem: _Problem, statistics: _Statistics, estimates: Mapping[str, ParameterEstimate],
-                     plan: ParameterPlan, dropped: Sequence[FixedParameter]) -> Identifiability:
+                     plan: ParameterPlan, dropped: Sequence[FixedParameter],
+                     optional: bool = True) -> Identifiability:
     names = problem.names
     pairs = []
     for i in range(len(names)):
@@ -757,11 +758,13 @@ def _identifiability(problem: _Problem, statistics: _Statistics, estimates: Mapp
         direction = direction * (1 if direction[np.argmax(np.abs(direction))] > 0 else -1)
         weakest = {(f"log {n}" if SPECS[n].log else n): round(float(v), 4)
                    for n, v in zip(names, direction) if abs(v) > 0.1}
-    searched = not any(f.reason == NOT_SEARCHED for f in dropped)
-    statements = [s for s in plan.statements if searched or s != PATCH_STATEMENT]
-    statements += [f"{f.name} was tried and is kept at the prior's value: {f.reason}." if f.reason != NOT_SEARCHED
-                   else f"{f.name} was not searched (optional parameters off) and is kept at the prior's value."
-                   for f in dropped]
+    if optional:
+        statements = list(plan.statements)
+        statements += [f"{f.name} was tried and is kept at the prior's value: {f.reason}." for f in dropped]
+    else:  # the optional parameters were not searched: the plan's statement about them does not hold
+        statements = [s for s in plan.statements if s != PATCH_STATEMENT]
+        statements += [f"{f.name} was not searched (optional parameters off) and is kept at the prior's value."
+                       for f in dropped]
     statements += [p.statement for p in pairs]
     for e in estimates.values():
         if e.determined == "not":
@@ -862,7 +865,7 @@ def estimate_soil(data: TestBedData, wheel: Wheel = Wheel(), prior: Soil = Soil(
         soil=problem.soil(z), prior=prior, wheel=wheel, data=data, parameters=estimates,
         fixed={f.name: f for f in (*plan.fixed, *dropped)}, correlation=statistics.correlation,
         covariance=statistics.covariance, residuals=residuals,
-        identifiability=_identifiability(problem, statistics, estimates, plan, dropped),
+        identifiability=_identifiability(problem, statistics, estimates, plan, dropped, optional),
         bekker_modulus=_bekker(problem, z, statistics, confidence), confidence=confidence,
         evaluations=evaluations + 1, seconds=time.perf_counter() - started, message=message)
 
