@@ -739,6 +739,18 @@ def _pair_statement(first: str, second: str, r: float, wheel: Wheel, data: TestB
     return f"{words}: the data determine a combination of them better than either."
 
 
+def _plan_statements(plan: ParameterPlan, dropped: Sequence[FixedParameter], optional: bool) -> list[str]:
+    """The plan's statements and one per optional parameter kept at the prior's value: tried and
+    not determined, or (``optional`` False) not searched, when the plan's statement about them
+    does not hold."""
+    if optional:
+        return [*plan.statements, *(f"{f.name} was tried and is kept at the prior's value: {f.reason}."
+                                    for f in dropped)]
+    return [*(s for s in plan.statements if s != PATCH_STATEMENT),
+            *(f"{f.name} was not searched (optional parameters off) and is kept at the prior's value."
+              for f in dropped)]
+
+
 def _identifiability(problem: _Problem, statistics: _Statistics, estimates: Mapping[str, ParameterEstimate],
                      plan: ParameterPlan, dropped: Sequence[FixedParameter],
                      optional: bool = True) -> Identifiability:
@@ -758,13 +770,7 @@ def _identifiability(problem: _Problem, statistics: _Statistics, estimates: Mapp
         direction = direction * (1 if direction[np.argmax(np.abs(direction))] > 0 else -1)
         weakest = {(f"log {n}" if SPECS[n].log else n): round(float(v), 4)
                    for n, v in zip(names, direction) if abs(v) > 0.1}
-    if optional:
-        statements = list(plan.statements)
-        statements += [f"{f.name} was tried and is kept at the prior's value: {f.reason}." for f in dropped]
-    else:  # the optional parameters were not searched: the plan's statement about them does not hold
-        statements = [s for s in plan.statements if s != PATCH_STATEMENT]
-        statements += [f"{f.name} was not searched (optional parameters off) and is kept at the prior's value."
-                       for f in dropped]
+    statements = _plan_statements(plan, dropped, optional)
     statements += [p.statement for p in pairs]
     for e in estimates.values():
         if e.determined == "not":
