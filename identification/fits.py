@@ -13,12 +13,12 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.interpolate import RegularGridInterpolator
-from scipy.optimize import least_squares
 
 #: Settled points enter the Fx(slip) fits when the wheel still rolls (see step_table), their torque
 #: is within what the rover uses (its open-loop run drives with 9-40 N·m) and their slip is in
@@ -55,6 +55,8 @@ def first_order_fit(time: np.ndarray, slip: np.ndarray, torque: float) -> tuple[
     reached = np.nonzero(np.abs(slip) >= 0.632 * abs(final))[0] if final != 0 else np.array([], int)
     t63 = float(time[reached[0]]) if reached.size and time[reached[0]] > 0 else float(time[1])
     dt = float(time[1] - time[0])
+    # imported here: scipy.optimize is a fifth of a second that a command fitting nothing waits for
+    from scipy.optimize import least_squares
 
     def residual(parameters: np.ndarray) -> np.ndarray:
         gain, log_t = parameters
@@ -83,9 +85,23 @@ class IdentifiedModel:
         self._inverse_loads = 1.0 / np.asarray(self.loads, float)  # decreasing
         self._settled_table = np.asarray(self.gain, float) * np.asarray(self.torques, float)[None, :]
         self._log_t_table = np.log(np.asarray(self.time_constant, float))
+
+    def _interpolator(self, table: np.ndarray) -> Any:
+        """``table`` over (1/W, tau), linear inside and extended linearly beyond. Made when first
+        asked for: scipy.interpolate is half a second of imports, and the controllers read the
+        tables themselves (a command that only steps them never imports it)."""
+        from scipy.interpolate import RegularGridInterpolator
+
         axes = (self._inverse_loads[::-1], np.asarray(self.torques, float))
-        self._settled = RegularGridInterpolator(axes, self._settled_table[::-1], bounds_error=False, fill_value=None)
-        self._t = RegularGridInterpolator(axes, self._log_t_table[::-1], bounds_error=False, fill_value=None)
+        return RegularGridInterpolator(axes, table[::-1], bounds_error=False, fill_value=None)
+
+    @functools.cached_property
+    def _settled(self) -> Any:
+        return self._interpolator(self._settled_table)
+
+    @functools.cached_property
+    def _t(self) -> Any:
+        return self._interpolator(self._log_t_table)
 
     @staticmethod
     def _point(load: float, torque: float) -> np.ndarray:

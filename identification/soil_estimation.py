@@ -42,7 +42,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize
 
 from rover_cosim.terramechanics import Soil, Wheel
 from rover_cosim.terramechanics.parameters import UNITS, xc_from_phi
@@ -625,6 +624,9 @@ def _fit(problem: _Problem, z: NDArray[np.float64], low: NDArray[np.float64],
          high: NDArray[np.float64]) -> tuple[NDArray[np.float64], str]:
     if not problem.names:
         return z, "nothing to search"
+    # imported here: a quarter of a second for every command that loads the adaptive controller
+    from scipy import optimize
+
     steps = np.array([SPECS[name].step for name in problem.names])
     result = optimize.least_squares(problem.residuals, z, bounds=(low, high), method=METHOD, x_scale=steps,
                                     diff_step=1e-7, ftol=FIT_TOL, xtol=FIT_TOL, gtol=FIT_TOL, max_nfev=200)
