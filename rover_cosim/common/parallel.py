@@ -21,6 +21,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, TypeVar
 
+from . import handoff
 from .heap import freeze_imports
 from .scratch import remove_stale_folders
 
@@ -208,7 +209,7 @@ class _Pool:
                 assert running is not None
                 if worker.conn in ready:
                     try:
-                        kind, result = worker.conn.recv()
+                        kind, result = handoff.receive(worker.conn)
                     except (EOFError, OSError):
                         pass
                     else:
@@ -249,7 +250,7 @@ def _work(conn: Any, function: Callable[..., Any], parent: int) -> None:
             break
         task, arguments = message
         try:
-            conn.send(("ok", function(*arguments)))
+            handoff.send(conn, ("ok", function(*arguments)))  # large arrays through shared memory
         except Exception as error:  # noqa: BLE001 - the function should not raise: said, not a dead worker
             conn.send(("raised", f"{type(error).__name__}: {error}"))
     conn.close()
