@@ -187,6 +187,20 @@ def test_sensitivity_finds_an_output_that_worsens_both_ways_from_the_nominal():
     assert rms.loc["a", "strongest"] == "monotonic" and rms.loc["a", "p_value"] < 0.01 < rms.loc["k", "p_value"]
 
 
+def test_the_ranks_and_p_values_are_scipy_stats_bit_for_bit():
+    """The sensitivity ranks with pandas and takes Student's t from scipy.special (scipy.stats is a
+    second of imports): the same bits as scipy.stats' rankdata and t.sf, ties and NaN included."""
+    rng = np.random.default_rng(7)
+    for trial in range(200):
+        n = int(rng.integers(3, 120))
+        values = rng.integers(0, 4, n).astype(float) if trial % 2 else rng.standard_normal(n)
+        values[rng.random(n) < 0.15] = np.nan
+        expected = stats.rankdata(np.where(np.isnan(values), np.inf, values))
+        assert np.array_equal(sensitivity._ranks(values), expected)
+        t, freedom = float(rng.standard_normal() * 10 ** rng.uniform(-3, 2)), int(rng.integers(1, 300))
+        assert sensitivity._two_sided_p(t, freedom) == float(2 * stats.t.sf(abs(t), freedom))
+
+
 def test_sensitivity_of_too_few_runs_is_empty_not_wrong():
     runs = pd.DataFrame({"a": [1.0, 2.0, 3.0], "b": [3.0, 1.0, 2.0], "rms_Fx_max_N": [1.0, 2.0, 3.0]})
     table = sensitivity.sensitivity(runs, ["a", "b"])
