@@ -613,11 +613,12 @@ def _bounds(prior: Soil, given: Mapping[str, tuple[float, float]] | None) -> dic
 
 
 def _t_quantile(probability: float, dof: float) -> float:
-    """Student's t quantile (scipy.stats imported here: a quarter of a second that the commands
-    which only import this module, every closed-loop one through the adaptive controller, skip)."""
-    from scipy import stats
+    """Student's t quantile: scipy.stats.t.ppf's bits from scipy.special's stdtrit, which it calls
+    (scipy.stats is a second of imports, paid again by every worker process of a Monte Carlo that
+    estimates soils); NaN for dof <= 0 as there."""
+    from scipy.special import stdtrit
 
-    return float(stats.t.ppf(probability, dof))
+    return float(stdtrit(dof, probability)) if dof > 0 else math.nan
 
 
 def _fit(problem: _Problem, z: NDArray[np.float64], low: NDArray[np.float64],

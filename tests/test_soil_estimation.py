@@ -324,3 +324,19 @@ def test_the_command_lines_channel_names_are_the_readers():
     from rover_cosim.identification.testbed_data import CHANNELS
 
     assert CHANNEL_NAMES == tuple(CHANNELS)
+
+
+def test_the_intervals_t_quantile_is_scipy_stats_bit_for_bit():
+    """The confidence intervals' Student's t quantile comes from scipy.special (scipy.stats is a
+    second of imports in every Monte Carlo worker): the same bits as scipy.stats.t.ppf, NaN where
+    it gives NaN (no degrees of freedom)."""
+    from scipy import stats
+
+    from rover_cosim.identification.soil_estimation import _t_quantile
+
+    rng = np.random.default_rng(3)
+    cases = [(0.975, dof) for dof in (0.0, -1.0, 0.5, 1.0, 2.0, 3.7, 10.0, 1e6, math.inf)]
+    cases += [(float(rng.uniform(0.5, 1.0)), float(rng.uniform(0.0, 500.0))) for _ in range(500)]
+    for probability, dof in cases:
+        ours, theirs = _t_quantile(probability, dof), float(stats.t.ppf(probability, dof))
+        assert ours == theirs or (math.isnan(ours) and math.isnan(theirs)), (probability, dof)
