@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "core.h"
+#include "finite.h"
 
 #define DEFAULT_RTOL 1e-6
 #define DEFAULT_MAX_STEP 0.0
@@ -116,10 +117,6 @@ void rc_forget_evaluation(Instance *c) {
     c->gain_valid = 0;
 }
 
-static int all_finite(const double *v, int n) {
-    for (int i = 0; i < n; i++) if (!isfinite(v[i])) return 0;
-    return 1;
-}
 
 static int rhs(void *ctx, double t, const double *x, double *xdot) {
     Instance *c = ctx;
@@ -165,7 +162,7 @@ static int input_columns(Instance *c, double t, const double *x) {
         c->eval.evaluations++;
         int failed = model_evaluate(c->arg, c->res, c->iw, c->w, 0);
         c->u_fd[j] = held;
-        if (failed || !all_finite(c->fd_xdot, nx)) return -1;
+        if (failed || !rc_all_finite(c->fd_xdot, nx)) return -1;
         double *column = c->dfdu + (size_t)nx * j;
         for (int i = 0; i < nx; i++) column[i] = (c->fd_xdot[i] - base[i]) / delta;
         c->dfdu_valid[j] = 1.0;
@@ -202,7 +199,7 @@ static Status initial_states(Instance *c, int f) {
     double *x0 = c->sens_x; /* scratch of size nx */
     c->arg[0] = c->p;
     c->res[0] = x0;
-    if (model_initial(c->arg, c->res, c->iw, c->w, 0) || !all_finite(x0, model_info.nx))
+    if (model_initial(c->arg, c->res, c->iw, c->w, 0) || !rc_all_finite(x0, model_info.nx))
         return rc_fail(c, f, BROKEN, "the start values of the states are not finite for these parameters");
     for (int i = 0; i < model_info.nx; i++)
         if (model_info.x_start_calculated[i] && !c->x_set[i]) c->x[i] = x0[i];
@@ -263,11 +260,11 @@ Status rc_update(Instance *c, int f, int need_xdot, int need_y) {
         }
         Status checked = failed ? STATUS_OK : check_asserts(c, f);
         if (checked == STATUS_ERROR) return STATUS_ERROR;
-        if (failed || !all_finite(c->y, model_info.ny))
+        if (failed || !rc_all_finite(c->y, model_info.ny))
             return rc_fail(c, f, BROKEN, "the outputs are not finite at t = %.17g", c->t);
         /* After the outputs: a parameter out of range is reported by its assert, not as a
          * non-finite derivative. */
-        if (need_xdot && !all_finite(c->xdot, model_info.nx))
+        if (need_xdot && !rc_all_finite(c->xdot, model_info.nx))
             return rc_fail(c, f, BROKEN, "the derivatives are not finite at t = %.17g", c->t);
         c->y_valid = 1;
         c->xdot_valid = 1;
@@ -528,7 +525,7 @@ static int input_gain(Instance *c) {
     double t = c->t;
     c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->m;
     c->res[0] = c->gain;
-    if (model_input_gain(c->arg, c->res, c->iw, c->w, 0) || !all_finite(c->gain, model_info.nx * model_info.nu))
+    if (model_input_gain(c->arg, c->res, c->iw, c->w, 0) || !rc_all_finite(c->gain, model_info.nx * model_info.nu))
         return -1;
     c->gain_valid = 1;
     return 0;
@@ -636,8 +633,8 @@ Status rc_directional(Instance *c, int f, const unsigned int vUnknown_ref[], siz
     c->arg[0] = &t; c->arg[1] = c->x; c->arg[2] = c->u; c->arg[3] = c->p; c->arg[4] = c->m;
     c->arg[5] = c->seed_x; c->arg[6] = c->seed_u;
     c->res[0] = c->sens_x; c->res[1] = c->sens_y;
-    if (model_directional(c->arg, c->res, c->iw, c->w, 0) || !all_finite(c->sens_x, model_info.nx) ||
-        !all_finite(c->sens_y, model_info.ny))
+    if (model_directional(c->arg, c->res, c->iw, c->w, 0) || !rc_all_finite(c->sens_x, model_info.nx) ||
+        !rc_all_finite(c->sens_y, model_info.ny))
         return rc_fail(c, F, BROKEN, "the directional derivative is not finite at t = %.17g", c->t);
     for (size_t k = 0; k < nUnknown; k++) {
         int r = real_index(vUnknown_ref[k]);
