@@ -15,7 +15,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pytest
-from scipy import stats
 
 from rover_cosim.jobs import simulate
 from rover_cosim.jobs.montecarlo import metrics, run_montecarlo, sensitivity
@@ -104,6 +103,8 @@ def test_sample_zero_is_the_nominal_and_more_runs_keep_the_first_samples():
 
 
 def test_bounds_are_honoured_and_the_marginals_are_right():
+    from scipy import stats  # here: a second of imports that every test worker's collection would pay
+
     values = draw(_study(seed=7), 20000)
     c, phi, kc = values.T
     assert c.min() >= 100 and c.max() <= 1000 and abs(c.mean() - 550) < 10
@@ -114,6 +115,8 @@ def test_bounds_are_honoured_and_the_marginals_are_right():
 
 
 def test_the_requested_correlation_is_honoured():
+    from scipy import stats
+
     rho = 0.6
     study = _study(correlation={"parameters": ["soil.c", "soil.kc"], "matrix": [[1.0, rho], [rho, 1.0]]})
     values = draw(study, 20000)
@@ -190,6 +193,8 @@ def test_sensitivity_finds_an_output_that_worsens_both_ways_from_the_nominal():
 def test_the_ranks_and_p_values_are_scipy_stats_bit_for_bit():
     """The sensitivity ranks with pandas and takes Student's t from scipy.special (scipy.stats is a
     second of imports): the same bits as scipy.stats' rankdata and t.sf, ties and NaN included."""
+    from scipy import stats
+
     rng = np.random.default_rng(7)
     for trial in range(200):
         n = int(rng.integers(3, 120))
