@@ -23,9 +23,14 @@ DISTRIBUTIONS = ("rms_Fx_max_N", "time_to_98_s", "position_lag_m", "max_slip")
 
 
 def _ecdf(ax, values: np.ndarray, label: str) -> None:  # noqa: ANN001 - matplotlib Axes
+    """The share of ``values`` at or below x: 0 up to the smallest, a step of 1/n at each value
+    (NaN, never, counts in n: the curve then ends below 1)."""
     finite = np.sort(values[np.isfinite(values)])
-    share = np.arange(1, len(finite) + 1) / max(len(values), 1)  # NaN (never) counts in the denominator
+    share = np.arange(1, len(finite) + 1) / max(len(values), 1)
+    if finite.size:  # the rise from 0 at the smallest value: the first run is a step, not the curve's start
+        finite, share = np.r_[finite[0], finite], np.r_[0.0, share]
     ax.step(finite, share, where="post", lw=2, label=label)
+    ax.margins(x=0.05)
 
 
 def distributions(runs: pd.DataFrame, nominal: pd.Series | None) -> bytes:
