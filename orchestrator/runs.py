@@ -142,12 +142,24 @@ class TableStream:
         self.last_time: float | None = None
         self.held: list[Table] = []   # chunks the disk refused, and every one after them
         self.failure: OSError | None = None
+        # the chunks are formatted and written by one thread of their own, in order, while the run
+        # goes on (pyarrow formats without the GIL); only that thread touches the file until _join
+        self._writing: Any = None
+        self._written: list[Any] = []  # the futures of the chunks handed to it
 
     def __call__(self, table: Table) -> None:
         if not len(table):
             return
         self.rows += len(table)
         self.last_time = float(table.columns[0][-1])
+        if self._writing is None:
+            from concurrent.futures import ThreadPoolExecutor
+
+            self._writing = ThreadPoolExecutor(max_workers=1, thread_name_prefix="rover-cosim-rows")
+        self._written.append(self._writing.submit(self._keep, table))
+
+    def _keep(self, table: Table) -> None:
+        """In the writing thread: the chunk written, or held (the disk refused it or one before)."""
         if self.failure is None:
             try:
                 self._write(table)
@@ -155,6 +167,15 @@ class TableStream:
             except OSError as error:
                 self.failure = error
         self.held.append(table)
+
+    def _join(self) -> None:
+        """Wait for the chunks handed over so far (a formatting error is raised here)."""
+        if self._writing is not None:
+            self._writing.shutdown(wait=True)
+            self._writing = None
+        futures, self._written = self._written, []
+        for future in futures:
+            future.result()
 
     def _write(self, table: Table) -> None:
         import pyarrow as pa
@@ -180,6 +201,7 @@ class TableStream:
 
     def _close(self) -> dict[Path, bytes]:
         """Close the file; what must still be written as bytes (nothing, unless the disk refused)."""
+        self._join()
         try:
             if self.writer is not None:
                 self.writer.close()
@@ -218,6 +240,12 @@ class TableStream:
 
     def discard(self) -> None:
         """Remove the temporary file (a run that wrote nothing to keep)."""
+        try:
+            self._join()
+        finally:
+            self._discard()
+
+    def _discard(self) -> None:
         try:
             self.stream.close()
         except OSError:
