@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import threading
 
 import numpy as np
 import pandas as pd
@@ -72,6 +73,21 @@ def test_only_a_large_message_travels_through_shared_memory():
     from multiprocessing.reduction import recv_handle
 
     os.close(recv_handle(parent))
+
+
+def test_a_shared_file_the_system_refuses_sends_the_message_through_the_pipe(monkeypatch):
+    def refused(*arguments: object) -> int:
+        raise OSError(12, "Cannot allocate memory")
+
+    monkeypatch.setattr(os, "pwrite", refused)
+    parent, child = multiprocessing.Pipe()
+    sender = threading.Thread(target=handoff.send, args=(child, _table(20_000, 2)))  # 6.4 MB: more than
+    sender.start()  # the socket holds, so it is read while it is sent
+    assert parent.poll(10), "nothing arrived: the sender gave up instead of using the pipe"
+    name, table, matrix = parent.recv()  # the message itself, not a shared file's layout
+    sender.join(10)
+    expected = _table(20_000, 2)
+    assert name == expected[0] and table.equals(expected[1]) and np.array_equal(matrix, expected[2])
 
 
 def test_a_sender_that_dies_between_the_message_and_its_file_is_an_end_of_file():

@@ -44,19 +44,33 @@ def send(conn: Any, message: Any) -> None:
     for view in views:
         layout.append((offset, view.nbytes))
         offset += -(-view.nbytes // ALIGNMENT) * ALIGNMENT
-    descriptor = os.memfd_create("rover-cosim-result", os.MFD_CLOEXEC)
     try:
-        os.ftruncate(descriptor, max(offset, 1))
-        for view, (start, size) in zip(views, layout):
-            written = 0
-            while written < size:
-                written += os.pwrite(descriptor, view[written:], start + written)
+        descriptor = _shared_file(views, layout, offset)
+    except OSError:  # no memory for it (a container's limit): through the pipe after all
+        conn.send(message)
+        return
+    try:
         conn.send((_SHARED, payload, layout))
         from multiprocessing.reduction import send_handle
 
         send_handle(conn, descriptor, os.getppid())
     finally:
         os.close(descriptor)
+
+
+def _shared_file(views: list[memoryview], layout: list[tuple[int, int]], size: int) -> int:
+    """An anonymous shared file of ``size`` bytes holding each view at its offset: its descriptor."""
+    descriptor = os.memfd_create("rover-cosim-result", os.MFD_CLOEXEC)
+    try:
+        os.ftruncate(descriptor, max(size, 1))
+        for view, (start, length) in zip(views, layout):
+            written = 0
+            while written < length:
+                written += os.pwrite(descriptor, view[written:], start + written)
+    except OSError:
+        os.close(descriptor)
+        raise
+    return descriptor
 
 
 def receive(conn: Any) -> Any:
