@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import pickle
 import threading
 
 import numpy as np
@@ -55,20 +56,21 @@ def test_a_message_arrives_equal_and_writable_either_way(rows):
     assert table.iloc[0, 0] == 1.5
 
 
-def test_only_a_large_message_travels_through_shared_memory():
-    sent: list[object] = []
+def test_only_large_arrays_travel_through_shared_memory():
+    sent: list[bytes] = []
 
     class Recorder:
-        def send(self, message: object) -> None:
-            sent.append(message)
+        def send_bytes(self, payload: bytes) -> None:
+            sent.append(payload)
 
-    handoff.send(Recorder(), _table(100, 1))  # 32 kB of arrays: the message itself
-    assert isinstance(sent[0], tuple) and sent[0][0] == "run 1"
+    handoff.send(Recorder(), _table(100, 1))  # 32 kB of arrays: the message, pickled once
+    name, table, _ = pickle.loads(sent[0])
+    assert name == "run 1" and table.equals(_table(100, 1)[1])
     parent, child = multiprocessing.Pipe()
     handoff.send(child, _table(20_000, 1))  # 6.4 MB: a shared file's layout, then its descriptor
     kind, payload, layout = parent.recv()
     assert kind == handoff._SHARED and len(payload) < 100_000
-    assert sum(size for _, size in layout) >= handoff.SHARED_MIN_BYTES
+    assert layout and all(size >= handoff.LARGE for _, size in layout)
     assert all(start % handoff.ALIGNMENT == 0 for start, _ in layout)
     from multiprocessing.reduction import recv_handle
 

@@ -117,7 +117,6 @@ void rc_forget_evaluation(Instance *c) {
     c->gain_valid = 0;
 }
 
-
 static int rhs(void *ctx, double t, const double *x, double *xdot) {
     Instance *c = ctx;
     if (evaluate(c, t, x)) return -1;

@@ -2,13 +2,14 @@
 
 A run's result carries its recorded columns: 17-42 MB for a leg-wheel run. Pickled into the pipe
 they were copied four times (pickled, written, read, unpickled), about 0.15 s a run on each side.
-Here the message is pickled with protocol 5, its arrays left out of band; when they come to
-``SHARED_MIN_BYTES`` or more they are written once into an anonymous shared file (Linux
-``memfd_create``), whose descriptor follows the message over the pipe (a Unix socket pair), and
-the parent maps that file copy-on-write: its arrays are the file's pages, writable, freed with
-the last array that uses them. Nothing has a name, so nothing is left behind by a process that
-dies half-way. Elsewhere (no ``memfd_create``), or for smaller messages, the message goes
-through the pipe as before. The parent gets the same objects either way, bit for bit.
+Here the message is pickled once, with protocol 5: its arrays of ``LARGE`` bytes or more are left
+out of band and written once into an anonymous shared file (Linux ``memfd_create``), whose
+descriptor follows the message over the pipe (a Unix socket pair), and the parent maps that file
+copy-on-write: its arrays are the file's pages, writable, freed with the last array that uses
+them. Nothing has a name, so nothing is left behind by a process that dies half-way. A message
+without large arrays goes through the pipe as that one pickle; elsewhere (no ``memfd_create``),
+or where the system refuses the file, the message goes through the pipe as before. The parent gets
+the same objects either way, bit for bit.
 """
 
 from __future__ import annotations
@@ -18,34 +19,41 @@ import os
 import pickle
 from typing import Any
 
-#: bytes: messages whose out-of-band arrays come to less go through the pipe.
-SHARED_MIN_BYTES = 1 << 20
+#: bytes: an array this large or larger travels in the shared file, a smaller one in the pickle.
+LARGE = 1 << 16
 #: bytes: each array starts at a multiple of this in the shared file (numpy's alignment).
 ALIGNMENT = 64
 _SHARED = "rover-cosim shared result"
 
 
 def send(conn: Any, message: Any) -> None:
-    """``conn.send(message)``; a message with ``SHARED_MIN_BYTES`` of arrays or more through an
-    anonymous shared file (``conn`` a Unix socket pair's end: ``multiprocessing.Pipe()``)."""
+    """``conn.send(message)``, its arrays of ``LARGE`` bytes or more through an anonymous shared
+    file (``conn`` a Unix socket pair's end: ``multiprocessing.Pipe()``)."""
     if not hasattr(os, "memfd_create"):
         conn.send(message)
         return
-    buffers: list[pickle.PickleBuffer] = []
-    payload = pickle.dumps(message, protocol=5, buffer_callback=buffers.append)
-    try:
-        views = [buffer.raw() for buffer in buffers]
-    except BufferError:  # an array neither C- nor Fortran-contiguous: pickled in band
-        views = []
-    if not views or sum(view.nbytes for view in views) < SHARED_MIN_BYTES:
-        conn.send(message)
+    large: list[memoryview] = []
+
+    def in_band(buffer: pickle.PickleBuffer) -> bool:
+        try:
+            view = buffer.raw()
+        except BufferError:  # neither C- nor Fortran-contiguous
+            return True
+        if view.nbytes < LARGE:
+            return True
+        large.append(view)
+        return False
+
+    payload = pickle.dumps(message, protocol=5, buffer_callback=in_band)
+    if not large:  # the whole message is in the pickle, which conn.recv() reads as its own
+        conn.send_bytes(payload)
         return
     layout, offset = [], 0
-    for view in views:
+    for view in large:
         layout.append((offset, view.nbytes))
         offset += -(-view.nbytes // ALIGNMENT) * ALIGNMENT
     try:
-        descriptor = _shared_file(views, layout, offset)
+        descriptor = _shared_file(large, layout, offset)
     except OSError:  # no memory for it (a container's limit): through the pipe after all
         conn.send(message)
         return
