@@ -87,6 +87,20 @@ def test_shear_stays_within_the_mohr_coulomb_strength_of_the_patch():
     assert (np.abs(forces.Tx) <= WHEEL.r * strength * (1 + 1e-9)).all()
 
 
+def test_an_anchored_wheel_holds_more_than_a_rolling_wheel_pulls():
+    """Push-roll's margin in this contact (the leg-wheel design page): a braked wheel that the limbs
+    hold still is held by the soil up to the patch's Mohr-Coulomb strength, and dragged back it takes
+    the mirrored skid's force, more than a rolling wheel pulls at any slip, which compaction costs."""
+    load = np.array(LOADS)
+    rolling = np.array([wheel_forces(load, 0.3 / (1 - slip) / WHEEL.r, 0.3).Fx  # at 0.3 m/s
+                        for slip in (0.5, 0.9, 0.999)]).max(axis=0)
+    dragged = wheel_forces(load, 0.0, -0.01).Fx   # braked, pushed back at 1 cm/s: the mirrored skid
+    holding = wheel_forces(load, 0.0, -REGIMES.v_stick)  # braked, creeping: the static regime
+    strength = shear_strength(load, holding.sinkage, WHEEL, SOIL)
+    assert (rolling > 0).all() and (dragged > rolling).all()
+    assert (strength > rolling).all() and (holding.Fx > 0).all() and (holding.Fx <= strength).all()
+
+
 def test_steady_weight_blends_from_rest_to_rolling():
     w = steady_weight([0.0, 0.25e-3, 1e-3, 1.0, -1.0], 1e-3)
     np.testing.assert_allclose(w, [0.0, 0.4375, 1.0, 1.0, 1.0])
