@@ -66,19 +66,18 @@ int controller_get_real(void *component, const unsigned int *vr, size_t n, doubl
     return OK;
 }
 
-int controller_do_step(void *component, double t, double h, int no_prior_state) {
-    Controller *c = component;
-    (void)no_prior_state;
-    if (law_step_allowed(c->message, h, c->settings[STEP]) != OK) return ERROR;
-    return outputs(c, t + h, 1, h);
-}
-
-/* The step's outputs at ``t`` itself (not t + h): what the Python block computes when a block
- * built on it steps the law from its own step (the adaptive controller's calibration), bit for bit. */
+/* The step of ``h`` [s] whose outputs are those at ``t`` itself: what the Python block computes when
+ * a block built on it steps the law from its own step (the adaptive controller's calibration), bit
+ * for bit; the engine's step from t is the one at t + h. */
 int controller_step_at(void *component, double t, double h) {
     Controller *c = component;
     if (law_step_allowed(c->message, h, c->settings[STEP]) != OK) return ERROR;
     return outputs(c, t, 1, h);
+}
+
+int controller_do_step(void *component, double t, double h, int no_prior_state) {
+    (void)no_prior_state;
+    return controller_step_at(component, t + h, h);
 }
 
 /* The filter's state (per wheel slip_f, slip_f' [1/s]) out of and into ``filter`` (2 x wheels):

@@ -138,8 +138,7 @@ def fingerprint(fmu_hashes: dict[str, str], model_hash: str, nominal: Choice) ->
 
 def plant(spec: RunSpec) -> System:
     """The run's system: the scenario's plant and controller on the sample's soil, wheel and parameters."""
-    system = RUN_SCENARIOS[spec.scenario].system(Path(spec.fmu_dir), spec.model, spec.choice(), spec.calibration,
-                                                 None)  # an adaptive run's sweep: in memory (its soil is its own)
+    system = RUN_SCENARIOS[spec.scenario].system(Path(spec.fmu_dir), spec.model, spec.choice(), spec.calibration)
     builder = SystemBuilder.from_system(system, f"Monte Carlo sample {spec.sample} ({spec.scenario})")
     builder.simulation(stop_time=spec.stop_time).set_parameters("rover", dict(spec.parameters))
     return builder.build()

@@ -49,20 +49,20 @@ class RunScenario:
 
         return path_stop_time or path_following.stop_time(PATH_SCENARIO)
 
-    def system(self, fmu_dir: Path, model: ModelSet, choice: Choice, calibration: Calibration,
-               cache: Path | None) -> System:
+    def system(self, fmu_dir: Path, model: ModelSet, choice: Choice, calibration: Calibration) -> System:
         """The run's system before the sample's FMU parameters: the plant of ``fmu_dir`` and the
         controller with ``model`` on the sample's soil and wheel (``choice``); an adaptive one with
-        ``calibration``, its sweeps cached in ``cache`` (None: in memory)."""
+        ``calibration``, its sweeps' runs kept in memory (the soil is the run's own estimate, which
+        no other run shares)."""
         from rover_cosim.jobs import path_following, simulate
 
         if self.straight and self.adapted_from:
-            return simulate.adaptive_system(fmu_dir, model, choice, calibration=calibration, cache_dir=cache)
+            return simulate.adaptive_system(fmu_dir, model, choice, calibration=calibration, cache_dir=None)
         if self.straight:
             return simulate.monolithic_system(fmu_dir, model, choice)
         if self.adapted_from:
             return path_following.adaptive_system(fmu_dir, model, PATH_SCENARIO, choice, calibration=calibration,
-                                                  cache_dir=cache)
+                                                  cache_dir=None)
         return path_following.monolithic_system(fmu_dir, model, PATH_SCENARIO, "inverse", choice)
 
     def metrics(self, data: pd.DataFrame, window: float) -> dict[str, Any]:
