@@ -32,7 +32,7 @@ from typing import Any
 
 from rover_cosim.common.scratch import cache_folder
 
-from . import catalog, codegen, description, description3, ode, prefix, source
+from . import catalog, codegen, description, description3, objects, ode, prefix, source
 from .artifact import (
     BUILD_RECORD,
     CFLAGS,
@@ -58,6 +58,8 @@ FMU_MODELS = fmu_models()
 
 FMI_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 FMI3_HEADERS = ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")
+#: The C files the FMUs of one build_all share the objects of: the runtime's (fmubuild.objects).
+SHARED_FILES = frozenset(f for f in (*RUNTIME_FILES, *RUNTIME_FILES_3) if f.endswith(".c"))
 
 #: The FMI versions build_fmu writes: their runtime API layer and standard headers.
 FMI_VERSIONS = {2: (RUNTIME_FILES, FMI_HEADERS), 3: (RUNTIME_FILES_3, FMI3_HEADERS)}
@@ -196,18 +198,20 @@ def platforms_digest(name: str, chosen: Sequence[Target]) -> str:
     return hashlib.sha256((input_digest(name) + json.dumps(key)).encode()).hexdigest()
 
 
-def _compile(name: str, target: Target, sources: Path, c_files: list[str], work: Path) -> tuple[Path, float]:
-    """Compile ``c_files`` into ``work``/<folder>/<name><suffix>; returns the library and the seconds."""
-    started = time.perf_counter()
+def _compile(name: str, target: Target, sources: Path, work: Path, jobs: int,
+             shared: objects.SharedObjects | None) -> tuple[Path, float]:
+    """Compile the C files of ``sources`` into ``work``/<folder>/<name><suffix>, ``jobs`` compilers
+    at a time; returns the library and the seconds."""
     out = work / target.folder
     out.mkdir(parents=True)
     library = out / f"{name}{target.suffix}"
-    command = [*target.command, *target.flags, "-I", str(sources), *c_files, "-o", str(library), *target.libraries]
-    result = subprocess.run(command, capture_output=True, text=True, check=False, cwd=out)
-    if result.returncode != 0 or not library.is_file():
-        raise RuntimeError(f"{name}: the C compiler failed for {target.folder} ({target.compiler}, exit "
-                           f"{result.returncode}):\n" + result.stderr[-4000:])
-    return library, time.perf_counter() - started
+    toolchain = objects.Toolchain(target.command, target.flags, target.libraries, target.compiler)
+    try:
+        seconds = objects.compile_library(toolchain, sources, library, jobs, shared)
+    except objects.CompileError as error:
+        raise RuntimeError(f"{name}: {error.what} for {target.folder} ({target.compiler}, exit {error.returncode}):"
+                           f"\n{error.output}") from None
+    return library, seconds
 
 
 #: A build's progress: called with the FMU's name and the stage just finished ("translate",
@@ -221,15 +225,18 @@ def steps_of(platforms: Sequence[str]) -> int:
 
 
 def compile_targets(name: str, chosen: Sequence[Target], sources: Path, binaries: Path, work: Path,
-                    jobs: int | None = None, step: StepReport | None = None) -> dict[str, float]:
-    """Compile the sources for every target, ``jobs`` compilers at a time (default: one per CPU),
-    into ``binaries``/<folder>/; returns the seconds per folder. The first failure is raised after
-    the other compilers finished. ``step`` hears of each compiler that finished."""
-    c_files = sorted(str(sources / f.name) for f in sources.iterdir() if f.suffix == ".c")
-    workers = max(1, min(jobs or os.cpu_count() or 1, len(chosen)))
+                    jobs: int | None = None, step: StepReport | None = None,
+                    shared: objects.SharedObjects | None = None) -> dict[str, float]:
+    """Compile the sources for every target, ``jobs`` compilers at a time (default: one per CPU;
+    the targets in parallel, and each target's files), into ``binaries``/<folder>/; returns the
+    seconds per folder. The first failure is raised after the other compilers finished. ``step``
+    hears of each target that finished; ``shared``: the runtime's objects shared with the other
+    FMUs of a build (:mod:`fmubuild.objects`)."""
+    jobs = max(1, jobs or os.cpu_count() or 1)
+    workers = min(jobs, len(chosen))
 
     def compile_one(target: Target) -> tuple[Path, float]:
-        done = _compile(name, target, sources, c_files, work)
+        done = _compile(name, target, sources, work, max(1, jobs // workers), shared)
         if step:
             step(name, f"compile {target.folder}")
         return done
@@ -268,7 +275,8 @@ def _one_build_at_a_time(lock: Path) -> Iterator[None]:
 
 def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Sequence[str] = (HOST,),
               compile_jobs: int | None = None, step: StepReport | None = None, fmi_version: int = 2,
-              axles: int | None = None, elementary: str = ELEMENTARY_DEFAULT) -> BuildResult:
+              axles: int | None = None, elementary: str = ELEMENTARY_DEFAULT,
+              shared_objects: objects.SharedObjects | None = None) -> BuildResult:
     """Build ``out_dir/<name>.fmu`` with the built-in backend (skipped when up to date) with binaries
     for ``platforms`` (``host``: this machine's, by its C compiler; other names: cross-compiled by
     zig, see :mod:`fmubuild.platforms`), ``compile_jobs`` compilers at a time; ``step`` hears of
@@ -276,17 +284,19 @@ def build_fmu(name: str, out_dir: Path, *, force: bool = False, platforms: Seque
     FMI 3.0 layer, the FMI 3.0 model description and platform folders). ``axles``: a rover FMU
     built for that many wheels per side (:func:`source.variant_source`; None: the package's own).
     ``elementary``: ``libm`` (the C library's exp, log, sin, ...) or ``own`` (runtime/elementary.h's:
-    the same bits on every host; :mod:`fmubuild.elementary`). One process at a time builds a given
-    FMU into a given folder (``_one_build_at_a_time``)."""
+    the same bits on every host; :mod:`fmubuild.elementary`). ``shared_objects``: the runtime's
+    objects shared with the other FMUs of a build (:mod:`fmubuild.objects`). One process at a time
+    builds a given FMU into a given folder (``_one_build_at_a_time``)."""
     folder = hashlib.sha256(str(Path(out_dir).resolve()).encode()).hexdigest()[:16]
     with _one_build_at_a_time(Path(tempfile.gettempdir()) / "rover-cosim-build-locks" / f"{folder}-{name}.lock"):
         return _build_fmu(name, Path(out_dir), force=force, platforms=platforms, compile_jobs=compile_jobs,
                           step=step, fmi_version=fmi_version, axles=axles,
-                          elementary=check_elementary(elementary))
+                          elementary=check_elementary(elementary), shared=shared_objects)
 
 
 def _build_fmu(name: str, out_dir: Path, *, force: bool, platforms: Sequence[str], compile_jobs: int | None,
-               step: StepReport | None, fmi_version: int, axles: int | None, elementary: str) -> BuildResult:
+               step: StepReport | None, fmi_version: int, axles: int | None, elementary: str,
+               shared: objects.SharedObjects | None) -> BuildResult:
     """build_fmu, the lock held."""
     _check_version(fmi_version)
     if axles is not None:
@@ -321,7 +331,8 @@ def _build_fmu(name: str, out_dir: Path, *, force: bool, platforms: Sequence[str
             step(name, "generate")
 
         t0 = time.perf_counter()
-        seconds = compile_targets(name, chosen, sources, root / "binaries", tmp / "compile", compile_jobs, step)
+        seconds = compile_targets(name, chosen, sources, root / "binaries", tmp / "compile", compile_jobs, step,
+                                  shared)
         if fmi_version == 3:  # the FMI 3.0 platform tuples (x86_64-linux, ...) name the folders
             for folder in seconds:
                 (root / "binaries" / folder).rename(root / "binaries" / fmi3_folder(folder))
@@ -411,14 +422,31 @@ def fmi3_folder(folder: str) -> str:
     return PLATFORMS[folder].fmi3 if folder in PLATFORMS else folder
 
 
-def _build_one(args: tuple[str, Path, bool, str, tuple[str, ...], int, Any, int, str]) -> BuildResult:
-    """One FMU (in a pool's worker): its stages go to ``steps`` (a queue of the parent's, or None)."""
-    name, out_dir, force, backend, platforms, compile_jobs, steps, fmi_version, elementary = args
-    if backend == "omc":
-        return build_fmu_omc(name, out_dir, force=force)
+@dataclass(frozen=True)
+class _BuildTask:
+    """One FMU of build_all, as a pool's worker gets it."""
+
+    name: str
+    out_dir: Path
+    force: bool
+    backend: str
+    platforms: tuple[str, ...]
+    compile_jobs: int
+    steps: Any          # a queue of the parent's (or _LocalSteps), or None
+    fmi_version: int
+    elementary: str
+    shared: objects.SharedObjects | None
+
+
+def _build_one(task: _BuildTask) -> BuildResult:
+    """One FMU (in a pool's worker): its stages go to ``task.steps``."""
+    if task.backend == "omc":
+        return build_fmu_omc(task.name, task.out_dir, force=task.force)
+    steps = task.steps
     step = (lambda fmu, stage: steps.put((fmu, stage))) if steps is not None else None
-    return build_fmu(name, out_dir, force=force, platforms=platforms, compile_jobs=compile_jobs, step=step,
-                     fmi_version=fmi_version, elementary=elementary)
+    return build_fmu(task.name, task.out_dir, force=task.force, platforms=task.platforms,
+                     compile_jobs=task.compile_jobs, step=step, fmi_version=task.fmi_version,
+                     elementary=task.elementary, shared_objects=task.shared)
 
 
 class _LocalSteps:
@@ -538,26 +566,29 @@ def build_all(names: Sequence[str] = FMU_MODELS, out_dir: Path = Path("fmus"), *
     compile_jobs = max(1, cpus // jobs)
     results: list[BuildResult] = []
     errors: list[BaseException] = []
-    if jobs == 1:
-        local = _LocalSteps(step) if step else None
-        tasks = [(n, Path(out_dir), force, backend, platforms, compile_jobs, local, fmi_version, elementary)
-                 for n in names]
-        for task in tasks:
-            try:
-                results.append(_build_one(task))
-                if report:
-                    report(results[-1])
-            except Exception as error:  # noqa: BLE001 - reported after the others
-                errors.append(error)
-    else:
-        # "spawn": a forked worker can deadlock on the locks of threads (rumoca's) in the parent.
-        context = multiprocessing.get_context("spawn")
-        with ExitStack() as stack:
+    with ExitStack() as stack:
+        folder = stack.enter_context(tempfile.TemporaryDirectory(prefix="fmubuild-objects-"))
+        shared = objects.SharedObjects(Path(folder), SHARED_FILES)
+
+        def task(name: str, steps: Any) -> _BuildTask:
+            return _BuildTask(name, Path(out_dir), force, backend, platforms, compile_jobs, steps, fmi_version,
+                              elementary, shared)
+
+        if jobs == 1:
+            local = _LocalSteps(step) if step else None
+            for name in names:
+                try:
+                    results.append(_build_one(task(name, local)))
+                    if report:
+                        report(results[-1])
+                except Exception as error:  # noqa: BLE001 - reported after the others
+                    errors.append(error)
+        else:
+            # "spawn": a forked worker can deadlock on the locks of threads (rumoca's) in the parent.
+            context = multiprocessing.get_context("spawn")
             steps = _forward_steps(stack, context, step) if step else None
             pool = stack.enter_context(ProcessPoolExecutor(max_workers=jobs, mp_context=context))
-            futures = {n: pool.submit(_build_one, (n, Path(out_dir), force, backend, platforms, compile_jobs,
-                                                   steps, fmi_version, elementary))
-                       for n in build_order(names, _build_seconds())}
+            futures = {n: pool.submit(_build_one, task(n, steps)) for n in build_order(names, _build_seconds())}
             for future in (futures[n] for n in names):  # reported in the order asked
                 try:
                     results.append(future.result())
