@@ -11,14 +11,16 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from . import catalog
 from .catalog import FMU_PACKAGE as FMU_PACKAGE  # noqa: F401 - the package's names, read here too (catalog owns them)
 from .catalog import MODELICA_ROOT as MODELICA_ROOT  # noqa: F401
 from .catalog import PACKAGE as PACKAGE  # noqa: F401
 from .catalog import fmu_class as fmu_class  # noqa: F401
+
+if TYPE_CHECKING:  # pandas only for the annotation: an FMU's build never imports it
+    import pandas as pd
 
 
 def package_file() -> Path:
