@@ -172,6 +172,7 @@ bench: $(BENCH_STAMP)
 	$(PY) -P benchmarks/bench_soil_estimation.py --out $(RESULTS)/bench/soil_estimation.json --markdown $(RESULTS)/bench/soil_estimation.md
 	$(PY) -P benchmarks/bench_quadrature.py --out $(RESULTS)/bench/quadrature.json --markdown $(RESULTS)/bench/quadrature.md
 	$(PY) -P benchmarks/bench_elementary.py --out $(RESULTS)/bench/elementary.json --model $(RESULTS)/identification/model.json
+	$(PY) -P benchmarks/bench_contact_limit.py --out $(RESULTS)/bench/contact_limit.json
 	$(PY) -P benchmarks/bench_closed_loop.py --out $(RESULTS)/bench/closed_loop.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_path_following.py --out $(RESULTS)/bench/path_following.json --model $(RESULTS)/identification/model.json
 	$(PY) -P benchmarks/bench_legwheel.py --out $(RESULTS)/bench/legwheel.json --model $(RESULTS)/identification/model.json
