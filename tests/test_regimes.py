@@ -135,15 +135,18 @@ def test_reference_test_bed_at_rest_stays_at_rest(load: float):
 def test_reference_free_rolling_slows_to_rest_without_turning_back():
     load = 424.0
     start = StartState(v=1.0, omega=1.0 / WHEEL.r)
-    run = run_reference_test_bed(load, TorqueProfile.step(0.0), 20.0, 0.05, start=start)
+    # stops at 12.55 s; rtol 1e-5 (the reference's 1e-7 costs the stiff approach to rest 1.6x as
+    # much): the same stop, energy never rises by more than 1e-23 J a sample, v never below -1e-12
+    run = run_reference_test_bed(load, TorqueProfile.step(0.0), 14.0, 0.05, start=start, rtol=1e-5)
     v = run["v"].to_numpy()
     assert v[-1] < 1e-3 and v.min() >= -1e-9
     assert np.diff(kinetic_energy(run, load)).max() <= 1e-9
 
 
 def test_reference_reverse_mirrors_forward_over_time():
-    ahead = run_reference_test_bed(424.0, TorqueProfile.step(30.0), 1.0, 0.01)
-    back = run_reference_test_bed(424.0, TorqueProfile.step(-30.0), 1.0, 0.01)
+    # rtol 1e-5: the mirror is exact at any tolerance (measured 0.0 at 1e-5 and at the default 1e-7)
+    ahead = run_reference_test_bed(424.0, TorqueProfile.step(30.0), 1.0, 0.01, rtol=1e-5)
+    back = run_reference_test_bed(424.0, TorqueProfile.step(-30.0), 1.0, 0.01, rtol=1e-5)
     for name in ("v", "omega", "Fx", "Tx", "slip"):
         scale = ahead[name].abs().max()
         assert np.abs(back[name] + ahead[name]).max() <= 1e-6 * scale, name
