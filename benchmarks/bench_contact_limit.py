@@ -184,7 +184,7 @@ def main() -> None:
     record = run_record("benchmarks/bench_contact_limit.py", {"nodes": NODES, "load_factors": LOAD_FACTORS,
                                                               "paper_load_N": PAPER_LOAD, "slips": SLIPS,
                                                               "rounds": args.rounds, "repeat": args.repeat})
-    record["contact_evaluation"] = measured
+    record["results"] = measured
     write_all({args.out: json_bytes(record)})
     for name, row in measured["variants"].items():
         paper = (row["scalar_ns_per_soil"]["paper"], row["vector_ns_per_soil"]["paper"])
