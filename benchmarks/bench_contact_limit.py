@@ -1,9 +1,10 @@
 """How far the wheel contact is from its arithmetic limit (issue 49, item 1): one wheel's force
 evaluation (Fx, Fz, Tx at a sinkage and slip, 10 Gauss-Legendre nodes a piece as in the FMUs)
 written node by node with the C library's sin, cos and exp (the shape of the FMUs' generated code)
-and stage by stage over all nodes with polynomial sine, cosine and exp that the compiler vectorises
-(benchmarks/contact_limit.c), compiled for the x86-64 baseline (SSE2, what the FMUs are built for)
-and for AVX2 with FMA; timed side by side in one run over the sinkages and slips of every shipped
+and stage by stage over all nodes with polynomial sine, cosine, exp and log that the compiler
+vectorises (fmubuild/runtime/contact.h, what the FMUs call since issue 49; benchmarks/contact_limit.c),
+compiled with the FMUs' flags for the x86-64 baseline (SSE2, what the FMUs are built for) and for
+AVX2 with FMA; timed side by side in one run over the sinkages and slips of every shipped
 soil at 0.25-2x the paper's wheel load, slips -0.5...0.9.
 
 Accuracy, stated with the times: the vector code's largest difference from the scalar code, and
@@ -29,15 +30,16 @@ from typing import Any
 import numpy as np
 
 from rover_cosim.common.outputs import json_bytes, run_record, write_all
+from rover_cosim.fmubuild.artifact import CFLAGS
 from rover_cosim.fmubuild.platforms import host_compiler
 from rover_cosim.terramechanics import Soil, Wheel, contact_forces, wheel_state
 from rover_cosim.terramechanics.library import build, entry, names
 
 KERNEL = Path(__file__).resolve().parent / "contact_limit.c"
+RUNTIME = Path(__file__).resolve().parents[1] / "fmubuild" / "runtime"  # contact.h
 NODES = 10  # the FMUs' Gauss-Legendre nodes per piece
-#: -fno-trapping-math: the FMUs never enable floating-point traps; it lets gcc vectorise the
-#: clamp of exp's argument (a select).
-BASE_FLAGS = ("-O3", "-fno-math-errno", "-fno-trapping-math", "-fPIC", "-shared", "-std=c99")
+#: The FMUs' flags (contact.h raises its own region to -O3 without trapping math, for gcc).
+BASE_FLAGS = tuple(CFLAGS)
 VARIANTS = {"x86-64 (SSE2)": (), "AVX2 + FMA": ("-mavx2", "-mfma")}
 PAPER_LOAD = 423.9  # N, the paper's wheel load (Table 2 rover)
 LOAD_FACTORS = (0.25, 0.5, 1.0, 1.5, 2.0)
@@ -61,7 +63,8 @@ def cases(soil: Soil, wheel: Wheel) -> tuple[np.ndarray, np.ndarray]:
 
 def compile_kernel(folder: Path, name: str, flags: tuple[str, ...]) -> ctypes.CDLL:
     library = folder / f"contact_limit_{abs(hash(name))}.so"
-    subprocess.run([host_compiler(), *BASE_FLAGS, *flags, str(KERNEL), "-o", str(library), "-lm"], check=True)
+    command = [host_compiler(), *BASE_FLAGS, "-fvisibility=default", *flags, "-I", str(RUNTIME), str(KERNEL)]
+    subprocess.run([*command, "-o", str(library), "-lm"], check=True)
     kernel = ctypes.CDLL(str(library))
     pointer = ctypes.POINTER(ctypes.c_double)
     for function in (kernel.contact_scalar, kernel.contact_vector):

@@ -16,7 +16,8 @@ from . import catalog, elementary
 RUNTIME = Path(__file__).parent / "runtime"
 #: The runtime's files in an FMU: the core (core.h, instance.c, state.c, cosim.c, ode23s) and the API
 #: layer of its FMI version.
-RUNTIME_CORE = ("model.h", "core.h", "finite.h", "ode23s.h", "ode23s.c", "instance.c", "state.c", "cosim.c")
+RUNTIME_CORE = ("model.h", "core.h", "finite.h", "contact.h", "ode23s.h", "ode23s.c", "instance.c", "state.c",
+                "cosim.c")
 RUNTIME_FILES = (*RUNTIME_CORE, "fmi2_api.c")
 RUNTIME_FILES_3 = (*RUNTIME_CORE, "fmi3_api.c")
 #: -fno-math-errno: libm calls are pure functions to the optimiser (the runtime never reads

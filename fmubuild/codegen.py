@@ -26,6 +26,7 @@ from pathlib import Path
 
 import casadi as ca
 
+from .contact import use_contact_kernel
 from .elementary import use_own_elementary
 from .guards import guard_generated_code
 from .ode import OdeModel
@@ -314,6 +315,8 @@ def write_sources(model: OdeModel, model_layout: ModelLayout, directory: Path, *
     # Each branch of a run-time if computed only when taken (fmubuild.guards).
     code, _ = guard_generated_code(generator.dump())
     code = _cold_code_at_o1(code, hot[-1].name())
+    # The contact's quadrature as vector code where the wheel allows (fmubuild.contact).
+    code = use_contact_kernel(code)
     if own_elementary:  # the same elementary functions on every host (fmubuild.elementary)
         code = use_own_elementary(code)
     digest = hashlib.sha256(code.encode())
