@@ -64,7 +64,7 @@ void contact_vector(const double *p, double h, double slip, const double *u, con
                     double *out) {
     double thetaF = acos(1 - h / p[R]), thetaR = -acos(1 - p[LAMBDA] * h / p[R]);
     rc_contact_forces(thetaF, thetaR, slip, p[C], tan(p[PHI]), p[KC], p[KPHI], p[N], p[KX], p[A0], p[A1], p[R], p[B],
-                      nodes, u, w, out);
+                      nodes, u, w, 0, out);
 }
 
 typedef void (*contact_fn)(const double *, double, double, const double *, const double *, int, double *);

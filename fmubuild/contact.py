@@ -3,15 +3,17 @@
 CasADi writes a Modelica function node by node, with a call of the C library per sine, cosine and
 exp; the contact's quadrature (``contactResidual``, the sinkage solve's residual with the forces)
 is most of a rover FMU's time. Where the generated code holds CasADi's function of
-``contactResidual`` for a straight-running wheel (``lateralAtZero`` false), this module renames it
+``contactResidual`` for a wheel whose lateral terms are computed only at a slip angle
+(``lateralAtZero`` false: the one the sinkage solve calls), this module renames it
 ``<name>_generic`` and puts a function of the old name in its place that calls
 ``runtime/contact.h``'s vector code (``rc_contact_forces``) when the wheel has no grousers,
-slip-sinkage, rut or slip angle (the paper's wheel, every wheel of the paper's runs), and the
-generic function otherwise. The entry and exit angles, tan(phi), the residual's log and the lateral
-outputs are computed as ``contactForces``/``contactResidual`` compute them, with the same
-elementary functions (``--elementary own`` renames them here too); only the quadrature's sines,
-cosines and exps are contact.h's. The derivatives (Jacobians, the sinkage's implicit derivative)
-stay CasADi's. Measured: tests/test_contact_kernel.py, benchmarks/bench_contact_limit.py.
+slip-sinkage or rut (the paper's wheel, driving straight or steered), and the generic function
+otherwise. The entry and exit angles, tan(phi), the moduli at the slip angle, Hegedus' factors, the
+residual's log and the sidewall's mobilisation are computed as ``contactForces``/
+``contactResidual`` compute them, with the same elementary functions (``--elementary own``
+renames them here too); only the quadrature's sines, cosines and exps are contact.h's. The
+derivatives (Jacobians, the sinkage's implicit derivative) stay CasADi's. Measured:
+tests/test_contact_kernel.py, benchmarks/bench_contact_limit.py.
 """
 
 from __future__ import annotations
@@ -31,8 +33,8 @@ _FUNCTION = re.compile(r"/\* contactResidual_(\d+)_0:\(([^)]*)\)->\(([^)]*)\) \*
 
 #: The inputs and outputs the replacement reads and writes, by contactResidual's names.
 INPUTS = ("logSinkage", "W", "slip", "soil_c", "soil_phi", "soil_kc", "soil_kphi", "soil_n", "soil_kx", "soil_a0",
-          "soil_a1", "soil_lam", "soil_kxBeta", "soil_ky", "soil_kyBeta", "soil_nSlip", "wheel_r", "wheel_b",
-          "wheel_grouserHeight", "WMin", "slipAngle", "rutDepth")
+          "soil_a1", "soil_lam", "soil_kxBeta", "soil_ky", "soil_kyBeta", "soil_rho", "soil_gravity", "soil_xc",
+          "soil_nSlip", "wheel_r", "wheel_b", "wheel_grouserHeight", "WMin", "slipAngle", "rutDepth")
 OUTPUTS = ("residual", "h", "Fx", "Fz", "Tx", "Fy", "FySidewall")
 
 
@@ -65,28 +67,42 @@ def _replacement(name: str, nodes: int, inputs: list[str], outputs: list[str]) -
         ("Fy", "fy"), ("FySidewall", "sidewall")))
     return f"""
 /* contactResidual_{nodes}_0 with the quadrature of runtime/contact.h (fmubuild/contact.py): the wheel
- * without grousers, slip-sinkage, rut or slip angle; CasADi's {name}_generic otherwise */
+ * without grousers, slip-sinkage or rut; CasADi's {name}_generic otherwise */
 static int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
   static const casadi_real u[{nodes}] = {{{u}}};
   static const casadi_real weights[{nodes}] = {{{w}}};
   casadi_real in[{len(inputs)}], forces[3];
   int k;
   for (k = 0; k < {len(inputs)}; k++) in[k] = arg[k] ? arg[k][0] : 0;
-  if ({v("slipAngle")} != 0 || {v("rutDepth")} != 0 || {v("soil_nSlip")} != 0 || {v("wheel_grouserHeight")} != 0
-      || !({v("logSinkage")} <= 700)) return {name}_generic(arg, res, iw, w, mem);
+  if ({v("rutDepth")} != 0 || {v("soil_nSlip")} != 0 || {v("wheel_grouserHeight")} != 0
+      || !({v("logSinkage")} <= 700) || !({v("slipAngle")} > -1.5 && {v("slipAngle")} < 1.5))
+    return {name}_generic(arg, res, iw, w, mem);
   {{
-  casadi_real r = {v("wheel_r")}, h = exp({v("logSinkage")});
-  casadi_real hc = h > 0.0 ? (h < r ? h : r) : 0.0;
+  casadi_real r = {v("wheel_r")}, slip = {v("slip")}, phi = {v("soil_phi")}, beta = {v("slipAngle")};
+  casadi_real h = exp({v("logSinkage")}), hc = h > 0.0 ? (h < r ? h : r) : 0.0;
   casadi_real thetaF = acos(1 - hc/r), thetaR = -acos(1 - {v("soil_lam")}*hc/r);
   casadi_real load = {v("W")} > {v("WMin")} ? {v("W")} : {v("WMin")};
-  casadi_real tanBeta = tan({v("slipAngle")}), ky = {v("soil_ky")} + {v("soil_kyBeta")}*0.0;
-  casadi_real sidewall, fy, residual;
-  rc_contact_forces(thetaF, thetaR, {v("slip")}, {v("soil_c")}, tan({v("soil_phi")}), {v("soil_kc")}, \
-{v("soil_kphi")}, {v("soil_n")},
-                    {v("soil_kx")}, {v("soil_a0")}, {v("soil_a1")}, r, {v("wheel_b")}, {nodes}, u, weights, forces);
+  casadi_real kx = {v("soil_kx")} + {v("soil_kxBeta")}*fabs(beta), ky = {v("soil_ky")} + {v("soil_kyBeta")}*fabs(beta);
+  casadi_real tanBeta = tan(beta), xc = {v("soil_xc")} > 0 ? {v("soil_xc")} : 0.7853981633974483 - phi/2;
+  casadi_real tanXc = tan(xc), sumFy = 0, sumPile = 0, sidewall, fy, residual;
+  RcLateral lateral;
+  lateral.tanBeta = tanBeta;
+  lateral.ky = ky;
+  lateral.d1 = 1/tanXc + tan(xc + phi);
+  lateral.d2 = 1/tanXc + tan(phi)/(tanXc*tanXc);
+  lateral.rho = {v("soil_rho")};
+  lateral.gravity = {v("soil_gravity")};
+  rc_contact_forces(thetaF, thetaR, slip, {v("soil_c")}, tan(phi), {v("soil_kc")}, {v("soil_kphi")}, {v("soil_n")}, kx,
+                    {v("soil_a0")}, {v("soil_a1")}, r, {v("wheel_b")}, {nodes}, u, weights,
+                    tanBeta != 0 ? &lateral : 0, forces);
+  if (tanBeta != 0) {{
+    sumFy = lateral.sumFy;
+    sumPile = lateral.sumPile;
+  }}
   residual = forces[1] > 0 ? log(forces[1]/load) : -1e3;
-  sidewall = -((1 - exp(-r*(1 - {v("slip")})*(thetaF - thetaR)*tanBeta/ky))*0.0);
-  fy = sidewall - r*{v("wheel_b")}*0.0;
+  sidewall = -((beta >= 0 ? 1 - exp(-r*(1 - slip)*(thetaF - thetaR)*tanBeta/ky)
+                : exp(r*(1 - slip)*(thetaF - thetaR)*tanBeta/ky) - 1)*sumPile);
+  fy = sidewall - r*{v("wheel_b")}*sumFy;
 {writes}
   }}
   (void)iw; (void)w; (void)mem;

@@ -111,11 +111,13 @@ def compile_importer(target: str, folder: Path, headers: Path) -> Path:
     return program
 
 
-def scenario(folder: Path) -> list[str]:
-    """The importer's arguments after the library: GUID, prefix, steps, step size, commands."""
+def scenario(folder: Path, extra: dict[str, float] | None = None) -> list[str]:
+    """The importer's arguments after the library: GUID, prefix, steps, step size, commands
+    (``extra``: values set besides PARAMETERS)."""
     md = fmpy.read_model_description(str(folder))
     refs = {v.name: v.valueReference for v in md.modelVariables}
-    commands = [word for name, value in PARAMETERS.items() for word in ("set", str(refs[name]), repr(value))]
+    commands = [word for name, value in (PARAMETERS | (extra or {})).items()
+                for word in ("set", str(refs[name]), repr(value))]
     commands += [word for step, name, value in CHANGES for word in ("at", str(step), str(refs[name]), repr(value))]
     commands += [word for name in OUTPUTS for word in ("out", str(refs[name]))]
     return [md.guid, "-", str(STEPS), repr(STEP_SIZE), *commands]
@@ -256,36 +258,51 @@ def wheel_own(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder
 
 
-def test_with_its_own_elementary_functions_every_host_gives_the_same_bits(wheel_own: Path, linux64_run: np.ndarray,
-                                                                          tmp_path: Path):
+#: A wheel in a rut: its contact is CasADi's node-by-node code (runtime/contact.h covers the wheel
+#: without one), where the elementary functions are called per node.
+IN_A_RUT = {"rutDepth": 0.005}
+
+
+def test_with_its_own_elementary_functions_every_host_gives_the_same_bits(wheel_all: Path, wheel_own: Path,
+                                                                          linux64_run: np.ndarray, tmp_path: Path):
     """--elementary own: linux64 (zig), the host's gcc build, aarch64 under qemu and win64 under wine
-    (whose C library rounds differently, see the test above) give equal tables; and the own
-    functions compute the same wheel as the C library's (1e-12)."""
+    (whose C library rounds differently, see the test above) give equal tables, on the paper's wheel
+    (runtime/contact.h's quadrature) and in a rut (CasADi's, with an elementary call per node); and
+    the own functions compute the same wheel as the C library's (1e-12)."""
     wine, qemu = wine_or_skip(), qemu_or_skip()
     md = json.loads((wheel_own / "documentation" / "build.json").read_text())
     assert md["elementary"] == "own" and "-elementary-own" in md["input_sha256"]
     linux = compile_importer("x86_64-linux-gnu.2.17", wheel_own, wheel_own / "sources")
-    own = run([str(linux), str(wheel_own / "binaries" / "linux64" / "Wheel.so"), *scenario(wheel_own)], wheel_own)
-    assert np.all(np.isfinite(own)) and own[-1, 1 + OUTPUTS.index("Fx")] > 100
-    np.testing.assert_allclose(own, linux64_run, rtol=1e-12, atol=1e-12)
-    # the own functions round differently from glibc's somewhere in the run
-    assert not np.array_equal(own, linux64_run)
+    linux_libm = compile_importer("x86_64-linux-gnu.2.17", wheel_all, wheel_all / "sources")
     arm = compile_importer("aarch64-linux-gnu.2.17", wheel_own, wheel_own / "sources")
-    np.testing.assert_array_equal(
-        run([qemu, "-L", str(AARCH64_SYSROOT), str(arm), str(wheel_own / "binaries" / "aarch64-linux" / "Wheel.so"),
-             *scenario(wheel_own)], wheel_own), own)
     folder = tmp_path / "win64"
     folder.mkdir()
     shutil.copy2(wheel_own / "binaries" / "win64" / "Wheel.dll", folder / "Wheel.dll")
     windows = compile_importer("x86_64-windows-gnu", folder, wheel_own / "sources")
     env = {**os.environ, "WINEPREFIX": str(tmp_path / "wineprefix"), "WINEDEBUG": "-all"}
-    np.testing.assert_array_equal(run([wine, windows.name, "Wheel.dll", *scenario(wheel_own)], folder, env), own)
+    host = None
     if platforms.host_folder() == "linux64":  # and the host's C compiler's build (gcc here, not zig)
         host = build.build_fmu("Wheel", tmp_path / "host", elementary="own")
         fmpy.extract(str(host.path), str(tmp_path / "host" / "Wheel"))
+    for extra in (None, IN_A_RUT):
+        own = run([str(linux), str(wheel_own / "binaries" / "linux64" / "Wheel.so"), *scenario(wheel_own, extra)],
+                  wheel_own)
+        assert np.all(np.isfinite(own)) and own[-1, 1 + OUTPUTS.index("Fx")] > 100
+        libm = linux64_run if extra is None else run(
+            [str(linux_libm), str(wheel_all / "binaries" / "linux64" / "Wheel.so"), *scenario(wheel_all, extra)],
+            wheel_all)
+        np.testing.assert_allclose(own, libm, rtol=1e-12, atol=1e-12)
+        if extra is not None:  # the own functions round differently from glibc's somewhere in the run
+            assert not np.array_equal(own, libm)
         np.testing.assert_array_equal(
-            run([str(linux), str(tmp_path / "host" / "Wheel" / "binaries" / "linux64" / "Wheel.so"),
-                 *scenario(wheel_own)], wheel_own), own)
+            run([qemu, "-L", str(AARCH64_SYSROOT), str(arm), str(wheel_own / "binaries" / "aarch64-linux" / "Wheel.so"),
+                 *scenario(wheel_own, extra)], wheel_own), own)
+        np.testing.assert_array_equal(run([wine, windows.name, "Wheel.dll", *scenario(wheel_own, extra)], folder, env),
+                                      own)
+        if host is not None:
+            np.testing.assert_array_equal(
+                run([str(linux), str(tmp_path / "host" / "Wheel" / "binaries" / "linux64" / "Wheel.so"),
+                     *scenario(wheel_own, extra)], wheel_own), own)
 
 
 def pe_exports(library: Path) -> set[str]:

@@ -1,11 +1,12 @@
 /* The wheel contact's quadrature as vector code: Fx, Fz and Tx of RoverTerramechanics.Functions.
- * contactForces for a wheel without grousers, slip-sinkage, rut or slip angle (the paper's wheel),
+ * contactForces for a wheel without grousers, slip-sinkage or rut (the paper's wheel, steered or not),
  * computed stage by stage over all nodes (angles, every sine and cosine, the normal stresses, every
  * exp, the sums) with sine, cosine, exp and log as polynomials in loops without calls or branches,
  * which the compiler turns into vector code. The generated model code calls it in place of
  * CasADi's node-by-node code of contactResidual where the wheel is such a wheel, and calls
  * CasADi's code otherwise (fmubuild/contact.py); the derivatives stay CasADi's.
  *
+ * With the lateral terms of a wheel at a slip angle (lateralShear and the sidewall's pile).
  * The same quadrature and the same order of every operation and sum as contactForces (front and
  * rear node of each pair in turn); only sine, cosine, exp and the power law's (r depth)^n =
  * exp(n log(r depth)) (n != 1) are computed otherwise than by the C library. Their limits:
@@ -108,14 +109,24 @@ static void rc_log_array(const double *x, double *out, int count) {
     }
 }
 
+/* The lateral terms of contactForces at a slip angle (Ishigami et al. 2007): tan of the slip angle,
+ * the lateral shear modulus ky [m] at it, Hegedus' D1 and D2, the soil's density rho [kg/m^3] and
+ * gravity [m/s^2]; the sums sumFy [Pa] and sumPile [N/m] come back in it. */
+typedef struct {
+    double tanBeta, ky, d1, d2, rho, gravity;
+    double sumFy, sumPile;
+} RcLateral;
+
 /* Fx, Fz, Tx [N, N, N m] (out[0..2]) of contactForces at the entry and exit angles thetaF =
  * acos(1 - h/r), thetaR = -acos(1 - lambda h/r) [rad] the caller computed (with its elementary
  * functions) for the clamped sinkage, at slip ratio `slip`, for a soil of c [Pa], tan(phi)
- * `tanPhi`, kc [N/m^(n+1)], kphi [N/m^(n+2)], n, kx [m], a0, a1 and a wheel of radius r and
- * width b [m]; `nodes` (<= RC_CONTACT_MAX_NODES) Gauss-Legendre nodes u and weights w on [0, 1]. */
+ * `tanPhi`, kc [N/m^(n+1)], kphi [N/m^(n+2)], n, kx [m] (at the slip angle), a0, a1 and a wheel of
+ * radius r and width b [m]; `nodes` (<= RC_CONTACT_MAX_NODES) Gauss-Legendre nodes u and weights w
+ * on [0, 1]; `lateral`: NULL where contactForces skips the lateral terms (tan beta = 0), else they
+ * are summed into it. */
 static void rc_contact_forces(double thetaF, double thetaR, double slip, double c, double tanPhi, double kc,
                               double kphi, double n, double kx, double a0, double a1, double r, double b, int nodes,
-                              const double *u, const double *w, double *out) {
+                              const double *u, const double *w, RcLateral *lateral, double *out) {
     double thetaM = (a0 + a1 * slip) * thetaF;
     double dFront = thetaF - thetaM, dRear = thetaM - thetaR;
     double theta[2 * RC_CONTACT_MAX_NODES + 1], weight[2 * RC_CONTACT_MAX_NODES];
@@ -170,6 +181,26 @@ static void rc_contact_forces(double thetaF, double thetaR, double slip, double 
     out[0] = r * b * fx;
     out[1] = r * b * fz;
     out[2] = r * r * b * tx;
+    if (!lateral)
+        return;
+    {   /* lateralShear and the sidewall's pile, in contactForces' order */
+        double tanBeta = lateral->tanBeta, ky = lateral->ky, sumFy = 0, sumPile = 0;
+        for (int i = 0; i < count; i++) {
+            j[i] = r * (1 - slip) * (thetaF - theta[i]) * tanBeta;
+            arg[i] = (j[i] >= 0 ? -j[i] : j[i]) / ky;
+        }
+        rc_exp_array(arg, ex, count);
+        for (int i = 0; i < count; i++) {
+            double tauY = (c + sigma[i] * tanPhi) * (j[i] >= 0 ? 1 - ex[i] : ex[i] - 1);
+            double depth = r * (cosT[i] - cosF);
+            depth = depth > 0 ? depth : 0.0;
+            sumFy = sumFy + weight[i] * tauY;
+            double pile = c * depth + lateral->d2 * lateral->rho * lateral->gravity * (depth * depth) / 2;
+            sumPile = sumPile + weight[i] * lateral->d1 * pile * (r - depth * cosT[i]);
+        }
+        lateral->sumFy = sumFy;
+        lateral->sumPile = sumPile;
+    }
 }
 
 #if defined(__GNUC__) && !defined(__clang__)
