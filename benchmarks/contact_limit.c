@@ -63,8 +63,9 @@ void contact_scalar(const double *p, double h, double slip, const double *u, con
 void contact_vector(const double *p, double h, double slip, const double *u, const double *w, int nodes,
                     double *out) {
     double thetaF = acos(1 - h / p[R]), thetaR = -acos(1 - p[LAMBDA] * h / p[R]);
-    rc_contact_forces(thetaF, thetaR, slip, p[C], tan(p[PHI]), p[KC], p[KPHI], p[N], p[KX], p[A0], p[A1], p[R], p[B],
-                      nodes, u, w, 0, out);
+    RcContact contact = {p[C], tan(p[PHI]), p[KC], p[KPHI], p[KX], p[A0], p[A1], p[N], p[N] == 1.0, p[R], p[B],
+                         p[R], 1.0, 1.0, 0.0};
+    rc_contact_forces(&contact, thetaF, thetaR, slip, nodes, u, w, 0, out);
 }
 
 typedef void (*contact_fn)(const double *, double, double, const double *, const double *, int, double *);

@@ -3,17 +3,17 @@
 CasADi writes a Modelica function node by node, with a call of the C library per sine, cosine and
 exp; the contact's quadrature (``contactResidual``, the sinkage solve's residual with the forces)
 is most of a rover FMU's time. Where the generated code holds CasADi's function of
-``contactResidual`` for a wheel whose lateral terms are computed only at a slip angle
-(``lateralAtZero`` false: the one the sinkage solve calls), this module renames it
-``<name>_generic`` and puts a function of the old name in its place that calls
-``runtime/contact.h``'s vector code (``rc_contact_forces``) when the wheel has no grousers,
-slip-sinkage or rut (the paper's wheel, driving straight or steered), and the generic function
-otherwise. The entry and exit angles, tan(phi), the moduli at the slip angle, Hegedus' factors, the
-residual's log and the sidewall's mobilisation are computed as ``contactForces``/
-``contactResidual`` compute them, with the same elementary functions (``--elementary own``
-renames them here too); only the quadrature's sines, cosines and exps are contact.h's. The
-derivatives (Jacobians, the sinkage's implicit derivative) stay CasADi's. Measured:
-tests/test_contact_kernel.py, benchmarks/bench_contact_limit.py.
+``contactResidual`` with ``lateralAtZero`` false (the one the sinkage solve calls), this module
+renames it ``<name>_generic`` and puts a function of the old name in its place that calls
+``runtime/contact.h``'s vector code (``rc_contact_forces``): every wheel the model describes
+(grousers, slip-sinkage, a rut, a slip angle); the generic function only for arguments out of the
+vector code's range (a NaN, a slip angle within 4 degrees of 90). The entry and exit angles,
+tan(phi), the moduli at the slip angle, the sinkage exponent at the slip, the grousers'
+engagement, Hegedus' factors, the residual's log and the sidewall's mobilisation are computed as
+``contactForces``/``contactResidual`` compute them, with the same elementary functions
+(``--elementary own`` renames them here too); only the quadrature's sines, cosines, exps and the
+power law's logs are contact.h's. The derivatives (Jacobians, the sinkage's implicit derivative)
+stay CasADi's. Measured: tests/test_contact_kernel.py, benchmarks/bench_contact_limit.py.
 """
 
 from __future__ import annotations
@@ -34,7 +34,8 @@ _FUNCTION = re.compile(r"/\* contactResidual_(\d+)_0:\(([^)]*)\)->\(([^)]*)\) \*
 #: The inputs and outputs the replacement reads and writes, by contactResidual's names.
 INPUTS = ("logSinkage", "W", "slip", "soil_c", "soil_phi", "soil_kc", "soil_kphi", "soil_n", "soil_kx", "soil_a0",
           "soil_a1", "soil_lam", "soil_kxBeta", "soil_ky", "soil_kyBeta", "soil_rho", "soil_gravity", "soil_xc",
-          "soil_nSlip", "wheel_r", "wheel_b", "wheel_grouserHeight", "WMin", "slipAngle", "rutDepth")
+          "soil_nSlip", "wheel_r", "wheel_b", "wheel_grouserHeight", "wheel_grouserCount", "WMin", "slipAngle",
+          "rutDepth")
 OUTPUTS = ("residual", "h", "Fx", "Fz", "Tx", "Fy", "FySidewall")
 
 
@@ -66,35 +67,52 @@ def _replacement(name: str, nodes: int, inputs: list[str], outputs: list[str]) -
         ("residual", "residual"), ("h", "h"), ("Fx", "forces[0]"), ("Fz", "forces[1]"), ("Tx", "forces[2]"),
         ("Fy", "fy"), ("FySidewall", "sidewall")))
     return f"""
-/* contactResidual_{nodes}_0 with the quadrature of runtime/contact.h (fmubuild/contact.py): the wheel
- * without grousers, slip-sinkage or rut; CasADi's {name}_generic otherwise */
+/* contactResidual_{nodes}_0 with the quadrature of runtime/contact.h (fmubuild/contact.py); CasADi's
+ * {name}_generic for arguments out of its range */
 static int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {{
   static const casadi_real u[{nodes}] = {{{u}}};
   static const casadi_real weights[{nodes}] = {{{w}}};
   casadi_real in[{len(inputs)}], forces[3];
   int k;
   for (k = 0; k < {len(inputs)}; k++) in[k] = arg[k] ? arg[k][0] : 0;
-  if ({v("rutDepth")} != 0 || {v("soil_nSlip")} != 0 || {v("wheel_grouserHeight")} != 0
-      || !({v("logSinkage")} <= 700) || !({v("slipAngle")} > -1.5 && {v("slipAngle")} < 1.5))
+  if (!({v("logSinkage")} <= 700) || !({v("slipAngle")} > -1.5 && {v("slipAngle")} < 1.5))
     return {name}_generic(arg, res, iw, w, mem);
   {{
-  casadi_real r = {v("wheel_r")}, slip = {v("slip")}, phi = {v("soil_phi")}, beta = {v("slipAngle")};
+  casadi_real r = {v("wheel_r")}, b = {v("wheel_b")}, slip = {v("slip")};
+  casadi_real phi = {v("soil_phi")}, beta = {v("slipAngle")};
+  casadi_real gh = {v("wheel_grouserHeight")}, nSlip = {v("soil_nSlip")};
   casadi_real h = exp({v("logSinkage")}), hc = h > 0.0 ? (h < r ? h : r) : 0.0;
   casadi_real thetaF = acos(1 - hc/r), thetaR = -acos(1 - {v("soil_lam")}*hc/r);
   casadi_real load = {v("W")} > {v("WMin")} ? {v("W")} : {v("WMin")};
-  casadi_real kx = {v("soil_kx")} + {v("soil_kxBeta")}*fabs(beta), ky = {v("soil_ky")} + {v("soil_kyBeta")}*fabs(beta);
+  casadi_real ky = {v("soil_ky")} + {v("soil_kyBeta")}*fabs(beta);
   casadi_real tanBeta = tan(beta), xc = {v("soil_xc")} > 0 ? {v("soil_xc")} : 0.7853981633974483 - phi/2;
-  casadi_real tanXc = tan(xc), sumFy = 0, sumPile = 0, sidewall, fy, residual;
+  casadi_real tanXc = tan(xc), engagement, sumFy = 0, sumPile = 0, sidewall, fy, residual;
+  RcContact contact;
   RcLateral lateral;
+  contact.c = {v("soil_c")};
+  contact.tanPhi = tan(phi);
+  contact.kc = {v("soil_kc")};
+  contact.kphi = {v("soil_kphi")};
+  contact.kx = {v("soil_kx")} + {v("soil_kxBeta")}*fabs(beta);
+  contact.a0 = {v("soil_a0")};
+  contact.a1 = {v("soil_a1")};
+  contact.exponent = {v("soil_n")} + nSlip*fabs(slip);
+  contact.product = contact.exponent == 1 && nSlip == 0;
+  contact.r = r;
+  contact.b = b;
+  engagement = {v("wheel_grouserCount")}*(thetaF - thetaR)/(2*3.141592653589793);
+  engagement = engagement < 1.0 ? engagement : 1.0;
+  contact.radius = r + engagement*gh;
+  contact.ratio = contact.radius/r;
+  contact.scaleForce = contact.ratio*(1 + 2*engagement*gh/b);
+  contact.rutOverR = {v("rutDepth")}/r;
   lateral.tanBeta = tanBeta;
   lateral.ky = ky;
   lateral.d1 = 1/tanXc + tan(xc + phi);
   lateral.d2 = 1/tanXc + tan(phi)/(tanXc*tanXc);
   lateral.rho = {v("soil_rho")};
   lateral.gravity = {v("soil_gravity")};
-  rc_contact_forces(thetaF, thetaR, slip, {v("soil_c")}, tan(phi), {v("soil_kc")}, {v("soil_kphi")}, {v("soil_n")}, kx,
-                    {v("soil_a0")}, {v("soil_a1")}, r, {v("wheel_b")}, {nodes}, u, weights,
-                    tanBeta != 0 ? &lateral : 0, forces);
+  rc_contact_forces(&contact, thetaF, thetaR, slip, {nodes}, u, weights, tanBeta != 0 ? &lateral : 0, forces);
   if (tanBeta != 0) {{
     sumFy = lateral.sumFy;
     sumPile = lateral.sumPile;
@@ -102,7 +120,7 @@ static int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, ca
   residual = forces[1] > 0 ? log(forces[1]/load) : -1e3;
   sidewall = -((beta >= 0 ? 1 - exp(-r*(1 - slip)*(thetaF - thetaR)*tanBeta/ky)
                 : exp(r*(1 - slip)*(thetaF - thetaR)*tanBeta/ky) - 1)*sumPile);
-  fy = sidewall - r*{v("wheel_b")}*sumFy;
+  fy = sidewall - r*b*sumFy;
 {writes}
   }}
   (void)iw; (void)w; (void)mem;
@@ -113,7 +131,7 @@ static int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, ca
 
 @dataclass(frozen=True)
 class ContactFunction:
-    """CasADi's function of a straight-running ``contactResidual`` in generated C."""
+    """CasADi's function of a ``contactResidual`` with ``lateralAtZero`` false in generated C."""
 
     name: str           # its C name (casadi_f5, ...); the generic one becomes <name>_generic
     nodes: int          # contactForces' nNodes
@@ -138,7 +156,7 @@ def contact_functions(code: str) -> list[ContactFunction]:
 
 
 def use_contact_kernel(code: str) -> str:
-    """``code`` (CasADi's C) with each straight-running ``contactResidual`` function calling
+    """``code`` (CasADi's C) with each ``contactResidual`` function (``lateralAtZero`` false) calling
     contact.h's vector code for the wheels it covers (see the module's text), and contact.h
     included; unchanged where there is none."""
     pieces = []

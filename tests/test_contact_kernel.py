@@ -1,8 +1,8 @@
-"""The contact's quadrature as vector code in the FMUs (fmubuild.contact, runtime/contact.h): where
-the wheel has no grousers, slip-sinkage or rut the generated contactResidual calls the vector code,
-and it gives CasADi's node-by-node results to the last digits over every soil of the library and
-the whole range of sinkage, load, slip and slip angle; the sinkage it returns bit for bit, and the
-lateral outputs too where the slip angle is 0; any other wheel goes to CasADi's code unchanged."""
+"""The contact's quadrature as vector code in the FMUs (fmubuild.contact, runtime/contact.h): the
+generated contactResidual calls the vector code, and it gives CasADi's node-by-node results to the
+last digits over every soil of the library and the whole range of sinkage, load, slip and slip
+angle, with and without grousers, slip-sinkage and a rut; the sinkage it returns bit for bit, and
+the lateral outputs too where the slip angle is 0; arguments out of its range go to CasADi's code."""
 
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ class Contact:
             archive.extractall(folder, [n for n in archive.namelist() if n.startswith("sources/")])
         sources = folder / "sources"
         functions = contact.contact_functions((sources / "model_casadi.c").read_text())
-        assert len(functions) == 1, "Wheel.fmu has one straight-running contactResidual"
+        assert len(functions) == 1, "Wheel.fmu has one contactResidual with lateralAtZero false"
         assert functions[0].name.endswith("_generic"), "CasADi's function, renamed by use_contact_kernel"
         self.inputs, self.outputs = functions[0].inputs, functions[0].outputs
         (sources / "harness.c").write_text(HARNESS % {"name": functions[0].name.removesuffix("_generic")})
@@ -101,8 +101,15 @@ def test_the_vector_code_gives_casadis_forces_over_every_soil_and_the_whole_rang
         for case in range(1500):
             h = math.exp(rng.uniform(math.log(1e-6), math.log(1.2 * wheel.r)))  # past r: clamped
             beta = 0.0 if case % 2 else rng.uniform(-0.6, 0.6)
+            effects = {}  # a quarter each: none, grousers, slip-sinkage, a rut
+            if case % 4 == 1:
+                effects = {"wheel_grouserHeight": rng.uniform(0.002, 0.02), "wheel_grouserCount": rng.uniform(8, 30)}
+            elif case % 4 == 2:
+                effects = {"soil_nSlip": rng.uniform(0.05, 0.5)}
+            elif case % 4 == 3:
+                effects = {"rutDepth": rng.uniform(0.0, 0.03)}
             values = _inputs(soil, wheel, logSinkage=math.log(h), W=rng.uniform(1.0, 2000.0), slip=rng.uniform(-1, 1),
-                             slipAngle=beta)
+                             slipAngle=beta, **effects)
             ours, casadi = wheel_contact(False, values), wheel_contact(True, values)
             keys = ("Fx", "Fz", "Tx", "Fy", "FySidewall")
             scale = max(*(abs(casadi[k]) for k in keys), abs(casadi["Tx"]) / wheel.r)
@@ -118,18 +125,17 @@ def test_the_vector_code_gives_casadis_forces_over_every_soil_and_the_whole_rang
     assert worst[True] <= 3e-14 and worst[False] <= 1e-12, worst
 
 
-@pytest.mark.parametrize("change", [{"wheel_grouserHeight": 0.01, "wheel_grouserCount": 20.0}, {"soil_nSlip": 0.3},
-                                    {"rutDepth": 0.01}, {"slipAngle": 1.55}, {"logSinkage": float("nan")},
-                                    {"slipAngle": float("nan")}],
-                         ids=["grousers", "slip-sinkage", "rut", "slip-angle-near-90-deg", "nan-sinkage",
-                              "nan-slip-angle"])
-def test_any_other_wheel_goes_to_casadis_code(wheel_contact, change):
+@pytest.mark.parametrize("change", [{"slipAngle": 1.55}, {"slipAngle": -1.5}, {"logSinkage": float("nan")},
+                                    {"slipAngle": float("nan")}, {"logSinkage": 800.0}],
+                         ids=["slip-angle-near-90-deg", "minus-1.5-rad", "nan-sinkage", "nan-slip-angle",
+                              "huge-log-sinkage"])
+def test_arguments_out_of_its_range_go_to_casadis_code(wheel_contact, change):
     values = _inputs(Soil(), Wheel(), logSinkage=math.log(0.02), W=400.0, slip=0.3) | change
     ours, casadi = wheel_contact(False, values), wheel_contact(True, values)
     assert np.array_equal(np.array(list(ours.values())), np.array(list(casadi.values())), equal_nan=True)
 
 
-def test_code_without_a_straight_running_contact_is_left_as_it_is():
+def test_code_without_the_solves_contact_is_left_as_it_is():
     code = "#include <math.h>\n/* contactResidual_10_1:(logSinkage)->(residual) */\nstatic int f(void) {\n}\n"
     assert contact.use_contact_kernel(code) == code
     assert contact.gauss_legendre(10, 10)[0] == pytest.approx(0.9869532642585859, abs=1e-15)

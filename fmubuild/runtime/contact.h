@@ -1,10 +1,10 @@
 /* The wheel contact's quadrature as vector code: Fx, Fz and Tx of RoverTerramechanics.Functions.
- * contactForces for a wheel without grousers, slip-sinkage or rut (the paper's wheel, steered or not),
+ * contactForces (with grousers, slip-sinkage, a rut, at a slip angle or not),
  * computed stage by stage over all nodes (angles, every sine and cosine, the normal stresses, every
  * exp, the sums) with sine, cosine, exp and log as polynomials in loops without calls or branches,
  * which the compiler turns into vector code. The generated model code calls it in place of
- * CasADi's node-by-node code of contactResidual where the wheel is such a wheel, and calls
- * CasADi's code otherwise (fmubuild/contact.py); the derivatives stay CasADi's.
+ * CasADi's node-by-node code of contactResidual (fmubuild/contact.py; CasADi's code stays for
+ * arguments out of its range); the derivatives stay CasADi's.
  *
  * With the lateral terms of a wheel at a slip angle (lateralShear and the sidewall's pile).
  * The same quadrature and the same order of every operation and sum as contactForces (front and
@@ -17,9 +17,9 @@
  * it returns exp(-700), under 1e-304); log of a normal number x = m 2^e, sqrt(1/2) <= m < sqrt 2,
  * is e ln 2 + 2 atanh((m - 1)/(m + 1)) by its series to the 21st power. Measured against the
  * C library's code of contactForces (tests/test_contact_kernel.py, the library's soils, sinkages
- * 1 um - 1.2 r, slips -1...1): forces within 1.5e-14 of the largest force from 1 mm of sinkage on,
- * 1.2e-13 below (where cos(theta) - cos(thetaF) cancels and either code's rounding of a cosine
- * shows); benchmarks/bench_contact_limit.py times it.
+ * 1 um - 1.2 r, slips -1...1, slip angles, grousers, slip-sinkage, ruts): forces within 1.5e-14 of
+ * the largest force from 1 mm of sinkage on, 3.3e-13 below (where cos(theta) - cos(thetaF) cancels
+ * and either code's rounding of a cosine shows); benchmarks/bench_contact_limit.py times it.
  *
  * Header only, every function static (two FMUs compiled into one program share no name), no call
  * of the C library: the --elementary choice does not touch it, and it gives the same bits on every
@@ -117,17 +117,26 @@ typedef struct {
     double sumFy, sumPile;
 } RcLateral;
 
-/* Fx, Fz, Tx [N, N, N m] (out[0..2]) of contactForces at the entry and exit angles thetaF =
+/* What contactForces computes once per call from the soil, the wheel, the slip and the slip angle. */
+typedef struct {
+    double c, tanPhi, kc, kphi, kx, a0, a1;  /* soil: c [Pa], tan(phi), kc [N/m^(n+1)], kphi [N/m^(n+2)],
+                                                kx [m] at the slip angle, a0, a1 */
+    double exponent;                         /* sinkage exponent at this slip: n + nSlip |slip| */
+    int product;                             /* the power law as the product r depth (n = 1, no slip-sinkage) */
+    double r, b;                             /* wheel radius and width [m] */
+    double radius, scaleForce, ratio;        /* grousers: shear radius [m] and the shear's weights (r, 1, 1 without) */
+    double rutOverR;                         /* depth of the rut under the wheel over r (0 without) */
+} RcContact;
+
+/* Fx, Fz, Tx [N, N, N m] (out[0..2]) of contactForces for `k` at the entry and exit angles thetaF =
  * acos(1 - h/r), thetaR = -acos(1 - lambda h/r) [rad] the caller computed (with its elementary
- * functions) for the clamped sinkage, at slip ratio `slip`, for a soil of c [Pa], tan(phi)
- * `tanPhi`, kc [N/m^(n+1)], kphi [N/m^(n+2)], n, kx [m] (at the slip angle), a0, a1 and a wheel of
- * radius r and width b [m]; `nodes` (<= RC_CONTACT_MAX_NODES) Gauss-Legendre nodes u and weights w
- * on [0, 1]; `lateral`: NULL where contactForces skips the lateral terms (tan beta = 0), else they
- * are summed into it. */
-static void rc_contact_forces(double thetaF, double thetaR, double slip, double c, double tanPhi, double kc,
-                              double kphi, double n, double kx, double a0, double a1, double r, double b, int nodes,
+ * functions) for the clamped sinkage, at slip ratio `slip`; `nodes` (<= RC_CONTACT_MAX_NODES)
+ * Gauss-Legendre nodes u and weights w on [0, 1]; `lateral`: NULL where contactForces skips the
+ * lateral terms (tan beta = 0), else they are summed into it. */
+static void rc_contact_forces(const RcContact *k, double thetaF, double thetaR, double slip, int nodes,
                               const double *u, const double *w, RcLateral *lateral, double *out) {
-    double thetaM = (a0 + a1 * slip) * thetaF;
+    double r = k->r, c = k->c, tanPhi = k->tanPhi, scaleForce = k->scaleForce;
+    double thetaM = (k->a0 + k->a1 * slip) * thetaF;
     double dFront = thetaF - thetaM, dRear = thetaM - thetaR;
     double theta[2 * RC_CONTACT_MAX_NODES + 1], weight[2 * RC_CONTACT_MAX_NODES];
     double sinT[2 * RC_CONTACT_MAX_NODES + 1], cosT[2 * RC_CONTACT_MAX_NODES + 1];
@@ -144,12 +153,12 @@ static void rc_contact_forces(double thetaF, double thetaR, double slip, double 
     }
     theta[count] = thetaF;
     rc_sincos_array(theta, sinT, cosT, count + 1);
-    double sinF = sinT[count], cosF = cosT[count], scale = kc / b + kphi;
+    double sinF = sinT[count], cosF = cosT[count], scale = k->kc / k->b + k->kphi;
     for (int i = 0; i < nodes; i++) {  /* Eq. (5) at the front node; Eq. (6)'s rear node has the same */
         double depth = cosT[2 * i] - cosF;
-        base[i] = depth > 0 ? depth : 0.0;
+        base[i] = k->rutOverR + (depth > 0 ? depth : 0.0);
     }
-    if (n == 1.0) {
+    if (k->product) {
         for (int i = 0; i < nodes; i++)
             sigma[2 * i] = scale * (r * base[i]);
     } else {  /* r^n depth^n = exp(n log(r depth)); 0 where the depth is 0 */
@@ -159,25 +168,26 @@ static void rc_contact_forces(double thetaF, double thetaR, double slip, double 
         }
         rc_log_array(power, logs, nodes);
         for (int i = 0; i < nodes; i++)
-            logs[i] *= n;
+            logs[i] *= k->exponent;
         rc_exp_array(logs, power, nodes);
         for (int i = 0; i < nodes; i++)
             sigma[2 * i] = base[i] > 0 ? scale * power[i] : 0.0;
     }
     for (int i = 0; i < nodes; i++)
         sigma[2 * i + 1] = sigma[2 * i];
-    for (int i = 0; i < count; i++) {  /* Eq. (10) and the argument of Eqs. (8)-(9)'s exp */
-        j[i] = r * (thetaF - theta[i] - (1 - slip) * (sinF - sinT[i]));
-        arg[i] = (j[i] >= 0 ? -j[i] : j[i]) / kx;
+    for (int i = 0; i < count; i++) {  /* Eq. (10) at the shear radius and the argument of Eqs. (8)-(9)'s exp */
+        j[i] = k->radius * (thetaF - theta[i] - (1 - slip) * (sinF - sinT[i]));
+        arg[i] = (j[i] >= 0 ? -j[i] : j[i]) / k->kx;
     }
     rc_exp_array(arg, ex, count);
     double fx = 0, fz = 0, tx = 0;
     for (int i = 0; i < count; i++) {  /* Eqs. (11)-(13), in contactForces' order */
         double tau = (c + sigma[i] * tanPhi) * (j[i] >= 0 ? 1 - ex[i] : ex[i] - 1);
-        fz = fz + weight[i] * (sigma[i] * cosT[i] + tau * sinT[i]);
-        fx = fx + weight[i] * (tau * cosT[i] - sigma[i] * sinT[i]);
-        tx = tx + weight[i] * tau;
+        fz = fz + weight[i] * (sigma[i] * cosT[i] + tau * scaleForce * sinT[i]);
+        fx = fx + weight[i] * (tau * scaleForce * cosT[i] - sigma[i] * sinT[i]);
+        tx = tx + weight[i] * (tau * scaleForce * k->ratio);
     }
+    double b = k->b;
     out[0] = r * b * fx;
     out[1] = r * b * fz;
     out[2] = r * r * b * tx;
