@@ -85,8 +85,7 @@ static int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, ca
   casadi_real thetaF = acos(1 - hc/r), thetaR = -acos(1 - {v("soil_lam")}*hc/r);
   casadi_real load = {v("W")} > {v("WMin")} ? {v("W")} : {v("WMin")};
   casadi_real ky = {v("soil_ky")} + {v("soil_kyBeta")}*fabs(beta);
-  casadi_real tanBeta = tan(beta), xc = {v("soil_xc")} > 0 ? {v("soil_xc")} : 0.7853981633974483 - phi/2;
-  casadi_real tanXc = tan(xc), engagement, sumFy = 0, sumPile = 0, sidewall, fy, residual;
+  casadi_real tanBeta = tan(beta), engagement, sumFy = 0, sumPile = 0, sidewall, fy, residual;
   RcContact contact;
   RcLateral lateral;
   contact.c = {v("soil_c")};
@@ -106,12 +105,15 @@ static int {name}(const casadi_real** arg, casadi_real** res, casadi_int* iw, ca
   contact.ratio = contact.radius/r;
   contact.scaleForce = contact.ratio*(1 + 2*engagement*gh/b);
   contact.rutOverR = {v("rutDepth")}/r;
-  lateral.tanBeta = tanBeta;
-  lateral.ky = ky;
-  lateral.d1 = 1/tanXc + tan(xc + phi);
-  lateral.d2 = 1/tanXc + tan(phi)/(tanXc*tanXc);
-  lateral.rho = {v("soil_rho")};
-  lateral.gravity = {v("soil_gravity")};
+  if (tanBeta != 0) {{  /* the lateral terms, as contactForces computes them only then */
+    casadi_real xc = {v("soil_xc")} > 0 ? {v("soil_xc")} : 0.7853981633974483 - phi/2, tanXc = tan(xc);
+    lateral.tanBeta = tanBeta;
+    lateral.ky = ky;
+    lateral.d1 = 1/tanXc + tan(xc + phi);
+    lateral.d2 = 1/tanXc + contact.tanPhi/(tanXc*tanXc);
+    lateral.rho = {v("soil_rho")};
+    lateral.gravity = {v("soil_gravity")};
+  }}
   rc_contact_forces(&contact, thetaF, thetaR, slip, {nodes}, u, weights, tanBeta != 0 ? &lateral : 0, forces);
   if (tanBeta != 0) {{
     sumFy = lateral.sumFy;
