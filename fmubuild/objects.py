@@ -18,7 +18,6 @@ import fcntl
 import hashlib
 import os
 import subprocess
-import tempfile
 import time
 from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -103,7 +102,7 @@ def compile_object(toolchain: Toolchain, sources: Path, c_file: str, out: Path,
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
             if not target.is_file():
-                partial = Path(tempfile.mkstemp(dir=shared.folder, prefix=f".{key}-", suffix=".o")[1])
+                partial = shared.folder / f".{key}.partial.o"  # the lock makes the name ours
                 try:
                     _run(_compile_command(toolchain, c_file, partial), sources,
                          f"the C compiler failed on {c_file}")
